@@ -1,0 +1,411 @@
+"""One event of the chain, integrated with fixed-step RK4 on the active set.
+
+Only sliding blocks are integrated. Blocks at rest that neighbour a sliding
+block are checked for onset after every step; all other blocks at rest can only
+start by loading, and their earliest analytic onset time `t_far` is tracked so
+that it is only recomputed when the event actually reaches it.
+
+A step in which a block sticks (v reaches 0) or starts (its force reaches the
+static threshold) is cut at that instant, located on the cubic Hermite
+interpolant of the step, and redone with the shorter step. Clamping v to zero at
+the end of a step instead would make the slip only second-order accurate.
+
+Work arrays (see `workspace.py`): rows of the float array `W` hold per-block
+quantities, `act` the active list, `flag` 0 (never slid in this event), 1
+(sliding), 2 (slid and now at rest), `touched` the blocks that slid.
+"""
+import math
+
+import numba as nb
+import numpy as np
+
+from .friction import friction, spring_force, state_rate
+from .onset import onset_delay
+from .workspace import (D_DURATION, D_FIRST, D_LAST, D_NSLIP, D_RESIDUAL, D_SLIP, D_STEPS,
+                        D_VMAX, D_WORK, F0, HD0, HD1, K1V, KP, KV, KY, NONFINITE, OK, P, P0, PS,
+                        SP, SV, SY, TOO_LONG, TR, UNSTABLE, V, V0, VS, Y, Y0, YS)
+
+# Stability limit of classical RK4 on the negative real axis: the state equation
+# relaxes at rate 1/theta (= v in steady sliding), so dt / theta must stay below it.
+RK4_STABILITY = 2.785
+_BISECT = 60
+
+
+@nb.njit(cache=True, inline="always")
+def _left(i):
+    return i - 1 if i > 0 else i
+
+
+@nb.njit(cache=True, inline="always")
+def _right(i, n):
+    return i + 1 if i < n - 1 else i
+
+
+@nb.njit(cache=True, inline="always")
+def _hermite(x, y0, y1, d0, d1):
+    """Cubic Hermite on [0, 1] with end values y0, y1 and end slopes d0, d1 (per unit x)."""
+    x2 = x * x
+    x3 = x2 * x
+    return ((2 * x3 - 3 * x2 + 1) * y0 + (x3 - 2 * x2 + x) * d0
+            + (3 * x2 - 2 * x3) * y1 + (x3 - x2) * d1)
+
+
+@nb.njit(cache=True, inline="always")
+def _rest_psi(W, j, tau):
+    """psi of a block at rest since local time TR: ln(theta_rest + tau - TR)."""
+    return W[P, j] + math.log1p((tau - W[TR, j]) * math.exp(-W[P, j]))
+
+
+@nb.njit(cache=True)
+def _stage(W, act, na, n, tau, l2, nu, a, b, yrest):
+    """Derivatives of all active blocks at stage state (YS, VS, PS) into KY, KV, KP.
+
+    Returns the friction power sum(Phi v) and the total slip sum(y) at the stage
+    (for the energy balance).
+    """
+    power = 0.0
+    ysum = yrest
+    for k in range(na):
+        i = act[k]
+        v = W[VS, i]
+        psi = W[PS, i]
+        phi = friction(v, psi, a, b)
+        W[KY, i] = v
+        W[KV, i] = spring_force(W[F0, i], tau, nu, l2, W[YS, _left(i)], W[YS, i],
+                                W[YS, _right(i, n)]) - phi
+        W[KP, i] = state_rate(v, psi)
+        if v > 0.0:
+            power += phi * v
+        ysum += W[YS, i]
+    return power, ysum
+
+
+@nb.njit(cache=True)
+def _rk4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest):
+    """Advance the active blocks from the step-start values (Y0, V0, P0) by h.
+
+    Resting blocks keep YS == Y, so neighbour slips are read from YS throughout.
+    Returns the RK4 quadratures of the friction power and of the total slip.
+    """
+    pw = 0.0
+    ys = 0.0
+    for stage in range(4):
+        if stage == 0:
+            frac, weight = 0.0, 1.0
+        elif stage == 3:
+            frac, weight = 1.0, 1.0
+        else:
+            frac, weight = 0.5, 2.0
+        if stage > 0:
+            for k in range(na):
+                i = act[k]
+                W[YS, i] = W[Y0, i] + frac * h * W[KY, i]
+                W[VS, i] = W[V0, i] + frac * h * W[KV, i]
+                W[PS, i] = W[P0, i] + frac * h * W[KP, i]
+        else:
+            for k in range(na):
+                i = act[k]
+                W[YS, i] = W[Y0, i]
+                W[VS, i] = W[V0, i]
+                W[PS, i] = W[P0, i]
+        power, ysum = _stage(W, act, na, n, tau + frac * h, l2, nu, a, b, yrest)
+        pw += weight * power
+        ys += weight * ysum
+        for k in range(na):
+            i = act[k]
+            if stage == 0:
+                W[K1V, i] = W[KV, i]
+                W[SY, i] = W[KY, i]
+                W[SV, i] = W[KV, i]
+                W[SP, i] = W[KP, i]
+            else:
+                W[SY, i] += weight * W[KY, i]
+                W[SV, i] += weight * W[KV, i]
+                W[SP, i] += weight * W[KP, i]
+    for k in range(na):
+        i = act[k]
+        W[Y, i] = W[Y0, i] + h / 6.0 * W[SY, i]
+        W[V, i] = W[V0, i] + h / 6.0 * W[SV, i]
+        W[P, i] = W[P0, i] + h / 6.0 * W[SP, i]
+        W[YS, i] = W[Y, i]
+    return pw * h / 6.0, ys * h / 6.0
+
+
+@nb.njit(cache=True)
+def _slip_at(W, flag, j, x):
+    """Slip of block j at fraction x of the current step (Hermite if it slides)."""
+    if flag[j] != 1:
+        return W[Y, j]
+    return _hermite(x, W[Y0, j], W[Y, j], W[HD0, j], W[HD1, j])
+
+
+@nb.njit(cache=True)
+def _excess(W, flag, n, j, tau, h, x, l2, nu, b):
+    """Force above the static threshold of resting block j at fraction x of the step."""
+    s = tau + x * h
+    yl = _slip_at(W, flag, _left(j), x)
+    yr = _slip_at(W, flag, _right(j, n), x)
+    return spring_force(W[F0, j], s, nu, l2, yl, W[Y, j], yr) - b * _rest_psi(W, j, s)
+
+
+@nb.njit(cache=True)
+def _force_now(W, n, j, tau, l2, nu):
+    return spring_force(W[F0, j], tau, nu, l2, W[Y, _left(j)], W[Y, j], W[Y, _right(j, n)])
+
+
+@nb.njit(cache=True)
+def _excess_now(W, n, j, tau, l2, nu, b):
+    """Force above the static threshold of resting block j at the current time."""
+    return _force_now(W, n, j, tau, l2, nu) - b * _rest_psi(W, j, tau)
+
+
+@nb.njit(cache=True)
+def _adjacent_to_active(flag, n, j):
+    return flag[_left(j)] == 1 or flag[_right(j, n)] == 1
+
+
+@nb.njit(cache=True)
+def _loading_onset(W, flag, n, j, tau, l2, nu, b):
+    """Local time at which resting block j starts by loading alone (inf if it is watched)."""
+    if flag[j] == 1 or _adjacent_to_active(flag, n, j):
+        return np.inf
+    return tau + onset_delay(_force_now(W, n, j, tau, l2, nu), _rest_psi(W, j, tau), nu, b)
+
+
+@nb.njit(cache=True)
+def _earliest_loading_onset(W, flag, n, tau, l2, nu, b):
+    best = np.inf
+    who = -1
+    for j in range(n):
+        t = _loading_onset(W, flag, n, j, tau, l2, nu, b)
+        if t < best:
+            best = t
+            who = j
+    return best, who
+
+
+@nb.njit(cache=True)
+def _start(W, act, na, flag, touched, nt, j, tau, yrest):
+    """Block j starts to slide at local time tau; returns (na, nt, yrest)."""
+    if flag[j] == 2:
+        yrest -= W[Y, j]
+    else:
+        touched[nt] = j
+        nt += 1
+    W[P, j] = _rest_psi(W, j, tau)
+    W[V, j] = 0.0
+    flag[j] = 1
+    act[na] = j
+    return na + 1, nt, yrest
+
+
+@nb.njit(cache=True)
+def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu, a, b, dt,
+                    t_far, max_duration, max_steps, diag):
+    """Integrate one event from the onset of `epicenter` until every block is at rest.
+
+    On entry W[F0] holds the force and W[P] the state psi of every block at the
+    onset (all at rest, c-free frame), all other rows and `flag` are zero.
+    `v_start` is the epicenter's initial velocity (0 for a natural onset),
+    `t_far` a lower bound of the loading onset time of every other block.
+    On return W[F0] and W[P] hold the state at the end of the event (all at
+    rest again), the other rows and `flag` are zero, and `diag` holds the event
+    summary (see workspace.D_*). Returns a status code (workspace.OK, ...).
+    """
+    na, nt, yrest = _start(W, act, 0, flag, touched, 0, epicenter, 0.0, 0.0)
+    W[V, epicenter] = v_start
+    tau = 0.0
+    work = 0.0
+    slip_time = 0.0
+    steps = 0
+    vmax = v_start
+    status = OK
+    while na > 0:
+        if steps >= max_steps or tau > max_duration:
+            status = TOO_LONG
+            break
+        for k in range(na):
+            i = act[k]
+            W[Y0, i] = W[Y, i]
+            W[V0, i] = W[V, i]
+            W[P0, i] = W[P, i]
+        h = dt
+        dwork, dslip = _rk4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest)
+        # Earliest transition inside the step, as a fraction x of it; the slip
+        # of a sliding block inside the step is the Hermite cubic with these slopes.
+        for k in range(na):
+            i = act[k]
+            W[HD0, i] = h * W[V0, i]
+            W[HD1, i] = h * W[V, i]
+        x_cut = 2.0
+        who = -1
+        kind = 0  # 1 stick, 2 onset next to a sliding block, 3 onset by loading
+        for k in range(na):
+            i = act[k]
+            if W[V, i] <= 0.0 and W[V0, i] > 0.0:
+                a_end = spring_force(W[F0, i], tau + h, nu, l2, W[Y, _left(i)], W[Y, i],
+                                     W[Y, _right(i, n)]) - friction(W[V, i], W[P, i], a, b)
+                d0 = h * W[K1V, i]
+                d1 = h * a_end
+                lo = 0.0
+                hi = 1.0
+                for _ in range(_BISECT):
+                    mid = 0.5 * (lo + hi)
+                    if _hermite(mid, W[V0, i], W[V, i], d0, d1) > 0.0:
+                        lo = mid
+                    else:
+                        hi = mid
+                if hi < x_cut:
+                    x_cut = hi
+                    who = i
+                    kind = 1
+        for k in range(na):
+            i = act[k]
+            for j in (_left(i), _right(i, n)):
+                if flag[j] == 1 or j == i:
+                    continue
+                if _excess(W, flag, n, j, tau, h, 1.0, l2, nu, b) > 0.0:
+                    lo = 0.0
+                    hi = 1.0
+                    if _excess(W, flag, n, j, tau, h, 0.0, l2, nu, b) >= 0.0:
+                        hi = 0.0
+                    for _ in range(_BISECT):
+                        if hi == 0.0:
+                            break
+                        mid = 0.5 * (lo + hi)
+                        if _excess(W, flag, n, j, tau, h, mid, l2, nu, b) > 0.0:
+                            hi = mid
+                        else:
+                            lo = mid
+                    if hi < x_cut:
+                        x_cut = hi
+                        who = j
+                        kind = 2
+        if t_far <= tau + h:
+            t_far, far = _earliest_loading_onset(W, flag, n, tau, l2, nu, b)
+            if t_far <= tau + h:
+                x = max(t_far - tau, 0.0) / h
+                if x < x_cut:
+                    x_cut = x
+                    who = far
+                    kind = 3
+        if kind != 0 and x_cut < 1.0:
+            h = x_cut * h
+            dwork, dslip = _rk4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest)
+        tau += h
+        steps += 1
+        work += dwork
+        slip_time += dslip
+        # Health of the step.
+        for k in range(na):
+            i = act[k]
+            v = W[V, i]
+            if not (math.isfinite(v) and math.isfinite(W[P, i]) and math.isfinite(W[Y, i])):
+                status = NONFINITE
+            rate = max(v, math.exp(-W[P, i]))
+            if v > vmax:
+                vmax = v
+            if h * rate > RK4_STABILITY and status == OK:
+                status = UNSTABLE
+        if status != OK:
+            break
+        # Transitions at tau: the located one, then anything that crossed with it.
+        if kind == 2 or kind == 3:
+            na, nt, yrest = _start(W, act, na, flag, touched, nt, who, tau, yrest)
+            W[V, who] = 0.0
+            if kind == 3:
+                t_far = -np.inf  # recompute on the next step
+        if kind == 1:
+            W[V, who] = 0.0
+        m = 0
+        nstuck = 0
+        for k in range(na):
+            i = act[k]
+            if W[V, i] <= 0.0 and not (i == who and kind >= 2):
+                # Blocks never move backward: a block that started this step
+                # but could not move keeps its slip.
+                if W[Y, i] < W[Y0, i]:
+                    W[Y, i] = W[Y0, i]
+                W[V, i] = 0.0
+                W[TR, i] = tau
+                W[YS, i] = W[Y, i]
+                flag[i] = 2
+                yrest += W[Y, i]
+                stuck[nstuck] = i
+                nstuck += 1
+            else:
+                act[m] = i
+                m += 1
+        na = m
+        for k in range(na):
+            i = act[k]
+            for j in (_left(i), _right(i, n)):
+                if flag[j] != 1 and j != i:
+                    if _excess_now(W, n, j, tau, l2, nu, b) > 0.0:
+                        na, nt, yrest = _start(W, act, na, flag, touched, nt, j, tau, yrest)
+        # Blocks no longer watched by a sliding neighbour may only start by
+        # loading: fold their analytic onset into t_far.
+        for k in range(nstuck):
+            i = stuck[k]
+            for j in (_left(i), i, _right(i, n)):
+                t = _loading_onset(W, flag, n, j, tau, l2, nu, b)
+                if t < t_far:
+                    t_far = t
+    _finish_event(W, flag, touched, nt, n, tau, l2, nu, work, slip_time, diag)
+    diag[D_STEPS] = steps
+    diag[D_VMAX] = vmax
+    return status
+
+
+@nb.njit(cache=True)
+def _finish_event(W, flag, touched, nt, n, tau, l2, nu, work, slip_time, diag):
+    """Summarise the event, move every block's state to the end time, clear the work rows."""
+    slip = 0.0
+    first = n
+    last = -1
+    nslip = 0
+    # Energy balance in the c-free frame (derivation in docs of workspace.py):
+    # dE - W_load = -sum(y F0) + sum(y^2)/2 + l2 sum(dy^2)/2 - nu tau sum(y) + nu int(sum y)
+    e_change = 0.0
+    for k in range(nt):
+        i = touched[k]
+        y = W[Y, i]
+        if y > 0.0:
+            slip += y
+            nslip += 1
+            first = min(first, i)
+            last = max(last, i)
+        e_change += -y * W[F0, i] + 0.5 * y * y
+        if i + 1 < n:
+            e_change += 0.5 * l2 * (W[Y, i + 1] - y) ** 2
+        if i - 1 >= 0 and flag[i - 1] == 0:
+            e_change += 0.5 * l2 * (y - W[Y, i - 1]) ** 2
+    e_change += -nu * tau * slip + nu * slip_time
+    diag[D_DURATION] = tau
+    diag[D_SLIP] = slip
+    diag[D_FIRST] = first
+    diag[D_LAST] = last
+    diag[D_NSLIP] = nslip
+    diag[D_WORK] = work
+    diag[D_RESIDUAL] = e_change + work
+    # New forces: loading during the event for everybody, slip for the touched
+    # blocks and their neighbours (free ends: an end block has one spring).
+    for i in range(n):
+        W[F0, i] += nu * tau
+        W[P, i] += math.log1p((tau - W[TR, i]) * math.exp(-W[P, i]))
+    for k in range(nt):
+        i = touched[k]
+        y = W[Y, i]
+        deg = (1 if i > 0 else 0) + (1 if i < n - 1 else 0)
+        W[F0, i] -= (1.0 + l2 * deg) * y
+        if i > 0:
+            W[F0, i - 1] += l2 * y
+        if i < n - 1:
+            W[F0, i + 1] += l2 * y
+    for k in range(nt):
+        i = touched[k]
+        W[Y, i] = 0.0
+        W[YS, i] = 0.0
+        W[V, i] = 0.0
+        W[TR, i] = 0.0
+        flag[i] = 0

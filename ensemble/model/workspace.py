@@ -1,0 +1,62 @@
+"""Work arrays shared by the event kernels, and the codes they return.
+
+The float work array W has one row per per-block quantity (index constants
+below) and N columns. Between events only two rows carry state:
+
+    W[F0]  force on each block, c-free frame: F_i = (nu t - u_i - c) + l^2 (lap u)_i
+    W[P]   psi_i = ln(theta_i)
+
+All other rows are scratch that the event integrator leaves zeroed.
+
+Energy balance of an event (c-free frame, x = u + c - nu t, slips y since onset,
+duration tau, W_f = int sum(Phi v) dt the friction work, W_load the work of the driver):
+
+    dE_elastic - W_load = -sum(y F0) + sum(y^2)/2 + l^2 sum((dy)^2)/2
+                          - nu tau sum(y) + nu int_0^tau sum(y) dt
+
+so residual = dE_elastic + W_f - W_load needs only the blocks that slipped.
+"""
+import numpy as np
+
+# rows of W
+Y, V, P, TR, F0, YS, VS, PS, Y0, V0, P0, KY, KV, KP, SY, SV, SP, K1V, HD0, HD1 = range(20)
+NROWS = 20
+
+# entries of the per-event diagnostics vector
+(D_DURATION, D_SLIP, D_FIRST, D_LAST, D_NSLIP, D_WORK, D_RESIDUAL, D_STEPS, D_VMAX) = range(9)
+NDIAG = 9
+
+# status codes of the kernels
+OK, NONFINITE, UNSTABLE, TOO_LONG = 0, 1, 2, 3
+STATUS_TEXT = {
+    NONFINITE: "non-finite state (numerical blow-up)",
+    UNSTABLE: "step beyond the stability limit of RK4 (dt / theta > 2.785); reduce integrator.dt",
+    TOO_LONG: "event exceeded integrator.max_duration (stable sliding? b below the block stiffness?)",
+}
+
+
+class Workspace:
+    """Scratch arrays for one chain of n blocks (allocate once per task)."""
+
+    def __init__(self, n):
+        self.W = np.zeros((NROWS, n))
+        self.act = np.zeros(n, dtype=np.int64)
+        self.flag = np.zeros(n, dtype=np.int8)
+        self.touched = np.zeros(n, dtype=np.int64)
+        self.stuck = np.zeros(n, dtype=np.int64)
+        self.diag = np.zeros(NDIAG)
+
+    def load(self, force, psi):
+        """Set the between-events state (force and psi of every block)."""
+        self.W[:] = 0.0
+        self.flag[:] = 0
+        self.W[F0] = force
+        self.W[P] = psi
+
+    @property
+    def force(self):
+        return self.W[F0]
+
+    @property
+    def psi(self):
+        return self.W[P]
