@@ -59,6 +59,7 @@ def simulate_rk4(W, act, flag, touched, stuck, diag, clock, l2, nu, a, b, dt, ma
     other than OK the state is that after the failed event, which is not counted.
     """
     n = W.shape[1]
+    no_profile = np.empty(0)
     for k in range(n_events):
         epicenter, delay, runner_up = next_onset(W, n, nu, b)
         load_quietly(W, n, nu, delay)
@@ -67,7 +68,8 @@ def simulate_rk4(W, act, flag, touched, stuck, diag, clock, l2, nu, a, b, dt, ma
         W[F0, epicenter] = b * W[P, epicenter]
         advance_clock(clock, delay)
         status = integrate_event(W, act, flag, touched, stuck, n, epicenter, 0.0, l2, nu, a,
-                                 b, dt, runner_up - delay, max_duration, max_steps, diag)
+                                 b, dt, runner_up - delay, max_duration, max_steps, diag,
+                                 no_profile)
         if status != OK:
             return status, k
         out_t[k] = clock[0] + clock[1]

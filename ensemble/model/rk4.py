@@ -201,7 +201,7 @@ def _start(W, act, na, flag, touched, nt, j, tau, yrest):
 
 @nb.njit(cache=True)
 def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu, a, b, dt,
-                    t_far, max_duration, max_steps, diag):
+                    t_far, max_duration, max_steps, diag, profile):
     """Integrate one event from the onset of `epicenter` until every block is at rest.
 
     On entry W[F0] holds the force and W[P] the state psi of every block at the
@@ -210,7 +210,8 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
     `t_far` a lower bound of the loading onset time of every other block.
     On return W[F0] and W[P] hold the state at the end of the event (all at
     rest again), the other rows and `flag` are zero, and `diag` holds the event
-    summary (see workspace.D_*). Returns a status code (workspace.OK, ...).
+    summary (see workspace.D_*). If `profile` has n entries it receives the
+    slip of every block (else pass an empty array). Returns a status code.
     """
     na, nt, yrest = _start(W, act, 0, flag, touched, 0, epicenter, 0.0, 0.0)
     W[V, epicenter] = v_start
@@ -351,6 +352,10 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
                 t = _loading_onset(W, flag, n, j, tau, l2, nu, b)
                 if t < t_far:
                     t_far = t
+    if profile.shape[0] == n:
+        profile[:] = 0.0
+        for k in range(nt):
+            profile[touched[k]] = W[Y, touched[k]]
     _finish_event(W, flag, touched, nt, n, tau, l2, nu, work, slip_time, diag)
     diag[D_STEPS] = steps
     diag[D_VMAX] = vmax

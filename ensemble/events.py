@@ -1,0 +1,73 @@
+"""Single events from a given state: the entry point for tests and benchmarks."""
+from dataclasses import dataclass
+
+import numpy as np
+
+from .integrators import INTEGRATORS
+from .model.chain import load_quietly, next_onset
+from .model.workspace import (D_DURATION, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK, OK,
+                              STATUS_TEXT, Workspace)
+
+
+@dataclass
+class EventResult:
+    status: int
+    slip: float             # sum of the slips
+    duration: float
+    steps: int
+    vmax: float
+    friction_work: float    # int sum(Phi v) dt, c-free frame
+    energy_residual: float  # dE_elastic + friction work - loading work
+    profile: np.ndarray     # slip of every block
+    force: np.ndarray       # state after the event (c-free frame)
+    psi: np.ndarray
+
+    @property
+    def relative_energy_residual(self):
+        """Residual over the friction work (both in the c-free frame)."""
+        return abs(self.energy_residual) / abs(self.friction_work)
+
+
+def physical_state(u, theta, t, model):
+    """Displacements u_i, states theta_i at time t -> (force, psi) in the c-free frame.
+
+    force_i = (nu t - u_i) + l^2 (u_{i+1} - 2 u_i + u_{i-1}) - c with free ends.
+    """
+    u = np.asarray(u, dtype=float)
+    lap = np.zeros_like(u)
+    lap[:-1] += u[1:] - u[:-1]
+    lap[1:] += u[:-1] - u[1:]
+    force = (model.nu * t - u) + model.l ** 2 * lap - model.c
+    return force, np.log(np.asarray(theta, dtype=float))
+
+
+def advance_to_onset(force, psi, model):
+    """Load quietly until the next onset: (epicenter, delay, force, psi) at the onset."""
+    ws = Workspace(len(force))
+    ws.load(force, psi)
+    epicenter, delay, _ = next_onset(ws.W, len(force), model.nu, model.b)
+    load_quietly(ws.W, len(force), model.nu, delay)
+    return epicenter, delay, ws.force.copy(), ws.psi.copy()
+
+
+def run_event(force, psi, epicenter, model, integrator, v_start=0.0):
+    """Integrate one event from the given onset state; returns an EventResult."""
+    n = len(force)
+    ws = Workspace(n)
+    ws.load(force, psi)
+    profile = np.zeros(n)
+    max_steps = int(min(2 * integrator.max_duration / integrator.dt + 1e6, 2**62))
+    status = INTEGRATORS[integrator.method].event(
+        ws.W, ws.act, ws.flag, ws.touched, ws.stuck, n, epicenter, v_start, model.l ** 2,
+        model.nu, model.a, model.b, integrator.dt, -np.inf, integrator.max_duration, max_steps,
+        ws.diag, profile)
+    d = ws.diag
+    return EventResult(status, d[D_SLIP], d[D_DURATION], int(d[D_STEPS]), d[D_VMAX], d[D_WORK],
+                       d[D_RESIDUAL], profile, ws.force.copy(), ws.psi.copy())
+
+
+def check(result, what="event"):
+    """Raise if an EventResult failed."""
+    if result.status != OK:
+        raise RuntimeError(f"{what}: {STATUS_TEXT[result.status]}")
+    return result

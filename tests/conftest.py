@@ -1,0 +1,64 @@
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ensemble.config import Integrator, Model, Run
+from ensemble.events import advance_to_onset, check, run_event
+from ensemble.model.chain import simulate_rk4
+from ensemble.model.workspace import NDIAG, Workspace
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def developed_state(model, events, seed=1, dt=1e-3):
+    """(force, psi) of a chain after `events` events from a random start."""
+    rng = np.random.default_rng(seed)
+    ws = Workspace(model.N)
+    ws.load(-rng.random(model.N), np.zeros(model.N))
+    clock = np.zeros(2)
+    t = np.empty(events)
+    epi = np.empty(events, dtype=np.int64)
+    diag = np.empty((events, NDIAG))
+    status, k = simulate_rk4(ws.W, ws.act, ws.flag, ws.touched, ws.stuck, ws.diag, clock,
+                             model.l ** 2, model.nu, model.a, model.b, dt, 1e5, 10**9, events,
+                             t, epi, diag)
+    assert status == 0
+    return ws.force.copy(), ws.psi.copy()
+
+
+def next_event(force, psi, model, dt, v_start=0.0):
+    """Jump to the next onset and integrate that event with fixed-step RK4 at dt."""
+    epicenter, _, f, p = advance_to_onset(force, psi, model)
+    f[epicenter] = model.b * p[epicenter]
+    return epicenter, check(run_event(f, p, epicenter, model, Integrator(dt=dt), v_start))
+
+
+def run_cli(*args, cwd=None):
+    env = dict(os.environ, NUMBA_CACHE_DIR=os.environ.get("NUMBA_CACHE_DIR", str(ROOT / ".numba_cache")))
+    return subprocess.run([sys.executable, "-m", "ensemble", *map(str, args)], cwd=cwd,
+                          capture_output=True, text=True, env=env)
+
+
+def write_config(path, **sections):
+    """A small config file: sections given as dicts override the test defaults."""
+    base = {"model": {"N": 60, "b": 20.0}, "run": {"events": 40, "transient": 20, "seeds": 2},
+            "integrator": {"dt": 1e-3}, "output": {"path": str(path.with_suffix(".h5"))}}
+    for name, values in sections.items():
+        base.setdefault(name, {}).update(values)
+    lines = []
+    for name, values in base.items():
+        lines.append(f"[{name}]")
+        for k, v in values.items():
+            if isinstance(v, str):
+                lines.append(f'{k} = "{v}"')
+            elif isinstance(v, list):
+                lines.append(f"{k} = {v!r}")
+            else:
+                lines.append(f"{k} = {v!r}")
+        lines.append("")
+    path.write_text("\n".join(lines))
+    return path
