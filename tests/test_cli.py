@@ -1,0 +1,108 @@
+"""Command line, config validation and the catalog written by a serial run."""
+import h5py
+import numpy as np
+import pytest
+
+from ensemble import catalog
+from ensemble.config import loads
+
+from .conftest import run_cli, write_config
+
+
+@pytest.fixture(scope="module")
+def small_run(tmp_path_factory):
+    d = tmp_path_factory.mktemp("run")
+    cfg = write_config(d / "cfg.toml", sweep={"b": [20.0, 30.0]}, run={"seeds": 2, "events": 30},
+                       integrator={"dt": 5e-4})
+    res = run_cli("run", cfg)
+    assert res.returncode == 0, res.stderr
+    return d, cfg
+
+
+def test_catalog_schema_and_content(small_run):
+    d, cfg = small_run
+    events, tasks, attrs = catalog.read(d / "cfg.h5")
+    assert len(tasks["point"]) == 4 and list(tasks["events_written"]) == [30] * 4
+    assert list(tasks["b"]) == [20.0, 20.0, 30.0, 30.0] and list(tasks["seed_index"]) == [0, 1, 0, 1]
+    assert len(events["t"]) == 120
+    assert loads(attrs["config"]).run.events == 30
+    for k in range(4):
+        mine = events["task"] == k
+        assert np.count_nonzero(mine) == 30
+        assert np.all(np.diff(events["t"][mine]) > 0)           # time order within a task
+    np.testing.assert_allclose(events["mu"], np.log10(events["slip"]))
+    assert np.all(events["first"] <= events["epicenter"]) and np.all(events["epicenter"] <= events["last"])
+    assert np.all(events["n_slipped"] <= events["last"] - events["first"] + 1)
+    assert np.array_equal(events["boundary"], (events["first"] == 0) | (events["last"] == 59))
+    assert np.all(events["duration"] > 0)
+    with h5py.File(d / "cfg.h5") as h5:
+        assert set(h5["events"]) == set(catalog.EVENT_FIELDS)
+        assert h5["events"]["boundary"].dtype == np.bool_
+
+
+def test_same_seed_same_catalog_other_seed_differs(small_run, tmp_path):
+    d, cfg = small_run
+    assert run_cli("run", cfg, "-o", tmp_path / "again.h5").returncode == 0
+    assert run_cli("run", cfg, "-o", tmp_path / "other.h5", "--set", "run.seed=5").returncode == 0
+    a, _, _ = catalog.read(d / "cfg.h5")
+    b, _, _ = catalog.read(tmp_path / "again.h5")
+    c, _, _ = catalog.read(tmp_path / "other.h5")
+    for name in catalog.EVENT_FIELDS:
+        np.testing.assert_array_equal(a[name], b[name])
+    assert not np.array_equal(a["slip"], c["slip"])
+
+
+def test_refuses_to_overwrite_without_force(small_run):
+    d, cfg = small_run
+    before = (d / "cfg.h5").read_bytes()
+    res = run_cli("run", cfg)
+    assert res.returncode != 0 and "exists" in res.stderr and "--force" in res.stderr
+    assert (d / "cfg.h5").read_bytes() == before
+
+
+def test_validate_prints_resolved_config_and_tasks(small_run):
+    d, cfg = small_run
+    res = run_cli("validate", cfg, "--set", "run.seeds=3")
+    assert res.returncode == 0, res.stderr
+    assert loads(res.stdout.split("# ")[0]).run.seeds == 3
+    assert "# 6 tasks" in res.stdout and "task 5: point 1 seed 2" in res.stdout
+
+
+@pytest.mark.parametrize("sections,key", [
+    ({"model": {"N": 60, "bb": 1.0}}, "model.bb"),
+    ({"model": {"N": 1}}, "model.N"),
+    ({"model": {"N": 60, "nu": -1e-8}}, "model.nu"),
+    ({"model": {"N": 60, "b": "big"}}, "model.b"),
+    ({"run": {"events": 0}}, "run.events"),
+    ({"integrator": {"method": "euler"}}, "integrator.method"),
+    ({"integrator": {"dt": 2.0}}, "integrator.dt"),
+    ({"sweep": {"q": [1, 2]}}, "sweep.q"),
+    ({"sweep": {"b": []}}, "sweep.b"),
+    ({"extra": {"x": 1}}, "[extra]"),
+])
+def test_bad_config_gives_one_line_error_naming_the_key(tmp_path, sections, key):
+    cfg = write_config(tmp_path / "bad.toml", **sections)
+    res = run_cli("run", cfg)
+    assert res.returncode == 2
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and key in lines[0] and lines[0].startswith("error:")
+    assert not (tmp_path / "bad.h5").exists()
+
+
+def test_bad_override_and_missing_file(tmp_path):
+    cfg = write_config(tmp_path / "c.toml")
+    res = run_cli("validate", cfg, "--set", "model.l=0")
+    assert res.returncode == 2 and "model.l" in res.stderr
+    res = run_cli("validate", tmp_path / "nope.toml")
+    assert res.returncode == 2 and "nope.toml" in res.stderr
+
+
+def test_unstable_step_stops_with_task_and_event_and_keeps_old_catalog(small_run, tmp_path):
+    """dt beyond the RK4 stability limit: a clear error naming task and event, nothing overwritten."""
+    d, cfg = small_run
+    before = (d / "cfg.h5").read_bytes()
+    res = run_cli("run", cfg, "--force", "--set", "integrator.dt=0.02")
+    assert res.returncode == 1
+    line = res.stderr.strip().splitlines()[-1]
+    assert "task 0" in line and "event" in line and "stability" in line
+    assert (d / "cfg.h5").read_bytes() == before
