@@ -2,4 +2,28 @@
 
 Kernels are pure: arrays and scalars in, arrays out. Nothing here knows about
 config objects, files, MPI or HDF5 (see ensemble.runner for the wrapper).
+
+Numba's on-disk cache only notices changes to the file of the cached function
+itself, not to the kernels it calls from other files; a stale cache would run
+old physics silently. The cache therefore lives in a directory named after a
+hash of all kernel sources: $NUMBA_CACHE_DIR/bk-<hash> (default
+~/.cache/bk-ensemble/numba/bk-<hash>).
 """
+import hashlib
+import os
+from pathlib import Path
+
+import numba
+
+
+def _cache_dir():
+    digest = hashlib.sha256()
+    for src in sorted(Path(__file__).parent.glob("*.py")):
+        digest.update(src.name.encode())
+        digest.update(src.read_bytes())
+    base = os.environ.get("NUMBA_CACHE_DIR") or os.path.join(
+        os.path.expanduser("~"), ".cache", "bk-ensemble", "numba")
+    return os.path.join(base, "bk-" + digest.hexdigest()[:16])
+
+
+numba.config.CACHE_DIR = _cache_dir()

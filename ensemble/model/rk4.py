@@ -22,7 +22,7 @@ import numpy as np
 from .friction import friction, spring_force, state_rate
 from .onset import onset_delay
 from .workspace import (D_DURATION, D_FIRST, D_LAST, D_NSLIP, D_RESIDUAL, D_SLIP, D_STEPS,
-                        D_VMAX, D_WORK, F0, HD0, HD1, K1V, KP, KV, KY, NONFINITE, OK, P, P0, PS,
+                        D_VMAX, D_WORK, D_BLOCK_STEPS, F0, HD0, HD1, K1V, KP, KV, KY, NONFINITE, OK, P, P0, PS,
                         SP, SV, SY, TOO_LONG, TR, UNSTABLE, V, V0, VS, Y, Y0, YS)
 
 # Stability limit of classical RK4 on the negative real axis: the state equation
@@ -56,7 +56,7 @@ def _rest_psi(W, j, tau):
     return W[P, j] + math.log1p((tau - W[TR, j]) * math.exp(-W[P, j]))
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, error_model="numpy")
 def _stage(W, act, na, n, tau, l2, nu, a, b, yrest):
     """Derivatives of all active blocks at stage state (YS, VS, PS) into KY, KV, KP.
 
@@ -80,7 +80,7 @@ def _stage(W, act, na, n, tau, l2, nu, a, b, yrest):
     return power, ysum
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, error_model="numpy")
 def _rk4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest):
     """Advance the active blocks from the step-start values (Y0, V0, P0) by h.
 
@@ -219,6 +219,7 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
     work = 0.0
     slip_time = 0.0
     steps = 0
+    block_steps = 0
     vmax = v_start
     status = OK
     while na > 0:
@@ -265,7 +266,11 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
             for j in (_left(i), _right(i, n)):
                 if flag[j] == 1 or j == i:
                     continue
-                if _excess(W, flag, n, j, tau, h, 1.0, l2, nu, b) > 0.0:
+                # Cheap filter first: the threshold of a resting block only grows,
+                # so a force below b * (psi when it came to rest) cannot start it.
+                if _force_now(W, n, j, tau + h, l2, nu) <= b * W[P, j]:
+                    continue
+                if _excess_now(W, n, j, tau + h, l2, nu, b) > 0.0:
                     lo = 0.0
                     hi = 1.0
                     if _excess(W, flag, n, j, tau, h, 0.0, l2, nu, b) >= 0.0:
@@ -295,18 +300,21 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
             dwork, dslip = _rk4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest)
         tau += h
         steps += 1
+        block_steps += na
         work += dwork
         slip_time += dslip
-        # Health of the step.
+        # Health of the step: finite, and within RK4's stability region for the
+        # state equation (rate 1/theta = exp(-psi)) and the velocity (rate v).
+        v_limit = RK4_STABILITY / h
+        psi_limit = -math.log(v_limit)
         for k in range(na):
             i = act[k]
             v = W[V, i]
             if not (math.isfinite(v) and math.isfinite(W[P, i]) and math.isfinite(W[Y, i])):
                 status = NONFINITE
-            rate = max(v, math.exp(-W[P, i]))
             if v > vmax:
                 vmax = v
-            if h * rate > RK4_STABILITY and status == OK:
+            if (v > v_limit or W[P, i] < psi_limit) and status == OK:
                 status = UNSTABLE
         if status != OK:
             break
@@ -341,7 +349,7 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
         for k in range(na):
             i = act[k]
             for j in (_left(i), _right(i, n)):
-                if flag[j] != 1 and j != i:
+                if flag[j] != 1 and j != i and _force_now(W, n, j, tau, l2, nu) > b * W[P, j]:
                     if _excess_now(W, n, j, tau, l2, nu, b) > 0.0:
                         na, nt, yrest = _start(W, act, na, flag, touched, nt, j, tau, yrest)
         # Blocks no longer watched by a sliding neighbour may only start by
@@ -359,6 +367,7 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
     _finish_event(W, flag, touched, nt, n, tau, l2, nu, work, slip_time, diag)
     diag[D_STEPS] = steps
     diag[D_VMAX] = vmax
+    diag[D_BLOCK_STEPS] = block_steps
     return status
 
 

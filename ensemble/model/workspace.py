@@ -23,8 +23,9 @@ Y, V, P, TR, F0, YS, VS, PS, Y0, V0, P0, KY, KV, KP, SY, SV, SP, K1V, HD0, HD1 =
 NROWS = 20
 
 # entries of the per-event diagnostics vector
-(D_DURATION, D_SLIP, D_FIRST, D_LAST, D_NSLIP, D_WORK, D_RESIDUAL, D_STEPS, D_VMAX) = range(9)
-NDIAG = 9
+(D_DURATION, D_SLIP, D_FIRST, D_LAST, D_NSLIP, D_WORK, D_RESIDUAL, D_STEPS, D_VMAX,
+ D_BLOCK_STEPS) = range(10)
+NDIAG = 10
 
 # status codes of the kernels
 OK, NONFINITE, UNSTABLE, TOO_LONG = 0, 1, 2, 3
