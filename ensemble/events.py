@@ -24,8 +24,17 @@ class EventResult:
 
     @property
     def relative_energy_residual(self):
-        """Residual over the friction work (both in the c-free frame)."""
-        return abs(self.energy_residual) / abs(self.friction_work)
+        return relative_energy_residual(self.energy_residual, self.friction_work)
+
+
+def relative_energy_residual(residual, friction_work):
+    """|residual| / (|friction work| + |elastic energy change - loading work|), c-free frame.
+
+    In the c-free frame friction b psi can be negative (theta < 1), so the
+    friction work alone is not a safe scale; the two terms balance each other.
+    Works elementwise on arrays of events.
+    """
+    return abs(residual) / (abs(friction_work) + abs(residual - friction_work))
 
 
 def physical_state(u, theta, t, model):

@@ -31,7 +31,7 @@ def next_onset(W, n, nu, b):
     second = np.inf
     epicenter = -1
     for i in range(n):
-        d = onset_delay(W[F0, i], W[P, i], nu, b)
+        d = onset_delay(W[i, F0], W[i, P], nu, b)
         if d < best:
             second = best
             best = d
@@ -45,8 +45,8 @@ def next_onset(W, n, nu, b):
 def load_quietly(W, n, nu, dt):
     """All blocks at rest for a time dt: the driver pulls, every theta grows."""
     for i in range(n):
-        W[F0, i] += nu * dt
-        W[P, i] = grow_state(W[P, i], dt)
+        W[i, F0] += nu * dt
+        W[i, P] = grow_state(W[i, P], dt)
 
 
 @nb.njit(cache=True)
@@ -58,14 +58,14 @@ def simulate_rk4(W, act, flag, touched, stuck, diag, clock, l2, nu, a, b, dt, ma
     out_diag[k] the event's diagnostics vector (workspace.D_*). On a status
     other than OK the state is that after the failed event, which is not counted.
     """
-    n = W.shape[1]
+    n = W.shape[0]
     no_profile = np.empty(0)
     for k in range(n_events):
         epicenter, delay, runner_up = next_onset(W, n, nu, b)
         load_quietly(W, n, nu, delay)
         # The onset is exact: put the epicenter on its threshold, not a
         # round-off below it, so the event starts without a false stick.
-        W[F0, epicenter] = b * W[P, epicenter]
+        W[epicenter, F0] = b * W[epicenter, P]
         advance_clock(clock, delay)
         status = integrate_event(W, act, flag, touched, stuck, n, epicenter, 0.0, l2, nu, a,
                                  b, dt, runner_up - delay, max_duration, max_steps, diag,

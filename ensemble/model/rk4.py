@@ -10,7 +10,7 @@ static threshold) is cut at that instant, located on the cubic Hermite
 interpolant of the step, and redone with the shorter step. Clamping v to zero at
 the end of a step instead would make the slip only second-order accurate.
 
-Work arrays (see `workspace.py`): rows of the float array `W` hold per-block
+Work arrays (see `workspace.py`): columns of the float array `W` hold per-block
 quantities, `act` the active list, `flag` 0 (never slid in this event), 1
 (sliding), 2 (slid and now at rest), `touched` the blocks that slid.
 """
@@ -53,7 +53,7 @@ def _hermite(x, y0, y1, d0, d1):
 @nb.njit(cache=True, inline="always")
 def _rest_psi(W, j, tau):
     """psi of a block at rest since local time TR: ln(theta_rest + tau - TR)."""
-    return W[P, j] + math.log1p((tau - W[TR, j]) * math.exp(-W[P, j]))
+    return W[j, P] + math.log1p((tau - W[j, TR]) * math.exp(-W[j, P]))
 
 
 @nb.njit(cache=True, error_model="numpy")
@@ -67,16 +67,16 @@ def _stage(W, act, na, n, tau, l2, nu, a, b, yrest):
     ysum = yrest
     for k in range(na):
         i = act[k]
-        v = W[VS, i]
-        psi = W[PS, i]
+        v = W[i, VS]
+        psi = W[i, PS]
         phi = friction(v, psi, a, b)
-        W[KY, i] = v
-        W[KV, i] = spring_force(W[F0, i], tau, nu, l2, W[YS, _left(i)], W[YS, i],
-                                W[YS, _right(i, n)]) - phi
-        W[KP, i] = state_rate(v, psi)
+        W[i, KY] = v
+        W[i, KV] = spring_force(W[i, F0], tau, nu, l2, W[_left(i), YS], W[i, YS],
+                                W[_right(i, n), YS]) - phi
+        W[i, KP] = state_rate(v, psi)
         if v > 0.0:
             power += phi * v
-        ysum += W[YS, i]
+        ysum += W[i, YS]
     return power, ysum
 
 
@@ -99,35 +99,35 @@ def _rk4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest):
         if stage > 0:
             for k in range(na):
                 i = act[k]
-                W[YS, i] = W[Y0, i] + frac * h * W[KY, i]
-                W[VS, i] = W[V0, i] + frac * h * W[KV, i]
-                W[PS, i] = W[P0, i] + frac * h * W[KP, i]
+                W[i, YS] = W[i, Y0] + frac * h * W[i, KY]
+                W[i, VS] = W[i, V0] + frac * h * W[i, KV]
+                W[i, PS] = W[i, P0] + frac * h * W[i, KP]
         else:
             for k in range(na):
                 i = act[k]
-                W[YS, i] = W[Y0, i]
-                W[VS, i] = W[V0, i]
-                W[PS, i] = W[P0, i]
+                W[i, YS] = W[i, Y0]
+                W[i, VS] = W[i, V0]
+                W[i, PS] = W[i, P0]
         power, ysum = _stage(W, act, na, n, tau + frac * h, l2, nu, a, b, yrest)
         pw += weight * power
         ys += weight * ysum
         for k in range(na):
             i = act[k]
             if stage == 0:
-                W[K1V, i] = W[KV, i]
-                W[SY, i] = W[KY, i]
-                W[SV, i] = W[KV, i]
-                W[SP, i] = W[KP, i]
+                W[i, K1V] = W[i, KV]
+                W[i, SY] = W[i, KY]
+                W[i, SV] = W[i, KV]
+                W[i, SP] = W[i, KP]
             else:
-                W[SY, i] += weight * W[KY, i]
-                W[SV, i] += weight * W[KV, i]
-                W[SP, i] += weight * W[KP, i]
+                W[i, SY] += weight * W[i, KY]
+                W[i, SV] += weight * W[i, KV]
+                W[i, SP] += weight * W[i, KP]
     for k in range(na):
         i = act[k]
-        W[Y, i] = W[Y0, i] + h / 6.0 * W[SY, i]
-        W[V, i] = W[V0, i] + h / 6.0 * W[SV, i]
-        W[P, i] = W[P0, i] + h / 6.0 * W[SP, i]
-        W[YS, i] = W[Y, i]
+        W[i, Y] = W[i, Y0] + h / 6.0 * W[i, SY]
+        W[i, V] = W[i, V0] + h / 6.0 * W[i, SV]
+        W[i, P] = W[i, P0] + h / 6.0 * W[i, SP]
+        W[i, YS] = W[i, Y]
     return pw * h / 6.0, ys * h / 6.0
 
 
@@ -135,8 +135,8 @@ def _rk4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest):
 def _slip_at(W, flag, j, x):
     """Slip of block j at fraction x of the current step (Hermite if it slides)."""
     if flag[j] != 1:
-        return W[Y, j]
-    return _hermite(x, W[Y0, j], W[Y, j], W[HD0, j], W[HD1, j])
+        return W[j, Y]
+    return _hermite(x, W[j, Y0], W[j, Y], W[j, HD0], W[j, HD1])
 
 
 @nb.njit(cache=True)
@@ -145,12 +145,12 @@ def _excess(W, flag, n, j, tau, h, x, l2, nu, b):
     s = tau + x * h
     yl = _slip_at(W, flag, _left(j), x)
     yr = _slip_at(W, flag, _right(j, n), x)
-    return spring_force(W[F0, j], s, nu, l2, yl, W[Y, j], yr) - b * _rest_psi(W, j, s)
+    return spring_force(W[j, F0], s, nu, l2, yl, W[j, Y], yr) - b * _rest_psi(W, j, s)
 
 
 @nb.njit(cache=True)
 def _force_now(W, n, j, tau, l2, nu):
-    return spring_force(W[F0, j], tau, nu, l2, W[Y, _left(j)], W[Y, j], W[Y, _right(j, n)])
+    return spring_force(W[j, F0], tau, nu, l2, W[_left(j), Y], W[j, Y], W[_right(j, n), Y])
 
 
 @nb.njit(cache=True)
@@ -188,12 +188,12 @@ def _earliest_loading_onset(W, flag, n, tau, l2, nu, b):
 def _start(W, act, na, flag, touched, nt, j, tau, yrest):
     """Block j starts to slide at local time tau; returns (na, nt, yrest)."""
     if flag[j] == 2:
-        yrest -= W[Y, j]
+        yrest -= W[j, Y]
     else:
         touched[nt] = j
         nt += 1
-    W[P, j] = _rest_psi(W, j, tau)
-    W[V, j] = 0.0
+    W[j, P] = _rest_psi(W, j, tau)
+    W[j, V] = 0.0
     flag[j] = 1
     act[na] = j
     return na + 1, nt, yrest
@@ -204,17 +204,17 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
                     t_far, max_duration, max_steps, diag, profile):
     """Integrate one event from the onset of `epicenter` until every block is at rest.
 
-    On entry W[F0] holds the force and W[P] the state psi of every block at the
-    onset (all at rest, c-free frame), all other rows and `flag` are zero.
+    On entry W[:, F0] holds the force and W[:, P] the state psi of every block at the
+    onset (all at rest, c-free frame), all other columns and `flag` are zero.
     `v_start` is the epicenter's initial velocity (0 for a natural onset),
     `t_far` a lower bound of the loading onset time of every other block.
-    On return W[F0] and W[P] hold the state at the end of the event (all at
-    rest again), the other rows and `flag` are zero, and `diag` holds the event
+    On return W[:, F0] and W[:, P] hold the state at the end of the event (all at
+    rest again), the other columns and `flag` are zero, and `diag` holds the event
     summary (see workspace.D_*). If `profile` has n entries it receives the
     slip of every block (else pass an empty array). Returns a status code.
     """
     na, nt, yrest = _start(W, act, 0, flag, touched, 0, epicenter, 0.0, 0.0)
-    W[V, epicenter] = v_start
+    W[epicenter, V] = v_start
     tau = 0.0
     work = 0.0
     slip_time = 0.0
@@ -228,32 +228,32 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
             break
         for k in range(na):
             i = act[k]
-            W[Y0, i] = W[Y, i]
-            W[V0, i] = W[V, i]
-            W[P0, i] = W[P, i]
+            W[i, Y0] = W[i, Y]
+            W[i, V0] = W[i, V]
+            W[i, P0] = W[i, P]
         h = dt
         dwork, dslip = _rk4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest)
         # Earliest transition inside the step, as a fraction x of it; the slip
         # of a sliding block inside the step is the Hermite cubic with these slopes.
         for k in range(na):
             i = act[k]
-            W[HD0, i] = h * W[V0, i]
-            W[HD1, i] = h * W[V, i]
+            W[i, HD0] = h * W[i, V0]
+            W[i, HD1] = h * W[i, V]
         x_cut = 2.0
         who = -1
         kind = 0  # 1 stick, 2 onset next to a sliding block, 3 onset by loading
         for k in range(na):
             i = act[k]
-            if W[V, i] <= 0.0 and W[V0, i] > 0.0:
-                a_end = spring_force(W[F0, i], tau + h, nu, l2, W[Y, _left(i)], W[Y, i],
-                                     W[Y, _right(i, n)]) - friction(W[V, i], W[P, i], a, b)
-                d0 = h * W[K1V, i]
+            if W[i, V] <= 0.0 and W[i, V0] > 0.0:
+                a_end = spring_force(W[i, F0], tau + h, nu, l2, W[_left(i), Y], W[i, Y],
+                                     W[_right(i, n), Y]) - friction(W[i, V], W[i, P], a, b)
+                d0 = h * W[i, K1V]
                 d1 = h * a_end
                 lo = 0.0
                 hi = 1.0
                 for _ in range(_BISECT):
                     mid = 0.5 * (lo + hi)
-                    if _hermite(mid, W[V0, i], W[V, i], d0, d1) > 0.0:
+                    if _hermite(mid, W[i, V0], W[i, V], d0, d1) > 0.0:
                         lo = mid
                     else:
                         hi = mid
@@ -268,7 +268,7 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
                     continue
                 # Cheap filter first: the threshold of a resting block only grows,
                 # so a force below b * (psi when it came to rest) cannot start it.
-                if _force_now(W, n, j, tau + h, l2, nu) <= b * W[P, j]:
+                if _force_now(W, n, j, tau + h, l2, nu) <= b * W[j, P]:
                     continue
                 if _excess_now(W, n, j, tau + h, l2, nu, b) > 0.0:
                     lo = 0.0
@@ -309,37 +309,37 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
         psi_limit = -math.log(v_limit)
         for k in range(na):
             i = act[k]
-            v = W[V, i]
-            if not (math.isfinite(v) and math.isfinite(W[P, i]) and math.isfinite(W[Y, i])):
+            v = W[i, V]
+            if not (math.isfinite(v) and math.isfinite(W[i, P]) and math.isfinite(W[i, Y])):
                 status = NONFINITE
             if v > vmax:
                 vmax = v
-            if (v > v_limit or W[P, i] < psi_limit) and status == OK:
+            if (v > v_limit or W[i, P] < psi_limit) and status == OK:
                 status = UNSTABLE
         if status != OK:
             break
         # Transitions at tau: the located one, then anything that crossed with it.
         if kind == 2 or kind == 3:
             na, nt, yrest = _start(W, act, na, flag, touched, nt, who, tau, yrest)
-            W[V, who] = 0.0
+            W[who, V] = 0.0
             if kind == 3:
                 t_far = -np.inf  # recompute on the next step
         if kind == 1:
-            W[V, who] = 0.0
+            W[who, V] = 0.0
         m = 0
         nstuck = 0
         for k in range(na):
             i = act[k]
-            if W[V, i] <= 0.0 and not (i == who and kind >= 2):
+            if W[i, V] <= 0.0 and not (i == who and kind >= 2):
                 # Blocks never move backward: a block that started this step
                 # but could not move keeps its slip.
-                if W[Y, i] < W[Y0, i]:
-                    W[Y, i] = W[Y0, i]
-                W[V, i] = 0.0
-                W[TR, i] = tau
-                W[YS, i] = W[Y, i]
+                if W[i, Y] < W[i, Y0]:
+                    W[i, Y] = W[i, Y0]
+                W[i, V] = 0.0
+                W[i, TR] = tau
+                W[i, YS] = W[i, Y]
                 flag[i] = 2
-                yrest += W[Y, i]
+                yrest += W[i, Y]
                 stuck[nstuck] = i
                 nstuck += 1
             else:
@@ -349,7 +349,7 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
         for k in range(na):
             i = act[k]
             for j in (_left(i), _right(i, n)):
-                if flag[j] != 1 and j != i and _force_now(W, n, j, tau, l2, nu) > b * W[P, j]:
+                if flag[j] != 1 and j != i and _force_now(W, n, j, tau, l2, nu) > b * W[j, P]:
                     if _excess_now(W, n, j, tau, l2, nu, b) > 0.0:
                         na, nt, yrest = _start(W, act, na, flag, touched, nt, j, tau, yrest)
         # Blocks no longer watched by a sliding neighbour may only start by
@@ -363,7 +363,7 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
     if profile.shape[0] == n:
         profile[:] = 0.0
         for k in range(nt):
-            profile[touched[k]] = W[Y, touched[k]]
+            profile[touched[k]] = W[touched[k], Y]
     _finish_event(W, flag, touched, nt, n, tau, l2, nu, work, slip_time, diag)
     diag[D_STEPS] = steps
     diag[D_VMAX] = vmax
@@ -373,7 +373,7 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
 
 @nb.njit(cache=True)
 def _finish_event(W, flag, touched, nt, n, tau, l2, nu, work, slip_time, diag):
-    """Summarise the event, move every block's state to the end time, clear the work rows."""
+    """Summarise the event, move every block's state to the end time, clear the work columns."""
     slip = 0.0
     first = n
     last = -1
@@ -383,17 +383,17 @@ def _finish_event(W, flag, touched, nt, n, tau, l2, nu, work, slip_time, diag):
     e_change = 0.0
     for k in range(nt):
         i = touched[k]
-        y = W[Y, i]
+        y = W[i, Y]
         if y > 0.0:
             slip += y
             nslip += 1
             first = min(first, i)
             last = max(last, i)
-        e_change += -y * W[F0, i] + 0.5 * y * y
+        e_change += -y * W[i, F0] + 0.5 * y * y
         if i + 1 < n:
-            e_change += 0.5 * l2 * (W[Y, i + 1] - y) ** 2
+            e_change += 0.5 * l2 * (W[i + 1, Y] - y) ** 2
         if i - 1 >= 0 and flag[i - 1] == 0:
-            e_change += 0.5 * l2 * (y - W[Y, i - 1]) ** 2
+            e_change += 0.5 * l2 * (y - W[i - 1, Y]) ** 2
     e_change += -nu * tau * slip + nu * slip_time
     diag[D_DURATION] = tau
     diag[D_SLIP] = slip
@@ -405,21 +405,21 @@ def _finish_event(W, flag, touched, nt, n, tau, l2, nu, work, slip_time, diag):
     # New forces: loading during the event for everybody, slip for the touched
     # blocks and their neighbours (free ends: an end block has one spring).
     for i in range(n):
-        W[F0, i] += nu * tau
-        W[P, i] += math.log1p((tau - W[TR, i]) * math.exp(-W[P, i]))
+        W[i, F0] += nu * tau
+        W[i, P] += math.log1p((tau - W[i, TR]) * math.exp(-W[i, P]))
     for k in range(nt):
         i = touched[k]
-        y = W[Y, i]
+        y = W[i, Y]
         deg = (1 if i > 0 else 0) + (1 if i < n - 1 else 0)
-        W[F0, i] -= (1.0 + l2 * deg) * y
+        W[i, F0] -= (1.0 + l2 * deg) * y
         if i > 0:
-            W[F0, i - 1] += l2 * y
+            W[i - 1, F0] += l2 * y
         if i < n - 1:
-            W[F0, i + 1] += l2 * y
+            W[i + 1, F0] += l2 * y
     for k in range(nt):
         i = touched[k]
-        W[Y, i] = 0.0
-        W[YS, i] = 0.0
-        W[V, i] = 0.0
-        W[TR, i] = 0.0
+        W[i, Y] = 0.0
+        W[i, YS] = 0.0
+        W[i, V] = 0.0
+        W[i, TR] = 0.0
         flag[i] = 0

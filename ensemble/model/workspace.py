@@ -1,12 +1,13 @@
 """Work arrays shared by the event kernels, and the codes they return.
 
-The float work array W has one row per per-block quantity (index constants
-below) and N columns. Between events only two rows carry state:
+The float work array W has one row per block and one column per per-block
+quantity (index constants below), so that everything the integrator touches for
+one block sits in one or two cache lines. Between events only two columns carry state:
 
-    W[F0]  force on each block, c-free frame: F_i = (nu t - u_i - c) + l^2 (lap u)_i
-    W[P]   psi_i = ln(theta_i)
+    W[:, F0]  force on each block, c-free frame: F_i = (nu t - u_i - c) + l^2 (lap u)_i
+    W[:, P]   psi_i = ln(theta_i)
 
-All other rows are scratch that the event integrator leaves zeroed.
+All other columns are scratch that the event integrator leaves zeroed.
 
 Energy balance of an event (c-free frame, x = u + c - nu t, slips y since onset,
 duration tau, W_f = int sum(Phi v) dt the friction work, W_load the work of the driver):
@@ -18,9 +19,9 @@ so residual = dE_elastic + W_f - W_load needs only the blocks that slipped.
 """
 import numpy as np
 
-# rows of W
+# columns of W
 Y, V, P, TR, F0, YS, VS, PS, Y0, V0, P0, KY, KV, KP, SY, SV, SP, K1V, HD0, HD1 = range(20)
-NROWS = 20
+NCOLS = 20
 
 # entries of the per-event diagnostics vector
 (D_DURATION, D_SLIP, D_FIRST, D_LAST, D_NSLIP, D_WORK, D_RESIDUAL, D_STEPS, D_VMAX,
@@ -40,7 +41,7 @@ class Workspace:
     """Scratch arrays for one chain of n blocks (allocate once per task)."""
 
     def __init__(self, n):
-        self.W = np.zeros((NROWS, n))
+        self.W = np.zeros((n, NCOLS))
         self.act = np.zeros(n, dtype=np.int64)
         self.flag = np.zeros(n, dtype=np.int8)
         self.touched = np.zeros(n, dtype=np.int64)
@@ -51,13 +52,13 @@ class Workspace:
         """Set the between-events state (force and psi of every block)."""
         self.W[:] = 0.0
         self.flag[:] = 0
-        self.W[F0] = force
-        self.W[P] = psi
+        self.W[:, F0] = force
+        self.W[:, P] = psi
 
     @property
     def force(self):
-        return self.W[F0]
+        return self.W[:, F0]
 
     @property
     def psi(self):
-        return self.W[P]
+        return self.W[:, P]

@@ -1,0 +1,50 @@
+"""Events per second of a developed chain, one core.
+
+    python benchmarks/throughput.py [--N 800] [--b 20] [--dt 1e-3] [--transient 1000] [--events 2000]
+
+Runs the transient (not timed, includes compilation), then times `events`
+recorded events and prints events/s, cost per block-step, the magnitude range
+and the largest relative energy residual.
+"""
+import argparse
+import time
+
+import numpy as np
+
+from ensemble.config import Config, Integrator, Model, Run
+from ensemble.events import relative_energy_residual
+from ensemble.model.workspace import D_BLOCK_STEPS, D_RESIDUAL, D_SLIP, D_STEPS, D_WORK
+from ensemble.runner import Trajectory
+from ensemble.tasks import task_list
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--N", type=int, default=800)
+    p.add_argument("--b", type=float, default=20.0)
+    p.add_argument("--a", type=float, default=0.0)
+    p.add_argument("--dt", type=float, default=1e-3)
+    p.add_argument("--transient", type=int, default=1000)
+    p.add_argument("--events", type=int, default=2000)
+    p.add_argument("--seed", type=int, default=0)
+    args = p.parse_args()
+    cfg = Config(model=Model(N=args.N, b=args.b, a=args.a),
+                 run=Run(events=args.events, transient=args.transient, seed=args.seed),
+                 integrator=Integrator(dt=args.dt))
+    traj = Trajectory(cfg, task_list(cfg)[0])
+    traj.advance(args.transient)
+    start = time.perf_counter()
+    _, _, diag = traj.advance(args.events)
+    elapsed = time.perf_counter() - start
+    mu = np.log10(diag[:, D_SLIP])
+    residual = relative_energy_residual(diag[:, D_RESIDUAL], diag[:, D_WORK])
+    print(f"N={args.N} b={args.b} a={args.a} dt={args.dt}: {args.events / elapsed:.1f} events/s "
+          f"({args.events} events in {elapsed:.1f} s after {args.transient} transient)")
+    print(f"  {diag[:, D_STEPS].mean():.0f} steps and {diag[:, D_BLOCK_STEPS].mean():.0f} block-steps per event, "
+          f"{elapsed / diag[:, D_BLOCK_STEPS].sum() * 1e9:.0f} ns per block-step")
+    print(f"  mu in [{mu.min():.2f}, {mu.max():.2f}], fraction mu >= 4: {np.mean(mu >= 4):.3f}, "
+          f"max relative energy residual {residual.max():.1e}")
+
+
+if __name__ == "__main__":
+    main()
