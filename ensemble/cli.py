@@ -1,12 +1,15 @@
-"""Command line: python -m ensemble run|validate CONFIG.toml ..."""
+"""Command line: python -m ensemble run|validate|status ...
+
+Under mpirun every rank runs the same command. An exception on any rank is
+printed with the rank (and the task, where there is one) and aborts all ranks
+at once, instead of leaving the others hanging in MPI.
+"""
 import argparse
 import sys
 
 from . import __version__
 from .catalog import CatalogError
 from .config import ConfigError, load, replace
-from .runner import SimulationError, run_serial
-from .tasks import describe, task_list
 
 
 def _parser():
@@ -21,23 +24,60 @@ def _parser():
                        help="override one config value (repeatable)")
     run.add_argument("-o", "--output", help="catalog path (default: output.path of the config)")
     run.add_argument("--force", action="store_true", help="overwrite an existing catalog")
+    run.add_argument("--resume", action="store_true", help="continue an interrupted run from its checkpoints")
+    st = sub.add_parser("status", help="summarise a catalog (finished, or being written)")
+    st.add_argument("catalog", help="catalog path (PATH.partial is found automatically)")
     return p
+
+
+def _config(args):
+    cfg = load(args.config, args.set)
+    if getattr(args, "output", None):
+        cfg = replace(cfg, "output", path=args.output)
+    return cfg
+
+
+def _validate(args):
+    from .tasks import describe, task_list
+    cfg = _config(args)
+    print(cfg.to_toml())
+    tasks = task_list(cfg)
+    print(f"# {len(tasks)} tasks")
+    print("\n".join("# " + line for line in describe(tasks)))
+    return 0
+
+
+def _status(args):
+    from .status import summary
+    print(summary(args.catalog))
+    return 0
+
+
+def _run(args):
+    from mpi4py import MPI
+
+    from .runner import run
+    comm = MPI.COMM_WORLD
+    rank = comm.Get_rank()
+    try:
+        cfg = _config(args)
+        return run(cfg, cfg.output.path, comm, resume=args.resume, force=args.force)
+    except (ConfigError, CatalogError) as err:
+        # raised on every rank alike (decisions are made on rank 0 and broadcast)
+        if rank == 0:
+            print(f"error: {err}", file=sys.stderr, flush=True)
+        return 2 if isinstance(err, ConfigError) else 1
+    except Exception as err:  # noqa: BLE001 - the guard that turns any failure into an abort
+        print(f"error: rank {rank}: {err}", file=sys.stderr, flush=True)
+        if comm.Get_size() > 1:
+            comm.Abort(1)
+        return 1
 
 
 def main(argv=None):
     args = _parser().parse_args(argv)
     try:
-        cfg = load(args.config, args.set)
-        if getattr(args, "output", None):
-            cfg = replace(cfg, "output", path=args.output)
-        if args.command == "validate":
-            print(cfg.to_toml())
-            tasks = task_list(cfg)
-            print(f"# {len(tasks)} tasks")
-            print("\n".join("# " + line for line in describe(tasks)))
-            return 0
-        run_serial(cfg, cfg.output.path, force=args.force)
-        return 0
-    except (ConfigError, CatalogError, SimulationError) as err:
+        return {"run": _run, "validate": _validate, "status": _status}[args.command](args)
+    except (ConfigError, CatalogError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2 if isinstance(err, ConfigError) else 1

@@ -43,6 +43,7 @@ class Run:
     transient: int = 10000     # events discarded at the start of each task
     seed: int = 0              # root seed: task k uses SeedSequence(seed, spawn_key=(k,))
     init_stress: float = 1.0   # initial forces are uniformly spread this far below threshold
+    poll_seconds: float = 0.25  # kernel calls last about this long between MPI polls
 
 
 @dataclass(frozen=True)
@@ -54,8 +55,11 @@ class Integrator:
 
 @dataclass(frozen=True)
 class Output:
-    path: str = "catalog.h5"   # HDF5 event catalog
-    batch: int = 10000         # events per kernel call and per write to the catalog
+    path: str = "catalog.h5"     # HDF5 event catalog
+    batch: int = 10000           # events buffered per task before they are written (with a checkpoint)
+    flush_seconds: float = 60.0  # ... or after this long, whichever comes first
+    progress_seconds: float = 30.0  # rank 0 prints a progress line this often
+    writer: str = "auto"         # "parallel" (mpio), "rank0" (messages to rank 0), "auto"
 
 
 _RULES = {
@@ -73,6 +77,10 @@ _RULES = {
     ("integrator", "dt"): (lambda x: 0 < x <= 1, "in (0, 1]"),
     ("integrator", "max_duration"): (_positive, "> 0"),
     ("output", "batch"): (lambda x: x >= 1, "an integer >= 1"),
+    ("output", "flush_seconds"): (_positive, "> 0"),
+    ("output", "progress_seconds"): (_positive, "> 0"),
+    ("output", "writer"): (lambda x: x in ("auto", "parallel", "rank0"), "one of auto, parallel, rank0"),
+    ("run", "poll_seconds"): (_positive, "> 0"),
     ("output", "path"): (lambda x: len(x) > 0, "a non-empty string"),
 }
 
