@@ -42,10 +42,11 @@ class Coordinator:
         self._received = {tag: np.zeros(self.size, dtype=np.int64) for tag in (STOP_TAG, COUNT_TAG)}
         self._requests = []
         self.report_seconds = report_seconds
-        self._unreported = 0
+        self._unreported = [0, 0]
         self._last_report = time.perf_counter()
         self.rma_wait = 0.0      # seconds spent in one-sided operations on the counters
-        self.events_total = 0    # on rank 0: events simulated on all ranks (as reported so far)
+        self.events_total = 0    # on rank 0: events done on all ranks (as reported so far)
+        self.events_resumed = 0  # ... of which done before a resume
 
     # -- one-sided counters -------------------------------------------------------------
 
@@ -87,23 +88,28 @@ class Coordinator:
             self.stop_requested = True
             self.signal_name = obj
         elif tag == COUNT_TAG:
-            self.events_total += obj
+            self.events_total += obj[0]
+            self.events_resumed += obj[1]
 
     def _drain(self, tag):
         status = MPI.Status()
         while self.comm.Iprobe(source=MPI.ANY_SOURCE, tag=tag, status=status):
             self._receive(tag, status.Get_source())
 
-    def count_events(self, n, force=False):
-        """Add n simulated events to the run-wide count (sent to rank 0 now and then)."""
-        self._unreported += n
+    def count_events(self, n, resumed=False, force=False):
+        """Add n events to the run-wide count (sent to rank 0 now and then).
+
+        resumed: events done by an earlier, interrupted run (not counted in the rate).
+        """
+        self._unreported[1 if resumed else 0] += n
         now = time.perf_counter()
-        if self._unreported and (force or now - self._last_report >= self.report_seconds):
+        if any(self._unreported) and (force or now - self._last_report >= self.report_seconds):
             if self.rank == 0:
-                self.events_total += self._unreported
+                self.events_total += self._unreported[0] + self._unreported[1]
+                self.events_resumed += self._unreported[1]
             else:
-                self._send(COUNT_TAG, self._unreported, 0)
-            self._unreported = 0
+                self._send(COUNT_TAG, (self._unreported[0] + self._unreported[1], self._unreported[1]), 0)
+            self._unreported = [0, 0]
             self._last_report = now
 
     # -- stop requests (signals) --------------------------------------------------------

@@ -93,7 +93,7 @@ class Progress:
         self.last = now
         tasks = self.coord.tasks_done() if tasks is None else tasks
         events = self.coord.events_total
-        rate = events / max(now - self.start, 1e-9)
+        rate = (events - self.coord.events_resumed) / max(now - self.start, 1e-9)
         left = (self.total - events) / rate if rate > 0 else float("inf")
         eta = f"{left / 60:.1f} min" if np.isfinite(left) else "?"
         self.log(f"progress: tasks {tasks}/{self.n_tasks}, events {events}/{self.total} "
@@ -119,7 +119,7 @@ class TaskRunner:
         cfg = self.cfg
         cp, written = self.writer.resume_point(task.index, task.model.N)
         if cp is not None:
-            self.coord.count_events(cp.done)
+            self.coord.count_events(cp.done, resumed=True)
         if written >= cfg.run.events:
             self.coord.task_done()
             return True

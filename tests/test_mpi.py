@@ -1,0 +1,175 @@
+"""The runner under real `mpiexec`: rank-count invariance, writers, resume, failures."""
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from ensemble import catalog
+
+from .conftest import ROOT, run_cli, write_config
+
+pytestmark = pytest.mark.mpi
+MPIEXEC = shutil.which("mpiexec")
+if MPIEXEC is None:
+    pytest.skip("mpiexec not found (make setup installs MPICH)", allow_module_level=True)
+
+
+def env():
+    return dict(os.environ, NUMBA_CACHE_DIR=os.environ.get("NUMBA_CACHE_DIR", str(ROOT / ".numba_cache")),
+                OMP_NUM_THREADS="1", NUMBA_NUM_THREADS="1")
+
+
+def mpi_cmd(n, *args):
+    return [MPIEXEC, "-n", str(n), sys.executable, "-m", "ensemble", *map(str, args)]
+
+
+def mpirun(n, *args, timeout=300):
+    return subprocess.run(mpi_cmd(n, *args), capture_output=True, text=True, env=env(), timeout=timeout)
+
+
+def assert_same_events(path_a, path_b):
+    a, ta, _ = catalog.read(path_a)
+    b, tb, _ = catalog.read(path_b)
+    assert len(a["t"]) == len(b["t"]) > 0
+    order_a = np.lexsort((a["t"], a["task"]))
+    order_b = np.lexsort((b["t"], b["task"]))
+    for name in catalog.EVENT_FIELDS:
+        np.testing.assert_array_equal(a[name][order_a], b[name][order_b], err_msg=name)
+    for name in catalog.TASK_FIELDS:
+        np.testing.assert_array_equal(ta[name], tb[name], err_msg=name)
+
+
+@pytest.fixture(scope="module")
+def two_tasks(tmp_path_factory):
+    """Two tasks (b = 20 and 30): fewer tasks than ranks with -n 3. Serial reference run."""
+    d = tmp_path_factory.mktemp("mpi2")
+    cfg = write_config(d / "cfg.toml", sweep={"b": [20.0, 30.0]}, run={"seeds": 1, "events": 150, "transient": 30},
+                       integrator={"dt": 5e-4}, output={"batch": 40, "flush_seconds": 0.5})
+    res = run_cli("run", cfg, "-o", d / "serial.h5")
+    assert res.returncode == 0, res.stderr
+    return d, cfg
+
+
+@pytest.mark.parametrize("ranks,writer", [(1, "auto"), (2, "parallel"), (2, "rank0"), (3, "parallel"),
+                                          (3, "rank0")])
+def test_catalog_independent_of_ranks_and_writer(two_tasks, ranks, writer):
+    d, cfg = two_tasks
+    out = d / f"n{ranks}_{writer}.h5"
+    res = mpirun(ranks, "run", cfg, "-o", out, "--set", f'output.writer="{writer}"')
+    assert res.returncode == 0, res.stderr
+    assert_same_events(d / "serial.h5", out)
+    _, tasks, _ = catalog.read(out)
+    assert set(tasks["rank"]) <= set(range(ranks)) and np.all(tasks["rank"] >= 0)
+    assert np.all(tasks["events_per_second"] > 0)
+
+
+@pytest.fixture(scope="module")
+def four_tasks(tmp_path_factory):
+    """Four tasks long enough (~10 s on 2 ranks) to be interrupted. Serial reference run."""
+    d = tmp_path_factory.mktemp("mpi4")
+    cfg = write_config(d / "cfg.toml", sweep={"b": [20.0, 30.0]},
+                       run={"seeds": 2, "events": 400, "transient": 50},
+                       integrator={"dt": 5e-4},
+                       output={"batch": 50, "flush_seconds": 0.5, "progress_seconds": 0.5})
+    res = run_cli("run", cfg, "-o", d / "full.h5")
+    assert res.returncode == 0, res.stderr
+    return d, cfg
+
+
+def rank_pids(root):
+    """PIDs of the ranks started by mpiexec `root` (hydra puts each in its own session)."""
+    table = subprocess.run(["ps", "-eo", "pid=,ppid=,args="], capture_output=True, text=True).stdout
+    children = {}
+    for line in table.splitlines():
+        pid, ppid, args = line.split(None, 2)
+        children.setdefault(int(ppid), []).append((int(pid), args))
+    found, todo = [], [root]
+    while todo:
+        for pid, args in children.get(todo.pop(), []):
+            todo.append(pid)
+            if "-m ensemble run" in args and "hydra" not in args and "mpiexec" not in args:
+                found.append(pid)
+    return sorted(found)
+
+
+def start_and_interrupt(cfg, out, how):
+    """Start a 2-rank run, wait for progress, interrupt it; returns (exit code, stdout)."""
+    proc = subprocess.Popen(mpi_cmd(2, "run", cfg, "-o", out), stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True, env=env(), start_new_session=True)
+    lines = []
+    for line in proc.stdout:
+        lines.append(line)
+        if line.startswith("progress:") and "events 0/" not in line:
+            break
+    time.sleep(1.5)
+    ranks = rank_pids(proc.pid)
+    assert len(ranks) == 2, ranks
+    if how == "kill":
+        for pid in ranks + [proc.pid]:
+            os.kill(pid, signal.SIGKILL)
+    else:
+        # Signal the ranks themselves, as Slurm does (hydra's mpiexec, when signalled, forwards
+        # the signal but then exits 0 whatever the ranks return). `one`: only the first rank.
+        sig, which = how
+        for pid in ranks[:1] if which == "one" else ranks:
+            os.kill(pid, sig)
+    rest, _ = proc.communicate(timeout=60)
+    return proc.returncode, "".join(lines) + rest
+
+
+@pytest.mark.parametrize("sig,which", [(signal.SIGTERM, "all"), (signal.SIGUSR1, "one"),
+                                       (signal.SIGINT, "all")])
+def test_resume_after_signal_equals_uninterrupted(four_tasks, sig, which):
+    """Every rank checkpoints and exits 75 (also when only one rank got the signal); resume completes."""
+    d, cfg = four_tasks
+    out = d / f"sig{int(sig)}.h5"
+    code, log = start_and_interrupt(cfg, out, (sig, which))
+    assert code == 75, log
+    assert "interrupted" in log and not out.exists()
+    _, tasks, _ = catalog.read(catalog.partial_path(out))
+    assert 0 < tasks["events_written"].sum() < 4 * 400      # really cut in the middle
+    res = mpirun(2, "run", cfg, "-o", out, "--resume")
+    assert res.returncode == 0, res.stderr
+    assert_same_events(d / "full.h5", out)
+
+
+def test_resume_after_kill9_loses_and_duplicates_nothing(four_tasks):
+    d, cfg = four_tasks
+    out = d / "killed.h5"
+    code, log = start_and_interrupt(cfg, out, "kill")
+    assert code != 0 and not out.exists()
+    events, tasks, _ = catalog.read(catalog.partial_path(out))   # readable after kill -9
+    assert len(events["t"]) == tasks["events_written"].sum() < 4 * 400
+    res = mpirun(2, "run", cfg, "-o", out, "--resume")
+    assert res.returncode == 0, res.stderr
+    assert_same_events(d / "full.h5", out)
+
+
+def test_resume_refuses_a_different_config(four_tasks):
+    d, cfg = four_tasks
+    out = d / "other.h5"
+    code, _ = start_and_interrupt(cfg, out, (signal.SIGTERM, "all"))
+    assert code == 75
+    res = run_cli("run", cfg, "-o", out, "--resume", "--set", "model.a=1.0")
+    assert res.returncode == 2 and "model.a" in res.stderr and "resume" in res.stderr
+    res = run_cli("run", cfg, "-o", out)
+    assert res.returncode == 1 and "--resume" in res.stderr
+
+
+def test_exception_on_one_rank_aborts_the_job_quickly(tmp_path):
+    """Task 1 (b = 80) is unstable at dt = 1e-3; its rank must take the whole job down at once."""
+    cfg = write_config(tmp_path / "cfg.toml", sweep={"b": [20.0, 80.0]},
+                       run={"seeds": 1, "events": 2000, "transient": 50}, integrator={"dt": 1e-3},
+                       output={"batch": 50, "flush_seconds": 0.5})
+    start = time.perf_counter()
+    res = mpirun(2, "run", cfg, "-o", tmp_path / "x.h5", timeout=120)
+    took = time.perf_counter() - start
+    assert res.returncode != 0
+    assert "task 1" in res.stderr and "rank" in res.stderr and "stability" in res.stderr
+    assert took < 60          # task 0 alone would run for ~20 s more; nobody waits for it
+    catalog.read(catalog.partial_path(tmp_path / "x.h5"))   # what was flushed stays readable
