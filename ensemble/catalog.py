@@ -110,7 +110,9 @@ class _Layout:
         h5.attrs["format"] = FORMAT
         ev = h5.create_group("events")
         for name, dtype in EVENT_FIELDS.items():
-            ev.create_dataset(name, shape=(rows,), dtype=dtype, fillvalue=_FILL[dtype])
+            # never fill: a full run would otherwise write the whole catalog twice; rows past
+            # /tasks/events_written are undefined and never read
+            ev.create_dataset(name, shape=(rows,), dtype=dtype, fillvalue=_FILL[dtype], fill_time="never")
         tg = h5.create_group("tasks")
         for name, dtype in TASK_FIELDS.items():
             values = [getattr(t.model, name) if name in ("N", "l", "nu", "a", "b", "c")

@@ -105,6 +105,7 @@ class TaskRunner:
 
     def __init__(self, cfg, writer, coord, progress):
         self.cfg, self.writer, self.coord, self.progress = cfg, writer, coord, progress
+        self.io_time = 0.0    # seconds spent handing events and checkpoints to the writer
 
     def run(self, task):
         """Returns True if the task finished, False if a stop request interrupted it."""
@@ -135,12 +136,14 @@ class TaskRunner:
 
         def flush():
             nonlocal buffer, buffered, written, last_flush
+            start = time.perf_counter()
             batch = ({name: np.concatenate([b[name] for b in buffer]) for name in buffer[0]}
                      if buffer else None)
             self.writer.commit(task.index, written, batch, traj.checkpoint())
             written += buffered
             buffer, buffered = [], 0
             last_flush = time.perf_counter()
+            self.io_time += last_flush - start
 
         while traj.done < total:
             if self.coord.poll():
@@ -241,7 +244,9 @@ def run(cfg, path, comm, resume=False, force=False, log=print):
         writer = Writer(partial, comm, cfg, tasks)
     else:
         writer = Writer(partial, comm)
-    coord = Coordinator(comm, report_seconds=min(1.0, cfg.output.progress_seconds / 2))
+    # event counts reach rank 0 as messages: about 100 per second in all, however many ranks
+    coord = Coordinator(comm, report_seconds=min(max(1.0, comm.Get_size() / 100),
+                                                  cfg.output.progress_seconds / 2))
     coord.install_signal_handlers()
     progress = Progress(coord, len(tasks), len(tasks) * (cfg.run.transient + cfg.run.events),
                         cfg.output.progress_seconds, log)
@@ -261,12 +266,12 @@ def run(cfg, path, comm, resume=False, force=False, log=print):
     stopped = done < len(tasks)
     coord.close()
     progress.maybe_print(tasks=done)
-    per_rank = comm.gather((busy, idle, coord.rma_wait), root=0)
+    per_rank = comm.gather((busy, idle, coord.rma_wait, worker.io_time), root=0)
     elapsed = time.perf_counter() - t_start
     if rank == 0:
-        for r, (b, i, w) in enumerate(per_rank):
-            log(f"rank {r}: busy {b:.1f} s (of which {w:.2f} s waiting for the task counter), "
-                f"idle {i:.1f} s at the end")
+        for r, (b, i, w, io) in enumerate(per_rank):
+            log(f"rank {r}: busy {b:.1f} s (of which {io:.2f} s writing, {w:.2f} s waiting for the "
+                f"task counter), idle {i:.1f} s at the end")
         if stopped:
             log(f"interrupted ({coord.signal_name}): every rank checkpointed into {partial}; "
                 f"continue with --resume")
