@@ -60,6 +60,16 @@ def test_refuses_to_overwrite_without_force(small_run):
     assert (d / "cfg.h5").read_bytes() == before
 
 
+def test_status_summarises_a_finished_catalog(small_run):
+    d, cfg = small_run
+    res = run_cli("status", d / "cfg.h5")
+    assert res.returncode == 0, res.stderr
+    assert "complete" in res.stdout and "tasks finished 4/4, events recorded 120/120" in res.stdout
+    assert res.stdout.count("     yes ") == 4
+    res = run_cli("status", d / "missing.h5")
+    assert res.returncode == 1 and "missing.h5" in res.stderr
+
+
 def test_validate_prints_resolved_config_and_tasks(small_run):
     d, cfg = small_run
     res = run_cli("validate", cfg, "--set", "run.seeds=3")

@@ -133,6 +133,8 @@ def test_resume_after_signal_equals_uninterrupted(four_tasks, sig, which):
     assert "interrupted" in log and not out.exists()
     _, tasks, _ = catalog.read(catalog.partial_path(out))
     assert 0 < tasks["events_written"].sum() < 4 * 400      # really cut in the middle
+    status = run_cli("status", out)
+    assert status.returncode == 0 and "in progress or interrupted" in status.stdout
     res = mpirun(2, "run", cfg, "-o", out, "--resume")
     assert res.returncode == 0, res.stderr
     assert_same_events(d / "full.h5", out)
