@@ -306,17 +306,31 @@ def choose_writer(name, comm):
     return WRITERS[name]
 
 
-def read(path):
-    """Catalog -> (events: dict of arrays with only the written rows, tasks: dict, attrs: dict)."""
+def _open_for_reading(path):
     if not os.path.exists(path):
         raise CatalogError(f"{path}: no such catalog")
     try:
         h5 = h5py.File(path, "r")
     except OSError as err:
         raise CatalogError(f"{path}: cannot read catalog ({err})") from None
-    with h5:
-        if h5.attrs.get("format") != FORMAT:
-            raise CatalogError(f"{path}: not an event catalog of this package")
+    if h5.attrs.get("format") != FORMAT:
+        h5.close()
+        raise CatalogError(f"{path}: not an event catalog of this package")
+    return h5
+
+
+def read_tasks(path):
+    """Catalog -> (rows per task, tasks: dict of arrays, attrs: dict), without the events."""
+    with _open_for_reading(path) as h5:
+        layout = _Layout(h5)
+        tasks = {name: ds[...] for name, ds in layout.tasks.items()}
+        attrs = {k: h5.attrs[k] for k in h5.attrs}
+        return layout.per_task, tasks, attrs
+
+
+def read(path):
+    """Catalog -> (events: dict of arrays with only the written rows, tasks: dict, attrs: dict)."""
+    with _open_for_reading(path) as h5:
         layout = _Layout(h5)
         tasks = {name: ds[...] for name, ds in layout.tasks.items()}
         rows = np.concatenate([np.arange(k * layout.per_task, k * layout.per_task + n)

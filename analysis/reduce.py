@@ -1,0 +1,192 @@
+"""Catalog -> per-task histograms (streamed) -> per-point statistics with bootstrap intervals.
+
+Each task is cut into `blocks` stretches of consecutive events; histograms and
+sums are kept per (task, stretch). Error bars come from resampling
+independent realisations: the seeds of a parameter point when it has two or
+more, else (one long trajectory) the stretches of that trajectory, a block
+bootstrap, which the summary says. Events within a trajectory are correlated,
+so resampling single events would understate the errors.
+"""
+from dataclasses import dataclass
+
+import h5py
+import numpy as np
+
+from ensemble import catalog
+
+from . import stats
+from .recurrence import RecurrenceScanner
+
+PARAMS = ("N", "l", "nu", "a", "b", "c")
+
+
+@dataclass(frozen=True)
+class Options:
+    mu_edges: np.ndarray
+    tnu_edges: np.ndarray
+    mu_c: float = 4.0
+    window: int = 10
+    b_cut: float = 3.0
+    bootstrap: int = 1000
+    level: float = 0.95
+    blocks: int = 20
+    seed: int = 0
+    chunk: int = 1 << 16
+
+
+def parse_bins(text):
+    """'lo:hi:n' -> n + 1 equally spaced edges."""
+    try:
+        lo, hi, n = text.split(":")
+        lo, hi, n = float(lo), float(hi), int(n)
+    except ValueError:
+        raise ValueError(f"bins must be lo:hi:n, got {text!r}") from None
+    if not (hi > lo and n >= 1):
+        raise ValueError(f"bins must have hi > lo and n >= 1, got {text!r}")
+    return np.linspace(lo, hi, n + 1)
+
+
+@dataclass
+class TaskHistograms:
+    """Additive statistics of one task, per stretch (leading axis)."""
+    mu: np.ndarray            # (blocks, n_mu) counts of mu
+    tnu: np.ndarray           # (blocks, n_tnu) counts of T * nu, all large events
+    tnu_interior: np.ndarray  # (blocks, n_tnu) counts of T * nu, interior starting events
+    numbers: np.ndarray       # (blocks, stats.N_STATS) counts and sums
+
+
+def _bin_add(hist, block, values, edges):
+    idx = np.searchsorted(edges, values, side="right") - 1
+    ok = (idx >= 0) & (idx < len(edges) - 1)
+    np.add.at(hist, (block[ok], idx[ok]), 1)
+
+
+def reduce_task(h5, task, written, per_task, nu, n_blocks_chain, opt):
+    """Stream one task's events from an open catalog into TaskHistograms."""
+    k = opt.blocks
+    out = TaskHistograms(np.zeros((k, len(opt.mu_edges) - 1), np.int64),
+                         np.zeros((k, len(opt.tnu_edges) - 1), np.int64),
+                         np.zeros((k, len(opt.tnu_edges) - 1), np.int64),
+                         np.zeros((k, stats.N_STATS)))
+    if written == 0:
+        return out
+    scanner = RecurrenceScanner(n_blocks_chain, opt.mu_c, opt.window)
+    ev = h5["events"]
+    base = task * per_task
+    for lo in range(0, written, opt.chunk):
+        hi = min(lo + opt.chunk, written)
+        t = ev["t"][base + lo:base + hi]
+        mu = ev["mu"][base + lo:base + hi]
+        epicenter = ev["epicenter"][base + lo:base + hi]
+        boundary = ev["boundary"][base + lo:base + hi]
+        block = (np.arange(lo, hi) * k) // written
+        _bin_add(out.mu, block, mu, opt.mu_edges)
+        np.add.at(out.numbers[:, stats.N_EVENTS], block, 1)
+        np.add.at(out.numbers[:, stats.N_LARGE], block, mu >= opt.mu_c)
+        gr = mu >= opt.b_cut
+        np.add.at(out.numbers[:, stats.N_GR], block[gr], 1)
+        np.add.at(out.numbers[:, stats.SUM_MU_GR], block[gr], mu[gr])
+        src, T, interior = scanner.feed(t, epicenter, mu, boundary)
+        rblock = (src * k) // written
+        tnu = T * nu
+        _bin_add(out.tnu, rblock, tnu, opt.tnu_edges)
+        _bin_add(out.tnu_interior, rblock[interior], tnu[interior], opt.tnu_edges)
+        np.add.at(out.numbers[:, stats.N_REC], rblock, 1)
+        np.add.at(out.numbers[:, stats.SUM_TNU], rblock, tnu)
+        np.add.at(out.numbers[:, stats.N_REC_INT], rblock[interior], 1)
+        np.add.at(out.numbers[:, stats.SUM_TNU_INT], rblock[interior], tnu[interior])
+    return out
+
+
+def reduce_tasks(path, task_indices, opt):
+    """TaskHistograms for the given tasks of a catalog (one rank's share)."""
+    per_task, tasks, _ = catalog.read_tasks(path)
+    out = {}
+    with h5py.File(path, "r") as h5:
+        for k in task_indices:
+            out[k] = reduce_task(h5, k, int(tasks["events_written"][k]), per_task,
+                                 float(tasks["nu"][k]), int(tasks["N"][k]), opt)
+    return out
+
+
+# -- per point ------------------------------------------------------------------------------
+
+NUMBERS = ("n_events", "n_large", "fraction_large", "n_recurrences", "mean_tnu", "mode_tnu",
+           "mean_tnu_interior", "b_value", "ks_gr")
+
+
+def _units(per_task, task_ids, seeds):
+    """Resampling units of a point: whole tasks if there are >= 2 seeds, else stretches."""
+    stack = [per_task[k] for k in task_ids]
+    if seeds >= 2:
+        pack = lambda name: np.stack([getattr(h, name).sum(axis=0) for h in stack])  # noqa: E731
+        return pack, "seeds"
+    pack = lambda name: np.concatenate([getattr(h, name) for h in stack])  # noqa: E731
+    return pack, "blocks"
+
+
+def point_statistics(per_task, task_ids, seeds, opt, rng):
+    """Merged densities and summary numbers of one parameter point, with bootstrap intervals."""
+    pack, method = _units(per_task, task_ids, seeds)
+    units = {name: pack(name) for name in ("mu", "tnu", "tnu_interior", "numbers")}
+    widths = (units["mu"].shape[1], units["tnu"].shape[1])
+    flat = np.concatenate([units["mu"], units["tnu"], units["tnu_interior"], units["numbers"]], axis=1)
+
+    def split(row):
+        a, b = widths
+        return row[:a], row[a:a + b], row[a + b:a + 2 * b], row[a + 2 * b:]
+
+    def numbers(row):
+        mu, tnu, _, s = split(row)
+        b = stats.b_value(s[stats.N_GR], s[stats.SUM_MU_GR], opt.b_cut)
+        mode = stats.centers(opt.tnu_edges)[np.argmax(tnu)] if tnu.sum() > 0 else np.nan
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.array([
+                s[stats.N_EVENTS], s[stats.N_LARGE], s[stats.N_LARGE] / s[stats.N_EVENTS],
+                s[stats.N_REC], s[stats.SUM_TNU] / s[stats.N_REC], mode,
+                s[stats.SUM_TNU_INT] / s[stats.N_REC_INT], b,
+                stats.gr_ks_distance(mu, opt.mu_edges, opt.b_cut, b)])
+
+    def curves(row):
+        mu, tnu, tint, s = split(row)
+        return np.concatenate([stats.density(mu, opt.mu_edges, s[stats.N_EVENTS]),
+                               stats.density(tnu, opt.tnu_edges, s[stats.N_REC]),
+                               stats.density(tint, opt.tnu_edges, s[stats.N_REC_INT])])
+
+    total = flat.sum(axis=0)
+    samples = stats.bootstrap(flat, lambda row: np.concatenate([curves(row), numbers(row)]),
+                              opt.bootstrap, rng) if len(flat) >= 2 else None
+    est = np.concatenate([curves(total), numbers(total)])
+    if samples is None:
+        lo = hi = np.full_like(est, np.nan)
+    else:
+        lo, hi = stats.percentile_interval(samples, opt.level)
+    n_curve = len(est) - len(NUMBERS)
+    peaks = _peaks_with_intervals(units["tnu"], opt, rng)
+    return {"curves": (est[:n_curve], lo[:n_curve], hi[:n_curve]),
+            "numbers": np.stack([est[n_curve:], lo[n_curve:], hi[n_curve:]], axis=1),
+            "peaks": peaks, "method": method, "units": len(flat)}
+
+
+def _peaks_with_intervals(tnu_units, opt, rng):
+    """Recurrence peaks of the merged histogram; each with the interval of the nearest peak
+    across bootstrap resamples. Rows: (position, lo, hi)."""
+    base = stats.find_peaks(tnu_units.sum(axis=0), opt.tnu_edges)
+    if len(base) == 0 or len(tnu_units) < 2:
+        return np.array([[p, np.nan, np.nan] for p in base]).reshape(-1, 3)
+    width = opt.tnu_edges[1] - opt.tnu_edges[0]
+    found = [[] for _ in base]
+    picks = rng.integers(0, len(tnu_units), size=(opt.bootstrap, len(tnu_units)))
+    for p in picks:
+        resampled = stats.find_peaks(tnu_units[p].sum(axis=0), opt.tnu_edges)
+        for i, b in enumerate(base):
+            if len(resampled):
+                near = resampled[np.argmin(np.abs(resampled - b))]
+                if abs(near - b) <= 5 * width:
+                    found[i].append(near)
+    rows = []
+    for b, f in zip(base, found):
+        lo, hi = (np.percentile(f, [50 * (1 - opt.level), 100 - 50 * (1 - opt.level)])
+                  if len(f) else (np.nan, np.nan))
+        rows.append([b, lo, hi])
+    return np.array(rows)

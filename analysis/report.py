@@ -1,0 +1,45 @@
+"""The summary numbers of every parameter point as a text table."""
+import numpy as np
+
+from .reduce import NUMBERS, PARAMS
+
+LABELS = {
+    "n_events": "events", "n_large": "large", "fraction_large": "frac(mu>=mu_c)",
+    "n_recurrences": "recurrences", "mean_tnu": "mean T*nu", "mode_tnu": "mode T*nu",
+    "mean_tnu_interior": "mean T*nu (int.)", "b_value": "b-value", "ks_gr": "KS to GR",
+}
+
+
+def varying(s):
+    """Model parameters that differ between points (for labels and legends)."""
+    return [p for p in PARAMS if len(np.unique(s[f"points/{p}"])) > 1] or ["b"]
+
+
+def point_label(s, i, keys=None):
+    keys = keys or varying(s)
+    return ", ".join(f"{k} = {s[f'points/{k}'][i]:g}" for k in keys)
+
+
+def _fmt(est, lo, hi):
+    if not np.isfinite(est):
+        return "-"
+    if np.isfinite(lo):
+        return f"{est:.4g} [{lo:.4g}, {hi:.4g}]"
+    return f"{est:.4g}"
+
+
+def table(s):
+    a = s["attrs"]
+    lines = [f"summary of {a['catalog']}: mu_c = {a['mu_c']}, window = {a['window']} blocks, "
+             f"b-value above mu = {a['b_cut']}, {int(a['level'] * 100)}% intervals from "
+             f"{a['bootstrap']} bootstrap resamples", ""]
+    for i in range(len(s["points/N"])):
+        lines.append(f"point {i}: " + point_label(s, i, list(PARAMS)) +
+                     f"  (resampling {s['points/method'][i]}, {s['points/units'][i]} units)")
+        for name in NUMBERS:
+            est, lo, hi = s[f"points/numbers/{name}"][i]
+            lines.append(f"    {LABELS[name]:>18s}  {_fmt(est, lo, hi)}")
+        peaks = [row for row in s["points/peaks"][i] if np.isfinite(row[0])]
+        lines.append(f"    {'T*nu peaks':>18s}  " + ("; ".join(_fmt(*row) for row in peaks) or "-"))
+        lines.append("")
+    return "\n".join(lines)
