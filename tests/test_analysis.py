@@ -1,0 +1,158 @@
+"""Reduction: merged histograms, recurrence times, bootstrap coverage, b-value, serial vs MPI."""
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from analysis import stats, summary
+from analysis.recurrence import RecurrenceScanner
+from ensemble import catalog
+
+from .conftest import run_cli, write_config
+
+
+def run_analysis(*args):
+    return subprocess.run([sys.executable, "-m", "analysis", *map(str, args)], capture_output=True, text=True)
+
+
+@pytest.fixture(scope="module")
+def reduced(tmp_path_factory):
+    """A real catalog (2 points x 2 seeds, N = 60) and its summary."""
+    d = tmp_path_factory.mktemp("analysis")
+    cfg = write_config(d / "cfg.toml", sweep={"b": [20.0, 30.0]}, run={"seeds": 2, "events": 300, "transient": 50},
+                       integrator={"dt": 5e-4})
+    assert run_cli("run", cfg, "-o", d / "cat.h5").returncode == 0
+    res = run_analysis("reduce", d / "cat.h5", "-o", d / "sum.h5", "--bootstrap", "200", "--mu-c", "3.5")
+    assert res.returncode == 0, res.stderr
+    return d
+
+
+def brute_force_recurrence(t, epi, mu, boundary, mu_c, window):
+    """O(n^2) reference: for each large event the first later large event within the window."""
+    out = []
+    large = np.flatnonzero(mu >= mu_c)
+    for a, i in enumerate(large):
+        for j in large[a + 1:]:
+            if abs(epi[j] - epi[i]) <= window:
+                out.append((i, t[j] - t[i], not boundary[i]))
+                break
+    return sorted(out)
+
+
+def test_merged_histograms_equal_histogram_of_pooled_events(reduced):
+    events, tasks, _ = catalog.read(reduced / "cat.h5")
+    s = summary.read(reduced / "sum.h5")
+    edges = s["bins/mu"]
+    for point in (0, 1):
+        mine = np.isin(events["task"], np.flatnonzero(tasks["point"] == point))
+        pooled, _ = np.histogram(events["mu"][mine], bins=edges)
+        merged = s["per_task/mu"][tasks["point"] == point].sum(axis=(0, 1))
+        np.testing.assert_array_equal(merged, pooled)
+        np.testing.assert_allclose(s["points/mu_density"][point],
+                                   pooled / (np.count_nonzero(mine) * np.diff(edges)))
+        # the recurrence histogram covers exactly the brute-force recurrence times
+        tnu = []
+        for k in np.flatnonzero(tasks["point"] == point):
+            e = events["task"] == k
+            rec = brute_force_recurrence(events["t"][e], events["epicenter"][e], events["mu"][e],
+                                         events["boundary"][e], 3.5, 10)
+            tnu += [T * 1e-8 for _, T, _ in rec]
+        pooled_t, _ = np.histogram(tnu, bins=s["bins/tnu"])
+        np.testing.assert_array_equal(s["per_task/tnu"][tasks["point"] == point].sum(axis=(0, 1)), pooled_t)
+        assert s["points/numbers/n_recurrences"][point][0] == len(tnu) > 10
+
+
+@pytest.mark.parametrize("chunk", [1, 7, 10000])
+def test_recurrence_scan_matches_brute_force(chunk):
+    """Synthetic catalog with epicenters exactly at the window edge and an interior filter."""
+    rng = np.random.default_rng(5)
+    n, window = 3000, 10
+    t = np.cumsum(rng.exponential(1.0, n))
+    epi = rng.integers(0, 200, n)
+    epi[100:110] = [50, 60, 71, 61, 50, 40, 29, 39, 50, 61]   # distances 10 (in) and 11 (out)
+    mu = rng.uniform(0, 6, n)
+    mu[100:110] = 5.0
+    boundary = rng.random(n) < 0.3
+    expected = brute_force_recurrence(t, epi, mu, boundary, 4.0, window)
+    scanner = RecurrenceScanner(200, 4.0, window)
+    got = []
+    for lo in range(0, n, chunk):
+        src, T, interior = scanner.feed(t[lo:lo + chunk], epi[lo:lo + chunk], mu[lo:lo + chunk],
+                                        boundary[lo:lo + chunk])
+        got += list(zip(src.tolist(), T.tolist(), interior.tolist()))
+    got.sort()
+    assert [g[0] for g in got] == [e[0] for e in expected]
+    np.testing.assert_allclose([g[1] for g in got], [e[1] for e in expected], rtol=1e-12)
+    assert [g[2] for g in got] == [e[2] for e in expected]
+    pairs = dict((g[0], g[1]) for g in got)
+    assert pairs[100] == pytest.approx(t[101] - t[100])      # |60 - 50| = 10: inside
+    assert pairs[102] == pytest.approx(t[103] - t[102])      # |61 - 71| = 10: inside
+    assert pairs[101] == pytest.approx(t[103] - t[101])      # 102 at |71 - 60| = 11 is outside
+
+
+def test_bootstrap_interval_covers_truth_at_nominal_rate():
+    """Mean of exponential data from 10 independent seeds: the 95% interval covers 1 about 95% of the time."""
+    rng = np.random.default_rng(2)
+    trials, covered = 300, 0
+    for _ in range(trials):
+        units = np.array([[50, rng.exponential(1.0, 50).sum()] for _ in range(10)])
+        samples = stats.bootstrap(units, lambda s: s[1] / s[0], 400, rng)
+        lo, hi = stats.percentile_interval(samples, 0.95)
+        covered += lo <= 1.0 <= hi
+    rate = covered / trials
+    print(f"bootstrap coverage of the nominal 95% interval: {rate:.3f}")
+    # percentile bootstrap with 10 units under-covers slightly; binomial sd at 0.95 is 0.013
+    assert 0.88 <= rate <= 0.99
+
+
+def test_b_value_recovers_known_gutenberg_richter():
+    rng = np.random.default_rng(4)
+    for b_true in (0.5, 1.0, 1.5):
+        mu = 3.0 + rng.exponential(np.log10(np.e) / b_true, 20000)
+        b = stats.b_value(len(mu), mu.sum(), 3.0)
+        assert abs(b - b_true) < 3 * b_true / np.sqrt(len(mu))
+        counts, edges = np.histogram(mu, bins=np.linspace(3, 8, 51))
+        assert stats.gr_ks_distance(counts, edges, 3.0, b) < 0.02        # fits a GR law
+        assert stats.gr_ks_distance(counts, edges, 3.0, 2 * b) > 0.2     # and not a wrong one
+
+
+def test_single_seed_uses_block_bootstrap_and_says_so(tmp_path):
+    cfg = write_config(tmp_path / "c.toml", run={"seeds": 1, "events": 200, "transient": 20})
+    assert run_cli("run", cfg, "-o", tmp_path / "one.h5").returncode == 0
+    res = run_analysis("reduce", tmp_path / "one.h5", "--bootstrap", "50", "--blocks", "10")
+    assert res.returncode == 0, res.stderr
+    assert "block bootstrap" in res.stdout
+    s = summary.read(tmp_path / "one.summary.h5")
+    assert list(s["points/method"]) == ["blocks"] and s["points/units"][0] == 10
+    lo, hi = s["points/numbers/fraction_large"][0][1:]
+    assert lo < hi
+
+
+def test_report_and_figures(reduced):
+    res = run_analysis("report", reduced / "sum.h5")
+    assert res.returncode == 0 and "b = 20" in res.stdout and "b-value" in res.stdout
+    for fig in ("magnitude", "recurrence"):
+        out = reduced / f"{fig}.png"
+        res = run_analysis("plot", reduced / "sum.h5", "--figure", fig, "-o", out)
+        assert res.returncode == 0, res.stderr
+        assert out.stat().st_size > 10000
+    res = run_analysis("reduce", reduced / "cat.h5", "-o", reduced / "sum.h5")
+    assert res.returncode == 1 and "--force" in res.stderr
+    res = run_analysis("reduce", reduced / "cat.h5", "--mu-bins", "3:1:5", "-o", reduced / "x.h5")
+    assert res.returncode == 2 and "bins" in res.stderr
+
+
+@pytest.mark.mpi
+@pytest.mark.skipif(shutil.which("mpiexec") is None, reason="mpiexec not found")
+def test_serial_and_mpi_reduction_agree(reduced):
+    res = subprocess.run(["mpiexec", "-n", "2", sys.executable, "-m", "analysis", "reduce", reduced / "cat.h5",
+                          "-o", reduced / "sum_mpi.h5", "--bootstrap", "200", "--mu-c", "3.5"],
+                         capture_output=True, text=True, timeout=300)
+    assert res.returncode == 0, res.stderr
+    a, b = summary.read(reduced / "sum.h5"), summary.read(reduced / "sum_mpi.h5")
+    assert set(a) == set(b)
+    for key in a:
+        if key != "attrs":
+            np.testing.assert_array_equal(a[key], b[key], err_msg=key)
