@@ -222,6 +222,8 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
     block_steps = 0
     vmax = v_start
     status = OK
+    v_limit = RK4_STABILITY / dt
+    psi_limit = -math.log(v_limit)
     while na > 0:
         if steps >= max_steps or tau > max_duration:
             status = TOO_LONG
@@ -303,10 +305,8 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
         block_steps += na
         work += dwork
         slip_time += dslip
-        # Health of the step: finite, and within RK4's stability region for the
-        # state equation (rate 1/theta = exp(-psi)) and the velocity (rate v).
-        v_limit = RK4_STABILITY / h
-        psi_limit = -math.log(v_limit)
+        # Health of the step: finite, and within RK4's stability region (for a
+        # full step dt) for the state equation (rate 1/theta = exp(-psi)) and v.
         for k in range(na):
             i = act[k]
             v = W[i, V]
