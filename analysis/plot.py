@@ -14,7 +14,8 @@ def _band(ax, x, y, lo, hi, label, color, log=False, style="-"):
     ax.plot(x[ok], y[ok], style, color=color, label=label, lw=1.4)
     okb = ok & np.isfinite(lo) & np.isfinite(hi)
     if okb.any():
-        low = np.where(log, np.maximum(lo, y * 1e-3), lo) if log else lo
+        # on a log axis a lower bound of 0 is drawn down to the axis' bottom
+        low = np.where(lo > 0, lo, 1e-300) if log else lo
         ax.fill_between(x[okb], low[okb], hi[okb], color=color, alpha=0.25, lw=0)
 
 
@@ -25,6 +26,9 @@ def magnitude(s, ax):
         _band(ax, x, s["points/mu_density"][i], s["points/mu_lo"][i], s["points/mu_hi"][i],
               point_label(s, i, keys), f"C{i}", log=True)
     ax.set_yscale("log")
+    positive = s["points/mu_density"][s["points/mu_density"] > 0]
+    if positive.size:
+        ax.set_ylim(positive.min() / 3, positive.max() * 3)
     ax.set_xlabel(r"magnitude $\mu$")
     ax.set_ylabel(r"$R(\mu)$")
     ax.legend(title="varying " + ", ".join(keys), fontsize=8)

@@ -26,8 +26,8 @@ def centers(edges):
     return 0.5 * (edges[1:] + edges[:-1])
 
 
-def find_peaks(counts, edges, rel_height=0.2, min_separation=3):
-    """Positions of the local maxima of a [1, 2, 1]-smoothed histogram.
+def find_peaks(counts, edges, rel_height=0.3, min_separation=4):
+    """Positions of the local maxima of a [1, 4, 6, 4, 1]-smoothed histogram.
 
     A peak must reach rel_height of the highest one and lie at least
     min_separation bins from a higher peak. Returned in decreasing height.
@@ -35,7 +35,7 @@ def find_peaks(counts, edges, rel_height=0.2, min_separation=3):
     c = np.asarray(counts, dtype=float)
     if c.sum() <= 0:
         return np.zeros(0)
-    s = np.convolve(np.pad(c, 1, mode="edge"), [0.25, 0.5, 0.25], mode="valid")
+    s = np.convolve(np.pad(c, 2, mode="edge"), np.array([1, 4, 6, 4, 1]) / 16, mode="valid")
     is_max = np.r_[s[0] > s[1], (s[1:-1] >= s[:-2]) & (s[1:-1] > s[2:]), s[-1] > s[-2]]
     candidates = [i for i in np.argsort(-s) if is_max[i] and s[i] >= rel_height * s.max()]
     chosen = []
