@@ -93,18 +93,19 @@ def test_recurrence_scan_matches_brute_force(chunk):
 
 
 def test_bootstrap_interval_covers_truth_at_nominal_rate():
-    """Mean of exponential data from 10 independent seeds: the 95% interval covers 1 about 95% of the time."""
+    """Mean of exponential data from 20 independent seeds: the 95% interval covers 1 about 95% of the time."""
     rng = np.random.default_rng(2)
-    trials, covered = 300, 0
+    trials, covered = 400, 0
     for _ in range(trials):
-        units = np.array([[50, rng.exponential(1.0, 50).sum()] for _ in range(10)])
+        units = np.array([[30, rng.exponential(1.0, 30).sum()] for _ in range(20)])
         samples = stats.bootstrap(units, lambda s: s[1] / s[0], 400, rng)
         lo, hi = stats.percentile_interval(samples, 0.95)
         covered += lo <= 1.0 <= hi
     rate = covered / trials
     print(f"bootstrap coverage of the nominal 95% interval: {rate:.3f}")
-    # percentile bootstrap with 10 units under-covers slightly; binomial sd at 0.95 is 0.013
-    assert 0.88 <= rate <= 0.99
+    # the percentile bootstrap under-covers a little with 20 units (about 0.93); the binomial
+    # standard deviation of the measured rate is 0.012
+    assert 0.90 <= rate <= 0.98
 
 
 def test_b_value_recovers_known_gutenberg_richter():
