@@ -5,7 +5,8 @@ import numpy as np
 
 from .integrators import INTEGRATORS
 from .model.chain import load_quietly, next_onset
-from .model.workspace import (D_DURATION, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK, OK,
+from .model.workspace import (D_BLOCK_STEPS, D_DURATION, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX,
+                              D_WORK, OK,
                               STATUS_TEXT, Workspace)
 
 
@@ -15,6 +16,7 @@ class EventResult:
     slip: float             # sum of the slips
     duration: float
     steps: int
+    block_steps: int        # sum over steps of the number of sliding blocks
     vmax: float
     friction_work: float    # int sum(Phi v) dt, c-free frame
     energy_residual: float  # dE_elastic + friction work - loading work
@@ -71,7 +73,8 @@ def run_event(force, psi, epicenter, model, integrator, v_start=0.0):
         model.nu, model.a, model.b, integrator.dt, -np.inf, integrator.max_duration, max_steps,
         ws.diag, profile)
     d = ws.diag
-    return EventResult(status, d[D_SLIP], d[D_DURATION], int(d[D_STEPS]), d[D_VMAX], d[D_WORK],
+    return EventResult(status, d[D_SLIP], d[D_DURATION], int(d[D_STEPS]), int(d[D_BLOCK_STEPS]),
+                       d[D_VMAX], d[D_WORK],
                        d[D_RESIDUAL], profile, ws.force.copy(), ws.psi.copy())
 
 
