@@ -1,4 +1,4 @@
-"""Command line: python -m ensemble run|validate|status ...
+"""Command line: python -m ensemble run|validate|status|slurm ...
 
 Under mpirun every rank runs the same command. An exception on any rank is
 printed with the rank (and the task, where there is one) and aborts all ranks
@@ -27,6 +27,8 @@ def _parser():
     run.add_argument("--resume", action="store_true", help="continue an interrupted run from its checkpoints")
     st = sub.add_parser("status", help="summarise a catalog (finished, or being written)")
     st.add_argument("catalog", help="catalog path (PATH.partial is found automatically)")
+    from .slurm import add_arguments
+    add_arguments(sub.add_parser("slurm", help="write (and submit) Slurm job scripts for a config"))
     return p
 
 
@@ -74,10 +76,15 @@ def _run(args):
         return 1
 
 
+def _slurm(args):
+    from .slurm import command
+    return command(args)
+
+
 def main(argv=None):
     args = _parser().parse_args(argv)
     try:
-        return {"run": _run, "validate": _validate, "status": _status}[args.command](args)
+        return {"run": _run, "validate": _validate, "status": _status, "slurm": _slurm}[args.command](args)
     except (ConfigError, CatalogError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2 if isinstance(err, ConfigError) else 1

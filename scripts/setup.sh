@@ -4,6 +4,7 @@
 # from source against them. A second run only checks and takes seconds.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+ROOT=$PWD
 export DEBIAN_FRONTEND=noninteractive
 
 need_pkgs=()
@@ -36,7 +37,9 @@ if ! $VPY -c "import h5py, sys; sys.exit(0 if h5py.get_config().mpi else 1)" 2>/
 fi
 # The project itself (editable) with its remaining dependencies and test tools.
 stamp=.venv/.ensemble-installed
-if [ ! -f "$stamp" ] || [ setup.cfg -nt "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
+# (an editable install maps the packages that existed when it ran: check from outside the tree)
+if [ ! -f "$stamp" ] || [ setup.cfg -nt "$stamp" ] || [ pyproject.toml -nt "$stamp" ] \
+   || ! (cd / && "$ROOT/$VPY" -c "import ensemble, analysis") 2>/dev/null; then
   echo "setup: installing the project"
   $VPY -m pip install -q --no-build-isolation -e ".[test]"
   touch "$stamp"

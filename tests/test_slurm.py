@@ -1,0 +1,437 @@
+"""Slurm job templates: rendering (fast), and the rendered jobs on a real single-node Slurm (slow).
+
+The slow tests install Slurm from Debian packages if it is missing, start munged, slurmctld and
+slurmd on this machine (own ports, own munge socket, state under a temporary directory, nothing
+in /etc touched) and submit the rendered jobs. They skip, naming the reason, where Slurm cannot
+be installed or started.
+"""
+import os
+import re
+import shutil
+import socket
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from ensemble import catalog
+from ensemble.config import load, loads
+from ensemble.slurm import (KINDS, PLACEHOLDER, PLACEHOLDERS, TEMPLATES, JobOptions, SlurmError,
+                            element_seed, fill, render, time_seconds)
+
+from .conftest import ROOT, write_config
+
+PACKAGES = ["slurmctld", "slurmd", "slurm-client", "munge"]
+DAEMONS = ["munged", "slurmctld", "slurmd", "sbatch", "srun", "scontrol", "sinfo"]
+FINISHED = {"COMPLETED", "FAILED", "CANCELLED", "TIMEOUT", "NODE_FAIL", "OUT_OF_MEMORY",
+            "BOOT_FAIL", "DEADLINE", "PREEMPTED"}
+
+
+def tiny_config(path, **sections):
+    """Two points x two seeds, about 2 s per task (N = 60, 200 events); the catalog path is
+    relative, so the rendered jobs write it into their job directory."""
+    base = {"sweep": {"b": [20.0, 30.0]}, "run": {"seeds": 2, "events": 200, "transient": 20},
+            "output": {"batch": 50, "flush_seconds": 0.5, "path": path.stem + ".h5"}}
+    for name, values in sections.items():
+        base.setdefault(name, {}).update(values)
+    return write_config(path, **base)
+
+
+def assert_same_events(path_a, path_b):
+    a, ta, _ = catalog.read(path_a)
+    b, tb, _ = catalog.read(path_b)
+    assert len(a["t"]) == len(b["t"]) > 0
+    order_a, order_b = np.lexsort((a["t"], a["task"])), np.lexsort((b["t"], b["task"]))
+    for name in catalog.EVENT_FIELDS:
+        np.testing.assert_array_equal(a[name][order_a], b[name][order_b], err_msg=name)
+    for name in catalog.TASK_FIELDS:
+        np.testing.assert_array_equal(ta[name], tb[name], err_msg=name)
+
+
+# ---------------------------------------------------------------- rendering (no Slurm needed)
+
+def test_time_limits_as_slurm_reads_them():
+    assert time_seconds("90") == 5400
+    assert time_seconds("1:30") == 120          # minutes:seconds, rounded up to whole minutes
+    assert time_seconds("02:00:00") == 7200
+    assert time_seconds("1-12") == 36 * 3600
+    assert time_seconds("1-0:30") == 86400 + 1800
+    assert time_seconds("2-00:00:30") == 2 * 86400 + 60
+    for bad in ("", "1:2:3:4", "x", "-5", "0", "1h"):
+        with pytest.raises(SlurmError):
+            time_seconds(bad)
+
+
+def test_every_placeholder_is_known_and_documented():
+    readme = (TEMPLATES / "README.md").read_text()
+    used = set()
+    for path in TEMPLATES.glob("*.sbatch"):
+        used |= set(PLACEHOLDER.findall(path.read_text()))
+    assert used == set(PLACEHOLDERS)
+    for name in PLACEHOLDERS:
+        assert f"@{name}@" in readme, name
+    assert {t for t, _ in KINDS.values()} | {"reduce.sbatch"} == {p.name for p in TEMPLATES.glob("*.sbatch")}
+
+
+def test_fill_drops_lines_with_empty_values_and_refuses_unknown_ones():
+    text = "#SBATCH --partition=@PARTITION@\n#SBATCH --ntasks=@NTASKS@\n@SETUP@\necho\n"
+    out = fill(text, {"PARTITION": "", "NTASKS": 4, "SETUP": "module load a\nmodule load b"})
+    assert out == "#SBATCH --ntasks=4\nmodule load a\nmodule load b\necho\n"
+    with pytest.raises(SlurmError, match="@NTASKS@"):
+        fill(text, {"PARTITION": "p", "SETUP": ""})
+
+
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_rendered_scripts_are_complete_and_valid_bash(tmp_path, kind):
+    cfg = load(tiny_config(tmp_path / "tiny.toml"))
+    opt = JobOptions(kind=kind, ntasks=8, time="02:00:00", partition="short", account="geo",
+                     setup=("module load mpich",), sbatch=("--mem-per-cpu=2G",), file_locking=False)
+    out = render(cfg, opt, tmp_path / "job", "tiny")
+    for script in (out.run_script, out.reduce_script, out.directory / "submit.sh"):
+        text = script.read_text()
+        assert not PLACEHOLDER.search(text), script
+        subprocess.run(["bash", "-n", str(script)], check=True)
+    text = out.run_script.read_text()
+    header = text[:text.index("set -u")]
+    for line in ("#SBATCH --partition=short", "#SBATCH --account=geo", "#SBATCH --ntasks=8",
+                 "#SBATCH --cpus-per-task=1", "#SBATCH --time=02:00:00", "#SBATCH --mem-per-cpu=2G"):
+        assert line in header, line
+    assert "module load mpich" in text and "export HDF5_USE_FILE_LOCKING=FALSE" in text
+    assert f"PYTHON={sys.executable}" in text
+    if kind != "single":
+        assert "#SBATCH --signal=B:USR1@300" in header and "#SBATCH --requeue" in header
+    assert "#SBATCH --kill-on-invalid-dep=yes" in out.reduce_script.read_text()
+    # without partition, account and locking advice those lines are gone
+    plain = render(cfg, JobOptions(kind=kind, ntasks=2, time="30"), tmp_path / "plain", "tiny")
+    text = plain.run_script.read_text()
+    assert "--partition" not in text and "--account" not in text
+    assert "HDF5_USE_FILE_LOCKING=" not in text.replace("#   export HDF5_USE_FILE_LOCKING=FALSE", "")
+
+
+def test_array_elements_are_standalone_configs_one_per_point(tmp_path):
+    cfg = load(tiny_config(tmp_path / "tiny.toml", sweep={"b": [20.0, 30.0, 40.0]}, run={"seed": 7}))
+    out = render(cfg, JobOptions(kind="array", ntasks=2, time="10", array_limit=2), tmp_path / "job")
+    assert "#SBATCH --array=0-2%2" in out.run_script.read_text()
+    assert [c.name for c in out.catalogs] == ["point-0000.h5", "point-0001.h5", "point-0002.h5"]
+    seeds = set()
+    for i, b in enumerate([20.0, 30.0, 40.0]):
+        sub = load(out.directory / "points" / f"point-{i:04d}.toml")
+        assert sub.sweep == () and sub.model.b == b and sub.run.seeds == 2
+        assert sub.run.seed == element_seed(7, i) and sub.output.path == str(out.catalogs[i])
+        seeds.add(sub.run.seed)
+    assert len(seeds) == 3
+    assert " ".join(map(str, out.catalogs)) in out.reduce_script.read_text()
+
+
+def test_bad_options_are_refused(tmp_path):
+    cfg = load(tiny_config(tmp_path / "tiny.toml"))
+    for opt in (JobOptions(time="1", signal_seconds=60), JobOptions(time="1", startup_seconds=40),
+                JobOptions(ntasks=0), JobOptions(launcher="ssh"), JobOptions(partition="a b")):
+        with pytest.raises(SlurmError):
+            render(cfg, opt, tmp_path / "job")
+    with pytest.raises(SlurmError, match="paths in job scripts"):
+        render(cfg, JobOptions(), tmp_path / "a job")
+
+
+def test_cli_renders_without_submitting(tmp_path):
+    cfg = tiny_config(tmp_path / "tiny.toml")
+    res = subprocess.run([sys.executable, "-m", "ensemble", "slurm", str(cfg), "--ntasks", "4",
+                          "--time", "01:00:00", "-o", str(tmp_path / "job")], capture_output=True,
+                         text=True, cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert "submit with: bash job/submit.sh" in res.stdout
+    assert (tmp_path / "job" / "requeue.sbatch").exists() and (tmp_path / "job" / "config.toml").exists()
+    snapshot = loads((tmp_path / "job" / "config.toml").read_text())
+    assert snapshot.output.path == str(tmp_path / "job" / "tiny.h5")
+    res = subprocess.run([sys.executable, "-m", "ensemble", "slurm", str(cfg), "--ntasks", "4",
+                          "--time", "1h"], capture_output=True, text=True, cwd=tmp_path)
+    assert res.returncode == 2 and "--time" in res.stderr
+
+
+# ---------------------------------------------------------------- a real Slurm (slow)
+
+def _free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _install():
+    """Install Slurm and munge from Debian packages; returns None or why it failed."""
+    env = dict(os.environ, DEBIAN_FRONTEND="noninteractive")
+    cmd = ["apt-get", "install", "-y", "-q", "--no-install-recommends", *PACKAGES]
+    for attempt in (cmd, ["apt-get", "update", "-q"], cmd):
+        res = subprocess.run(attempt, capture_output=True, text=True, env=env, stdin=subprocess.DEVNULL,
+                             timeout=900)
+        if res.returncode == 0 and attempt is cmd:
+            return None
+    return f"apt-get install {' '.join(PACKAGES)} failed: {res.stderr.strip()[-300:]}"
+
+
+class Cluster:
+    """munged, slurmctld and slurmd on this machine: one node (this host, 2 CPUs), one partition."""
+
+    def __init__(self, base):
+        self.base = base
+        self.conf = base / "slurm.conf"
+        self.procs = []
+        self.env = dict(os.environ, SLURM_CONF=str(self.conf), TMPDIR=str(base / "tmp"))
+        # jobs get the submitting environment: keep numba's cache job-local (the template's
+        # default under $TMPDIR) instead of the one the test session may have exported
+        self.env.pop("NUMBA_CACHE_DIR", None)
+
+    def write_config(self):
+        node = socket.gethostname().split(".")[0]
+        for d in ("state", "spool", "log", "munge", "tmp"):
+            (self.base / d).mkdir(mode=0o700, exist_ok=True)
+        key = self.base / "munge" / "munge.key"
+        key.write_bytes(os.urandom(1024))
+        key.chmod(0o600)
+        b = self.base
+        self.conf.write_text(f"""\
+ClusterName=bktest
+SlurmctldHost={node}(127.0.0.1)
+SlurmUser=root
+SlurmdUser=root
+SlurmctldPort={_free_port()}
+SlurmdPort={_free_port()}
+AuthType=auth/munge
+AuthInfo=socket={b}/munge/munge.sock
+CryptoType=crypto/munge
+StateSaveLocation={b}/state
+SlurmdSpoolDir={b}/spool
+SlurmctldPidFile={b}/slurmctld.pid
+SlurmdPidFile={b}/slurmd.pid
+SlurmctldLogFile={b}/log/slurmctld.log
+SlurmdLogFile={b}/log/slurmd.log
+ProctrackType=proctrack/linuxproc
+TaskPlugin=task/none
+SelectType=select/cons_tres
+SelectTypeParameters=CR_Core
+MpiDefault=none
+JobRequeue=1
+ReturnToService=2
+MinJobAge=600
+KillWait=10
+InactiveLimit=0
+SchedulerParameters=sched_interval=2
+JobAcctGatherType=jobacct_gather/none
+AccountingStorageType=accounting_storage/none
+MailProg=/bin/true
+NodeName={node} NodeAddr=127.0.0.1 CPUs=2 RealMemory=1000 State=UNKNOWN
+PartitionName=debug Nodes=ALL Default=YES MaxTime=INFINITE State=UP
+""")
+        return node
+
+    def _start(self, *cmd):
+        log = open(self.base / "log" / f"{os.path.basename(cmd[0])}.out", "w")
+        self.procs.append(subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, env=self.env,
+                                           stdin=subprocess.DEVNULL))
+
+    def start(self):
+        """Start the daemons; returns None or why the node did not come up."""
+        self.write_config()
+        b = self.base / "munge"
+        self._start("munged", "-F", "--force", f"--key-file={b}/munge.key", f"--socket={b}/munge.sock",
+                    f"--pid-file={b}/munged.pid", f"--log-file={b}/munged.log", f"--seed-file={b}/seed")
+        if not self._wait(lambda: (b / "munge.sock").exists(), 20):
+            return "munged did not start: " + self.tail(b / "munged.log")
+        self._start("slurmctld", "-D", "-c", "-f", str(self.conf))
+        self._start("slurmd", "-D", "-f", str(self.conf))
+        if not self._wait(lambda: self.run("sinfo", "-h", "-o", "%T").stdout.strip() == "idle", 60):
+            return ("the node did not become idle: " + self.tail(self.base / "log" / "slurmctld.log")
+                    + " / " + self.tail(self.base / "log" / "slurmd.log"))
+        return None
+
+    def stop(self):
+        self.run("scancel", "--user=root")
+        self._wait(lambda: not self.run("squeue", "-h").stdout.strip(), 30)
+        for proc in reversed(self.procs):
+            proc.terminate()
+            try:
+                proc.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
+
+    @staticmethod
+    def tail(path, n=5):
+        try:
+            return " | ".join(path.read_text().strip().splitlines()[-n:])
+        except OSError:
+            return f"(no {path.name})"
+
+    @staticmethod
+    def _wait(predicate, timeout):
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            if predicate():
+                return True
+            time.sleep(0.5)
+        return False
+
+    def run(self, *cmd, check=False):
+        res = subprocess.run(cmd, capture_output=True, text=True, env=self.env, stdin=subprocess.DEVNULL,
+                             timeout=120)
+        if check:
+            assert res.returncode == 0, f"{' '.join(cmd)}: {res.stderr}"
+        return res
+
+    def cli(self, *args, cwd=None):
+        """python -m ensemble ... with the cluster's environment (for --submit)."""
+        return subprocess.run([sys.executable, "-m", "ensemble", *map(str, args)], capture_output=True,
+                              text=True, env=self.env, cwd=cwd, stdin=subprocess.DEVNULL)
+
+    def jobs(self, job_id):
+        """scontrol's view of a job (one dict per array element): {key: value}."""
+        res = self.run("scontrol", "-o", "show", "job", str(job_id), check=True)
+        return [dict(re.findall(r"(\w+)=(\S*)", line)) for line in res.stdout.strip().splitlines()]
+
+    def wait(self, job_ids, timeout, check=None):
+        """Wait until every job (every element) has finished. Requeued jobs are released at
+        once: Slurm holds a requeued job for 120 s before it may start again (hard-coded), which
+        would only make the test longer. `check()` runs at each poll while jobs are left."""
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            states = [j for job_id in job_ids for j in self.jobs(job_id)]
+            for j in states:
+                if j["JobState"] == "PENDING" and j["Reason"] == "BeginTime" and int(j["Restarts"]) > 0:
+                    self.run("scontrol", "update", f"JobId={j['JobId']}", "StartTime=now")
+            if all(j["JobState"] in FINISHED for j in states):
+                return states
+            if check is not None:
+                check()
+            time.sleep(1)
+        raise AssertionError(f"jobs {job_ids} not finished after {timeout} s: "
+                             + "; ".join(f"{j['JobId']} {j['JobState']} {j['Reason']}" for j in states))
+
+
+@pytest.fixture(scope="module")
+def cluster(tmp_path_factory):
+    if os.geteuid() != 0:
+        pytest.skip("starting a Slurm cluster needs root")
+    if any(shutil.which(d) is None for d in DAEMONS):
+        if shutil.which("apt-get") is None:
+            pytest.skip("Slurm is not installed and there is no apt-get to install it")
+        why = _install()
+        if why:
+            pytest.skip(why)
+    c = Cluster(tmp_path_factory.mktemp("slurm"))
+    why = c.start()
+    if why:
+        c.stop()
+        pytest.skip(f"Slurm did not start: {why}")
+    yield c
+    c.stop()
+
+
+def submitted(res):
+    """Job ids from the output of `python -m ensemble slurm --submit`: (run, reduce)."""
+    assert res.returncode == 0, res.stdout + res.stderr
+    run_id = re.search(r"submitted run job (\d+)", res.stdout).group(1)
+    reduce_id = re.search(r"submitted reduction job (\d+)", res.stdout).group(1)
+    return run_id, reduce_id
+
+
+def slurm_time(text):
+    return time.mktime(time.strptime(text, "%Y-%m-%dT%H:%M:%S"))
+
+
+def reference_run(cfg, out, ranks=1):
+    """An uninterrupted run outside Slurm (serial, or under mpiexec -n ranks)."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=os.environ.get("NUMBA_CACHE_DIR", str(ROOT / ".numba_cache")),
+               OMP_NUM_THREADS="1", NUMBA_NUM_THREADS="1")
+    mpiexec = shutil.which("mpiexec")
+    launch = [mpiexec, "-n", str(ranks)] if ranks > 1 and mpiexec else []
+    res = subprocess.run(launch + [sys.executable, "-m", "ensemble", "run", str(cfg), "-o", str(out)],
+                         capture_output=True, text=True, env=env, stdin=subprocess.DEVNULL)
+    assert res.returncode == 0, res.stderr
+
+
+def logs(directory):
+    return "\n".join(p.read_text() for p in sorted((directory / "logs").glob("*.out")))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("launcher", ["srun", "mpiexec"])
+def test_single_run_job_equals_serial_run(cluster, tmp_path, launcher):
+    cfg = tiny_config(tmp_path / "tiny.toml")
+    reference_run(cfg, tmp_path / "serial.h5")
+    job = tmp_path / "job"
+    run_id, reduce_id = submitted(cluster.cli("slurm", cfg, "--kind", "single", "--ntasks", 2,
+                                              "--time", 10, "--launcher", launcher, "-o", job, "--submit"))
+    run, reduce = cluster.wait([run_id, reduce_id], 300)
+    assert run["JobState"] == "COMPLETED", logs(job)
+    assert_same_events(tmp_path / "serial.h5", job / "tiny.h5")
+    _, tasks, _ = catalog.read(job / "tiny.h5")
+    assert set(tasks["rank"]) == {0, 1}     # both ranks of the job took tasks
+    assert reduce["JobState"] == "COMPLETED", logs(job)
+    for name in ("tiny.summary.h5", "tiny-magnitude.png", "tiny-recurrence.png", "tiny.report.txt"):
+        assert (job / "results" / name).exists(), name
+
+
+@pytest.mark.slow
+def test_walltime_job_requeues_resumes_and_equals_uninterrupted_run(cluster, tmp_path):
+    """A one-minute limit, USR1 30 s ahead: Slurm checks every ~30 s, so the signal comes 0-30 s
+    after each start and is held until 20 s (--startup-seconds). The run needs about 40 s on two
+    ranks plus the kernels' compile into the job-local cache: at least one requeue."""
+    cfg = tiny_config(tmp_path / "long.toml", sweep={"b": [20.0]}, run={"seeds": 4, "events": 2000},
+                      output={"progress_seconds": 5.0})
+    reference_run(cfg, tmp_path / "full.h5", ranks=2)   # = serial (tests/test_mpi.py)
+    job = tmp_path / "job"
+    run_id, reduce_id = submitted(cluster.cli("slurm", cfg, "--ntasks", 2, "--time", 1,
+                                              "--signal-seconds", 30, "--startup-seconds", 20,
+                                              "--max-requeues", 10, "-o", job, "--submit"))
+    run, reduce = cluster.wait([run_id, reduce_id], 480)
+    text = logs(job)
+    assert run["JobState"] == "COMPLETED", text
+    assert int(run["Restarts"]) >= 1, text
+    print(f"walltime job: {int(run['Restarts'])} requeues")
+    assert text.count("requeueing job") == int(run["Restarts"])
+    assert "interrupted (SIGUSR1)" in text and f"finished: {job / 'long.h5'}" in text
+    assert_same_events(tmp_path / "full.h5", job / "long.h5")
+    # the reduction waited through the requeues for the final, successful end
+    assert reduce["JobState"] == "COMPLETED", text
+    assert slurm_time(reduce["StartTime"]) >= slurm_time(run["EndTime"])
+    assert (job / "results" / "long.summary.h5").exists()
+
+
+@pytest.mark.slow
+def test_array_sweep_then_reduction_only_after_every_element_succeeded(cluster, tmp_path):
+    cfg = tiny_config(tmp_path / "sweep.toml")
+    good, bad = tmp_path / "good", tmp_path / "bad"
+    # an array one of whose elements fails (its config is broken after rendering) ...
+    res = cluster.cli("slurm", cfg, "--kind", "array", "--ntasks", 1, "--time", 5, "-o", bad)
+    assert res.returncode == 0, res.stderr
+    (bad / "points" / "point-0001.toml").write_text("[model]\nN = 'sixty'\n")
+    res = cluster.run("bash", str(bad / "submit.sh"), check=True)
+    bad_run, bad_reduce = re.search(r"run job (\d+).*reduction job (\d+)", res.stdout).groups()
+    # ... and a good one
+    run_id, reduce_id = submitted(cluster.cli("slurm", cfg, "--kind", "array", "--ntasks", 1, "--time", 5,
+                                              "-o", good, "--submit"))
+
+    def no_summary_before_the_end():
+        elements = cluster.jobs(run_id)
+        if any(e["JobState"] not in FINISHED for e in elements):
+            assert not list((good / "results").glob("*.summary.h5"))
+            assert cluster.jobs(reduce_id)[0]["JobState"] == "PENDING"
+
+    states = cluster.wait([run_id, reduce_id, bad_run], 400, check=no_summary_before_the_end)
+    elements, reduce = states[:2], states[2]
+    assert [e["JobState"] for e in elements] == ["COMPLETED", "COMPLETED"], logs(good)
+    assert reduce["JobState"] == "COMPLETED", logs(good)
+    assert slurm_time(reduce["StartTime"]) >= max(slurm_time(e["EndTime"]) for e in elements)
+    for i, b in enumerate([20.0, 30.0]):
+        events, tasks, attrs = catalog.read(good / "points" / f"point-{i:04d}.h5")
+        assert list(tasks["b"]) == [b, b] and len(events["t"]) == 400
+        assert loads(attrs["config"]).run.seed == element_seed(0, i)
+        for suffix in (".summary.h5", "-magnitude.png", "-recurrence.png", ".report.txt"):
+            assert (good / "results" / f"point-{i:04d}{suffix}").exists()
+    # the failed element: the reduction never ran (Slurm cancelled it: --kill-on-invalid-dep)
+    bad_elements = cluster.jobs(bad_run)
+    assert sorted(e["JobState"] for e in bad_elements) == ["COMPLETED", "FAILED"], logs(bad)
+    assert cluster._wait(lambda: cluster.jobs(bad_reduce)[0]["JobState"] == "CANCELLED", 30), \
+        cluster.jobs(bad_reduce)
+    assert not (bad / "results").exists()
