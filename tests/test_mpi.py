@@ -81,6 +81,12 @@ def four_tasks(tmp_path_factory):
     return d, cfg
 
 
+def resume_equals_uninterrupted(d, cfg, out):
+    res = mpirun(2, "run", cfg, "-o", out, "--resume")
+    assert res.returncode == 0, res.stderr
+    assert_same_events(d / "full.h5", out)
+
+
 def rank_pids(root):
     """PIDs of the ranks started by mpiexec `root` (hydra puts each in its own session)."""
     table = subprocess.run(["ps", "-eo", "pid=,ppid=,args="], capture_output=True, text=True).stdout
@@ -135,9 +141,7 @@ def test_resume_after_signal_equals_uninterrupted(four_tasks, sig, which):
     assert 0 < tasks["events_written"].sum() < 4 * 400      # really cut in the middle
     status = run_cli("status", out)
     assert status.returncode == 0 and "in progress or interrupted" in status.stdout
-    res = mpirun(2, "run", cfg, "-o", out, "--resume")
-    assert res.returncode == 0, res.stderr
-    assert_same_events(d / "full.h5", out)
+    resume_equals_uninterrupted(d, cfg, out)
 
 
 def test_resume_after_kill9_loses_and_duplicates_nothing(four_tasks):
@@ -147,9 +151,7 @@ def test_resume_after_kill9_loses_and_duplicates_nothing(four_tasks):
     assert code != 0 and not out.exists()
     events, tasks, _ = catalog.read(catalog.partial_path(out))   # readable after kill -9
     assert len(events["t"]) == tasks["events_written"].sum() < 4 * 400
-    res = mpirun(2, "run", cfg, "-o", out, "--resume")
-    assert res.returncode == 0, res.stderr
-    assert_same_events(d / "full.h5", out)
+    resume_equals_uninterrupted(d, cfg, out)
 
 
 def test_resume_refuses_a_different_config(four_tasks):
