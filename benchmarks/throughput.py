@@ -1,6 +1,7 @@
 """Events per second of a developed chain, one core.
 
-    python benchmarks/throughput.py [--N 800] [--b 20] [--dt 1e-3] [--transient 1000] [--events 2000]
+    python benchmarks/throughput.py [--N 800] [--b 20] [--dt 1e-3] [--method rk4|ark3] [--rtol 1e-6]
+                                    [--transient 1000] [--events 2000]
 
 Runs the transient (not timed, includes compilation), then times `events`
 recorded events and prints events/s, cost per block-step, the magnitude range
@@ -24,13 +25,15 @@ def main():
     p.add_argument("--b", type=float, default=20.0)
     p.add_argument("--a", type=float, default=0.0)
     p.add_argument("--dt", type=float, default=1e-3)
+    p.add_argument("--method", default="rk4", help="rk4 or ark3")
+    p.add_argument("--rtol", type=float, default=1e-6, help="ark3 tolerance")
     p.add_argument("--transient", type=int, default=1000)
     p.add_argument("--events", type=int, default=2000)
     p.add_argument("--seed", type=int, default=0)
     args = p.parse_args()
     cfg = Config(model=Model(N=args.N, b=args.b, a=args.a),
                  run=Run(events=args.events, transient=args.transient, seed=args.seed),
-                 integrator=Integrator(dt=args.dt))
+                 integrator=Integrator(method=args.method, dt=args.dt, rtol=args.rtol))
     traj = Trajectory(cfg, task_list(cfg)[0])
     traj.advance(args.transient)
     start = time.perf_counter()
@@ -38,7 +41,8 @@ def main():
     elapsed = time.perf_counter() - start
     mu = np.log10(diag[:, D_SLIP])
     residual = relative_energy_residual(diag[:, D_RESIDUAL], diag[:, D_WORK])
-    print(f"N={args.N} b={args.b} a={args.a} dt={args.dt}: {args.events / elapsed:.1f} events/s "
+    how = f"dt={args.dt}" if args.method == "rk4" else f"rtol={args.rtol:g}"
+    print(f"N={args.N} b={args.b} a={args.a} {args.method} {how}: {args.events / elapsed:.1f} events/s "
           f"({args.events} events in {elapsed:.1f} s after {args.transient} transient)")
     print(f"  {diag[:, D_STEPS].mean():.0f} steps and {diag[:, D_BLOCK_STEPS].mean():.0f} block-steps per event, "
           f"{elapsed / diag[:, D_BLOCK_STEPS].sum() * 1e9:.0f} ns per block-step")

@@ -5,7 +5,8 @@
 From fixed pre-event states of a developed chain (the next small event, mu < 3, and the next large
 one, mu >= 4), integrates the same event with
 
-- the kernel's fixed-step RK4 (located stick and onset) over a range of dt, and
+- the kernel's fixed-step RK4 (located stick and onset) over a range of dt,
+- the kernel's adaptive IMEX ARK3(2) over a range of rtol (the "dt" column holds rtol), and
 - a straightforward full-array numpy RK4 (every block every step, stick by clamping v at the end of
   a step), the baseline a first implementation would be,
 
@@ -45,10 +46,10 @@ def pre_event_states(model, transient, seed=0):
     return found
 
 
-def kernel_event(f, p, epicenter, model, dt):
-    run_event(f, p, epicenter, model, Integrator(dt=dt))          # compile / warm caches
+def kernel_event(f, p, epicenter, model, integrator):
+    run_event(f, p, epicenter, model, integrator)          # compile / warm caches
     start = time.perf_counter()
-    ev = check(run_event(f, p, epicenter, model, Integrator(dt=dt)))
+    ev = check(run_event(f, p, epicenter, model, integrator))
     return ev, time.perf_counter() - start
 
 
@@ -99,6 +100,7 @@ def main():
     p.add_argument("--transient", type=int, default=300)
     p.add_argument("--dts", type=float, nargs="+", default=[2e-3, 1e-3, 5e-4, 2.5e-4])
     p.add_argument("--numpy-dts", type=float, nargs="+", default=[1e-3, 5e-4])
+    p.add_argument("--rtols", type=float, nargs="+", default=[1e-4, 1e-5, 1e-6, 1e-7, 1e-8])
     p.add_argument("--out", default="benchmarks/results")
     args = p.parse_args()
     model = Model(N=args.N, b=args.b)
@@ -106,19 +108,23 @@ def main():
     out.mkdir(parents=True, exist_ok=True)
     rows = []
     for label, (f, psi, epicenter, mu) in pre_event_states(model, args.transient).items():
-        ref, _ = kernel_event(f, psi, epicenter, model, min(args.dts) / 4)
+        ref, _ = kernel_event(f, psi, epicenter, model, Integrator(dt=min(args.dts) / 4))
 
         def record(method, dt, profile, wall, work):
             slip_err = abs(profile.sum() - ref.slip) / ref.slip
             prof_err = np.linalg.norm(profile - ref.profile) / np.linalg.norm(ref.profile)
             rows.append({"event": label, "mu": mu, "method": method, "dt": dt, "slip_error": slip_err,
                          "profile_error": prof_err, "seconds": wall, "block_rhs": work})
-            print(f"{label:5s} mu={mu:.2f} {method:9s} dt={dt:.2e}: slip error {slip_err:.1e}, "
+            knob = "rtol" if method == "ark3" else "dt"
+            print(f"{label:5s} mu={mu:.2f} {method:9s} {knob}={dt:.0e}: slip error {slip_err:.1e}, "
                   f"profile error {prof_err:.1e}, {wall:.3f} s, {work:.3g} block RHS evaluations")
 
         for dt in args.dts:
-            ev, wall = kernel_event(f, psi, epicenter, model, dt)
+            ev, wall = kernel_event(f, psi, epicenter, model, Integrator(dt=dt))
             record("rk4", dt, ev.profile, wall, 4 * ev.block_steps)
+        for rtol in args.rtols:
+            ev, wall = kernel_event(f, psi, epicenter, model, Integrator(method="ark3", rtol=rtol))
+            record("ark3", rtol, ev.profile, wall, 4 * ev.block_steps)
         for dt in args.numpy_dts:
             y, wall, work = numpy_rk4_event(f, psi, epicenter, model, dt)
             record("numpy-rk4", dt, y, wall, 4 * work)
@@ -132,7 +138,7 @@ def plot(rows, path, title):
     import matplotlib.pyplot as plt
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     for ax, label in zip(axes, ("small", "large")):
-        for k, method in enumerate(("rk4", "numpy-rk4")):
+        for k, method in enumerate(("rk4", "numpy-rk4", "ark3")):
             sel = [r for r in rows if r["event"] == label and r["method"] == method]
             if sel:
                 ax.loglog([r["seconds"] for r in sel], [max(r["slip_error"], 1e-17) for r in sel],

@@ -49,7 +49,10 @@ class Run:
 @dataclass(frozen=True)
 class Integrator:
     method: str = "rk4"            # event integrator (see ensemble.integrators.INTEGRATORS)
-    dt: float = 1e-3               # time step of fixed-step RK4
+    dt: float = 1e-3               # time step of "rk4"; first step of "ark3"
+    rtol: float = 1e-6             # "ark3": relative tolerance of the local error per step
+    atol: float = 1e-12            # "ark3": absolute tolerance (slip, velocity)
+    max_step: float = 0.5          # "ark3": largest step
     max_duration: float = 1e5      # an event lasting longer than this is an error
 
 
@@ -76,6 +79,9 @@ _RULES = {
     ("run", "init_stress"): (_positive, "> 0"),
     ("integrator", "dt"): (lambda x: 0 < x <= 1, "in (0, 1]"),
     ("integrator", "max_duration"): (_positive, "> 0"),
+    ("integrator", "rtol"): (lambda x: 0 < x < 1, "in (0, 1)"),
+    ("integrator", "atol"): (_positive, "> 0"),
+    ("integrator", "max_step"): (_positive, "> 0"),
     ("output", "batch"): (lambda x: x >= 1, "an integer >= 1"),
     ("output", "flush_seconds"): (_positive, "> 0"),
     ("output", "progress_seconds"): (_positive, "> 0"),

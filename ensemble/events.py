@@ -3,10 +3,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .integrators import INTEGRATORS
+from .integrators import kernel_args
+from .model.event import integrate_event
 from .model.chain import load_quietly, next_onset
 from .model.workspace import (D_BLOCK_STEPS, D_DURATION, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX,
-                              D_WORK, OK,
+                                    D_WORK, OK,
                               STATUS_TEXT, Workspace)
 
 
@@ -67,11 +68,10 @@ def run_event(force, psi, epicenter, model, integrator, v_start=0.0):
     ws = Workspace(n)
     ws.load(force, psi)
     profile = np.zeros(n)
-    max_steps = int(min(2 * integrator.max_duration / integrator.dt + 1e6, 2**62))
-    status = INTEGRATORS[integrator.method].event(
-        ws.W, ws.act, ws.flag, ws.touched, ws.stuck, n, epicenter, v_start, model.l ** 2,
-        model.nu, model.a, model.b, integrator.dt, -np.inf, integrator.max_duration, max_steps,
-        ws.diag, profile)
+    l2, nu, a, b, method, dt, rtol, atol, h_max, max_duration, max_steps = kernel_args(model, integrator)
+    status = integrate_event(ws.W, ws.act, ws.flag, ws.touched, ws.stuck, n, epicenter, v_start, l2, nu,
+                             a, b, method, dt, rtol, atol, h_max, -np.inf, max_duration, max_steps,
+                             ws.diag, profile)
     d = ws.diag
     return EventResult(status, d[D_SLIP], d[D_DURATION], int(d[D_STEPS]), int(d[D_BLOCK_STEPS]),
                        d[D_VMAX], d[D_WORK],

@@ -1,19 +1,34 @@
-"""Registry of event integrators: config name -> (batch kernel, single-event kernel)."""
+"""Registry of event integrators: config name -> kernel method and description.
+
+Both run through the same event kernel (ensemble.model.event.integrate_event),
+which locates sticks and onsets inside a step the same way for each.
+"""
 from dataclasses import dataclass
 
-from .model.chain import simulate_rk4
-from .model.rk4 import integrate_event as integrate_event_rk4
+from .model.event import ARK3, RK4
 
 
 @dataclass(frozen=True)
 class Integrator:
-    simulate: object      # numba kernel: a batch of events (see model.chain.simulate_rk4)
-    event: object         # numba kernel: one event from a given state (see model.rk4.integrate_event)
+    code: int             # method id understood by the kernels
     description: str
 
 
 INTEGRATORS = {
-    "rk4": Integrator(simulate_rk4, integrate_event_rk4,
-                      "classical fourth-order Runge-Kutta, fixed step dt, on the sliding blocks; "
-                      "stick and onset located inside the step"),
+    "rk4": Integrator(RK4, "classical fourth-order Runge-Kutta with fixed step integrator.dt "
+                           "(the paper's method); stable only while dt / theta < 2.785"),
+    "ark3": Integrator(ARK3, "adaptive IMEX Runge-Kutta ARK3(2)4L[2]SA: explicit in slip and "
+                             "velocity, L-stable implicit in the state; step controlled by "
+                             "integrator.rtol / atol, at most integrator.max_step"),
 }
+
+
+def kernel_args(model, integrator):
+    """The kernels' scalar arguments from [model] and [integrator] (config dataclasses).
+
+    Order: l^2, nu, a, b, method, dt, rtol, atol, max_step, max_duration, max_steps.
+    """
+    max_steps = int(min(2 * integrator.max_duration / integrator.dt + 1e6, 2**62))
+    return (model.l ** 2, model.nu, model.a, model.b, INTEGRATORS[integrator.method].code,
+            integrator.dt, integrator.rtol, integrator.atol, integrator.max_step,
+            integrator.max_duration, max_steps)

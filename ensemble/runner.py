@@ -12,7 +12,8 @@ import numpy as np
 from . import catalog
 from .catalog import Checkpoint, CatalogError
 from .config import ConfigError, loads
-from .integrators import INTEGRATORS
+from .integrators import kernel_args
+from .model.chain import simulate
 from .model.workspace import (D_DURATION, D_FIRST, D_LAST, D_NSLIP, D_SLIP, NDIAG, OK,
                               STATUS_TEXT, Workspace)
 from .parallel import Coordinator
@@ -31,7 +32,6 @@ class Trajectory:
     def __init__(self, cfg, task, checkpoint=None):
         self.cfg = cfg
         self.task = task
-        self.kernel = INTEGRATORS[cfg.integrator.method].simulate
         self.ws = Workspace(task.model.N)
         if checkpoint is None:
             self.ws.load(*initial_state(cfg, task))
@@ -41,9 +41,7 @@ class Trajectory:
             self.ws.load(checkpoint.force, checkpoint.psi)
             self.clock = checkpoint.clock.copy()
             self.done = checkpoint.done
-        m, it = task.model, cfg.integrator
-        self.args = (m.l * m.l, m.nu, m.a, m.b, it.dt, it.max_duration,
-                     int(min(2 * it.max_duration / it.dt + 1e6, 2**62)))
+        self.args = kernel_args(task.model, cfg.integrator)
 
     def checkpoint(self):
         return Checkpoint(self.ws.force.copy(), self.ws.psi.copy(), self.clock.copy(), self.done)
@@ -54,7 +52,7 @@ class Trajectory:
         epicenter = np.empty(n, dtype=np.int64)
         diag = np.empty((n, NDIAG))
         ws = self.ws
-        status, k = self.kernel(ws.W, ws.act, ws.flag, ws.touched, ws.stuck, ws.diag, self.clock,
+        status, k = simulate(ws.W, ws.act, ws.flag, ws.touched, ws.stuck, ws.diag, self.clock,
                                 *self.args, n, t, epicenter, diag)
         if status != OK:
             where = self.done + k

@@ -8,7 +8,8 @@ import pytest
 
 from ensemble.config import Integrator, Model, Run
 from ensemble.events import advance_to_onset, check, run_event
-from ensemble.model.chain import simulate_rk4
+from ensemble.integrators import kernel_args
+from ensemble.model.chain import simulate
 from ensemble.model.workspace import NDIAG, Workspace
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -23,9 +24,8 @@ def developed_state(model, events, seed=1, dt=1e-3):
     t = np.empty(events)
     epi = np.empty(events, dtype=np.int64)
     diag = np.empty((events, NDIAG))
-    status, k = simulate_rk4(ws.W, ws.act, ws.flag, ws.touched, ws.stuck, ws.diag, clock,
-                             model.l ** 2, model.nu, model.a, model.b, dt, 1e5, 10**9, events,
-                             t, epi, diag)
+    status, k = simulate(ws.W, ws.act, ws.flag, ws.touched, ws.stuck, ws.diag, clock,
+                         *kernel_args(model, Integrator(dt=dt)), events, t, epi, diag)
     assert status == 0
     return ws.force.copy(), ws.psi.copy()
 

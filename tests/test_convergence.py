@@ -1,7 +1,10 @@
 """Convergence of fixed-step RK4 with located stick and onset times."""
 import numpy as np
 
-from ensemble.config import Model
+from ensemble.config import Integrator, Model
+from ensemble.integrators import kernel_args
+from ensemble.model.chain import simulate
+from ensemble.model.workspace import NDIAG, Workspace
 
 from .conftest import developed_state, next_event
 
@@ -28,8 +31,6 @@ def test_event_slip_converges_with_order_at_least_3():
 
 def test_clock_offset_does_not_change_events():
     """Time is local to each event: a run at t ~ 1e15 gives the same events as one at t = 0."""
-    from ensemble.model.chain import simulate_rk4
-    from ensemble.model.workspace import NDIAG, Workspace
     model = Model(N=60)
     force, psi = developed_state(model, 50)
     out = []
@@ -40,8 +41,8 @@ def test_clock_offset_does_not_change_events():
         t = np.empty(20)
         epi = np.empty(20, dtype=np.int64)
         diag = np.empty((20, NDIAG))
-        status, _ = simulate_rk4(ws.W, ws.act, ws.flag, ws.touched, ws.stuck, ws.diag, clock,
-                                 9.0, model.nu, model.a, model.b, 1e-3, 1e5, 10**9, 20, t, epi, diag)
+        status, _ = simulate(ws.W, ws.act, ws.flag, ws.touched, ws.stuck, ws.diag, clock,
+                             *kernel_args(model, Integrator()), 20, t, epi, diag)
         assert status == 0
         out.append((t - start, epi, diag))
     np.testing.assert_array_equal(out[0][2], out[1][2])

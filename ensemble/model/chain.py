@@ -11,7 +11,7 @@ import numba as nb
 import numpy as np
 
 from .onset import grow_state, onset_delay
-from .rk4 import integrate_event
+from .event import integrate_event
 from .workspace import D_DURATION, F0, OK, P
 
 
@@ -50,8 +50,8 @@ def load_quietly(W, n, nu, dt):
 
 
 @nb.njit(cache=True)
-def simulate_rk4(W, act, flag, touched, stuck, diag, clock, l2, nu, a, b, dt, max_duration,
-             max_steps, n_events, out_t, out_epicenter, out_diag):
+def simulate(W, act, flag, touched, stuck, diag, clock, l2, nu, a, b, method, dt, rtol, atol, h_max,
+             max_duration, max_steps, n_events, out_t, out_epicenter, out_diag):
     """Run n_events events; returns (status, number of events completed).
 
     out_t[k] is the onset time of event k, out_epicenter[k] its epicenter,
@@ -68,8 +68,8 @@ def simulate_rk4(W, act, flag, touched, stuck, diag, clock, l2, nu, a, b, dt, ma
         W[epicenter, F0] = b * W[epicenter, P]
         advance_clock(clock, delay)
         status = integrate_event(W, act, flag, touched, stuck, n, epicenter, 0.0, l2, nu, a,
-                                 b, dt, runner_up - delay, max_duration, max_steps, diag,
-                                 no_profile)
+                                 b, method, dt, rtol, atol, h_max, runner_up - delay, max_duration,
+                                 max_steps, diag, no_profile)
         if status != OK:
             return status, k
         out_t[k] = clock[0] + clock[1]

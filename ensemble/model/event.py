@@ -1,4 +1,4 @@
-"""One event of the chain, integrated with fixed-step RK4 on the active set.
+"""One event of the chain, integrated on the active set (fixed-step RK4 or adaptive ARK3).
 
 Only sliding blocks are integrated. Blocks at rest that neighbour a sliding
 block are checked for onset after every step; all other blocks at rest can only
@@ -19,11 +19,15 @@ import math
 import numba as nb
 import numpy as np
 
-from .friction import friction, spring_force, state_rate
+from .friction import friction, spring_force
 from .onset import onset_delay
-from .workspace import (D_DURATION, D_FIRST, D_LAST, D_NSLIP, D_RESIDUAL, D_SLIP, D_STEPS,
-                        D_VMAX, D_WORK, D_BLOCK_STEPS, F0, HD0, HD1, K1V, KP, KV, KY, NONFINITE, OK, P, P0, PS,
-                        SP, SV, SY, TOO_LONG, TR, UNSTABLE, V, V0, VS, Y, Y0, YS)
+from .steppers import ark3_step, rk4_step
+from .workspace import (D_BLOCK_STEPS, D_DURATION, D_FIRST, D_LAST, D_NSLIP, D_RESIDUAL, D_SLIP,
+                        D_STEPS, D_VMAX, D_WORK, F0, HD0, HD1, K1V, NONFINITE, OK, P, P0, TOO_LONG,
+                        TR, UNSTABLE, V, V0, Y, Y0, YS)
+
+# integrators (see ensemble.integrators): fixed-step RK4, adaptive IMEX ARK3(2)
+RK4, ARK3 = 0, 1
 
 # Stability limit of classical RK4 on the negative real axis: the state equation
 # relaxes at rate 1/theta (= v in steady sliding), so dt / theta must stay below it.
@@ -54,81 +58,6 @@ def _hermite(x, y0, y1, d0, d1):
 def _rest_psi(W, j, tau):
     """psi of a block at rest since local time TR: ln(theta_rest + tau - TR)."""
     return W[j, P] + math.log1p((tau - W[j, TR]) * math.exp(-W[j, P]))
-
-
-@nb.njit(cache=True, error_model="numpy")
-def _stage(W, act, na, n, tau, l2, nu, a, b, yrest):
-    """Derivatives of all active blocks at stage state (YS, VS, PS) into KY, KV, KP.
-
-    Returns the friction power sum(Phi v) and the total slip sum(y) at the stage
-    (for the energy balance).
-    """
-    power = 0.0
-    ysum = yrest
-    for k in range(na):
-        i = act[k]
-        v = W[i, VS]
-        psi = W[i, PS]
-        phi = friction(v, psi, a, b)
-        W[i, KY] = v
-        W[i, KV] = spring_force(W[i, F0], tau, nu, l2, W[_left(i), YS], W[i, YS],
-                                W[_right(i, n), YS]) - phi
-        W[i, KP] = state_rate(v, psi)
-        if v > 0.0:
-            power += phi * v
-        ysum += W[i, YS]
-    return power, ysum
-
-
-@nb.njit(cache=True, error_model="numpy")
-def _rk4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest):
-    """Advance the active blocks from the step-start values (Y0, V0, P0) by h.
-
-    Resting blocks keep YS == Y, so neighbour slips are read from YS throughout.
-    Returns the RK4 quadratures of the friction power and of the total slip.
-    """
-    pw = 0.0
-    ys = 0.0
-    for stage in range(4):
-        if stage == 0:
-            frac, weight = 0.0, 1.0
-        elif stage == 3:
-            frac, weight = 1.0, 1.0
-        else:
-            frac, weight = 0.5, 2.0
-        if stage > 0:
-            for k in range(na):
-                i = act[k]
-                W[i, YS] = W[i, Y0] + frac * h * W[i, KY]
-                W[i, VS] = W[i, V0] + frac * h * W[i, KV]
-                W[i, PS] = W[i, P0] + frac * h * W[i, KP]
-        else:
-            for k in range(na):
-                i = act[k]
-                W[i, YS] = W[i, Y0]
-                W[i, VS] = W[i, V0]
-                W[i, PS] = W[i, P0]
-        power, ysum = _stage(W, act, na, n, tau + frac * h, l2, nu, a, b, yrest)
-        pw += weight * power
-        ys += weight * ysum
-        for k in range(na):
-            i = act[k]
-            if stage == 0:
-                W[i, K1V] = W[i, KV]
-                W[i, SY] = W[i, KY]
-                W[i, SV] = W[i, KV]
-                W[i, SP] = W[i, KP]
-            else:
-                W[i, SY] += weight * W[i, KY]
-                W[i, SV] += weight * W[i, KV]
-                W[i, SP] += weight * W[i, KP]
-    for k in range(na):
-        i = act[k]
-        W[i, Y] = W[i, Y0] + h / 6.0 * W[i, SY]
-        W[i, V] = W[i, V0] + h / 6.0 * W[i, SV]
-        W[i, P] = W[i, P0] + h / 6.0 * W[i, SP]
-        W[i, YS] = W[i, Y]
-    return pw * h / 6.0, ys * h / 6.0
 
 
 @nb.njit(cache=True)
@@ -200,14 +129,23 @@ def _start(W, act, na, flag, touched, nt, j, tau, yrest):
 
 
 @nb.njit(cache=True)
-def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu, a, b, dt,
-                    t_far, max_duration, max_steps, diag, profile):
+def _step(method, W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol):
+    if method == RK4:
+        return rk4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
+    return ark3_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
+
+
+@nb.njit(cache=True)
+def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu, a, b, method, dt,
+                    rtol, atol, h_max, t_far, max_duration, max_steps, diag, profile):
     """Integrate one event from the onset of `epicenter` until every block is at rest.
 
     On entry W[:, F0] holds the force and W[:, P] the state psi of every block at the
     onset (all at rest, c-free frame), all other columns and `flag` are zero.
     `v_start` is the epicenter's initial velocity (0 for a natural onset),
     `t_far` a lower bound of the loading onset time of every other block.
+    method RK4 steps by dt; ARK3 starts with dt and controls the step (at most
+    h_max) so that the embedded error estimate stays below rtol, atol.
     On return W[:, F0] and W[:, P] hold the state at the end of the event (all at
     rest again), the other columns and `flag` are zero, and `diag` holds the event
     summary (see workspace.D_*). If `profile` has n entries it receives the
@@ -224,6 +162,7 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
     status = OK
     v_limit = RK4_STABILITY / dt
     psi_limit = -math.log(v_limit)
+    h_next = dt
     while na > 0:
         if steps >= max_steps or tau > max_duration:
             status = TOO_LONG
@@ -233,8 +172,16 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
             W[i, Y0] = W[i, Y]
             W[i, V0] = W[i, V]
             W[i, P0] = W[i, P]
-        h = dt
-        dwork, dslip = _rk4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest)
+        h = h_next
+        while True:
+            dwork, dslip, err = _step(method, W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
+            if method == RK4 or err <= 1.0 or h < 1e-12:
+                break
+            h *= max(0.2, 0.9 * err ** (-1.0 / 3.0))    # rejected: retry from (Y0, V0, P0)
+            steps += 1
+        if method != RK4:
+            grow = 5.0 if err == 0.0 else min(5.0, max(0.2, 0.9 * err ** (-1.0 / 3.0)))
+            h_next = min(h_max, h * grow)
         # Earliest transition inside the step, as a fraction x of it; the slip
         # of a sliding block inside the step is the Hermite cubic with these slopes.
         for k in range(na):
@@ -299,7 +246,7 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
                     kind = 3
         if kind != 0 and x_cut < 1.0:
             h = x_cut * h
-            dwork, dslip = _rk4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest)
+            dwork, dslip, _ = _step(method, W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
         tau += h
         steps += 1
         block_steps += na
@@ -314,7 +261,7 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
                 status = NONFINITE
             if v > vmax:
                 vmax = v
-            if (v > v_limit or W[i, P] < psi_limit) and status == OK:
+            if method == RK4 and (v > v_limit or W[i, P] < psi_limit) and status == OK:
                 status = UNSTABLE
         if status != OK:
             break
