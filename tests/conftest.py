@@ -4,9 +4,8 @@ import sys
 from pathlib import Path
 
 import numpy as np
-import pytest
 
-from ensemble.config import Integrator, Model, Run
+from ensemble.config import Integrator
 from ensemble.events import advance_to_onset, check, run_event
 from ensemble.integrators import kernel_args
 from ensemble.model.chain import simulate
