@@ -130,14 +130,14 @@ _BHAT = (2756255671327.0 / 12835298489170.0, -10771552573575.0 / 22201958757719.
 
 
 @nb.njit(cache=True, inline="always")
-def _implicit_state(rhs, hg, v):
-    """psi with psi - hg (exp(-psi) - max(v, 0)) = rhs.
+def _implicit_state(rhs, hg, v, guess):
+    """psi with psi - hg (exp(-psi) - max(v, 0)) = rhs, Newton from `guess`.
 
     The left side is increasing and concave in psi, so Newton's iterates reach
     the root from below after the first step and never overshoot it.
     """
     target = rhs - hg * (v if v > 0.0 else 0.0)
-    psi = target
+    psi = guess
     for _ in range(60):
         e = hg * math.exp(-psi)
         step = (psi - e - target) / (1.0 + e)
@@ -164,7 +164,8 @@ def ark3_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol):
                 r += h * _AI[s][j] * W[i, ARK_G + j]
             W[i, YS] = y
             W[i, VS] = v
-            W[i, PS] = r if s == 0 else _implicit_state(r, h * _G, v)
+            # the previous stage's psi (still in PS) starts Newton close to the root
+            W[i, PS] = r if s == 0 else _implicit_state(r, h * _G, v, W[i, PS])
         power, ysum = stage_rates(W, act, na, n, tau + _C[s] * h, l2, nu, a, b, yrest)
         pw += _B[s] * power
         ys += _B[s] * ysum
