@@ -19,7 +19,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .friction import friction, spring_force
+from .friction import friction, left, right, spring_force
 from .onset import onset_delay
 from .steppers import ark3_step, rk4_step
 from .workspace import (D_BLOCK_STEPS, D_DURATION, D_FIRST, D_LAST, D_NSLIP, D_RESIDUAL, D_SLIP,
@@ -33,16 +33,6 @@ RK4, ARK3 = 0, 1
 # relaxes at rate 1/theta (= v in steady sliding), so dt / theta must stay below it.
 RK4_STABILITY = 2.785
 _BISECT = 60
-
-
-@nb.njit(cache=True, inline="always")
-def _left(i):
-    return i - 1 if i > 0 else i
-
-
-@nb.njit(cache=True, inline="always")
-def _right(i, n):
-    return i + 1 if i < n - 1 else i
 
 
 @nb.njit(cache=True, inline="always")
@@ -72,14 +62,14 @@ def _slip_at(W, flag, j, x):
 def _excess(W, flag, n, j, tau, h, x, l2, nu, b):
     """Force above the static threshold of resting block j at fraction x of the step."""
     s = tau + x * h
-    yl = _slip_at(W, flag, _left(j), x)
-    yr = _slip_at(W, flag, _right(j, n), x)
+    yl = _slip_at(W, flag, left(j), x)
+    yr = _slip_at(W, flag, right(j, n), x)
     return spring_force(W[j, F0], s, nu, l2, yl, W[j, Y], yr) - b * _rest_psi(W, j, s)
 
 
 @nb.njit(cache=True)
 def _force_now(W, n, j, tau, l2, nu):
-    return spring_force(W[j, F0], tau, nu, l2, W[_left(j), Y], W[j, Y], W[_right(j, n), Y])
+    return spring_force(W[j, F0], tau, nu, l2, W[left(j), Y], W[j, Y], W[right(j, n), Y])
 
 
 @nb.njit(cache=True)
@@ -90,7 +80,7 @@ def _excess_now(W, n, j, tau, l2, nu, b):
 
 @nb.njit(cache=True)
 def _adjacent_to_active(flag, n, j):
-    return flag[_left(j)] == 1 or flag[_right(j, n)] == 1
+    return flag[left(j)] == 1 or flag[right(j, n)] == 1
 
 
 @nb.njit(cache=True)
@@ -194,8 +184,8 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
         for k in range(na):
             i = act[k]
             if W[i, V] <= 0.0 and W[i, V0] > 0.0:
-                a_end = spring_force(W[i, F0], tau + h, nu, l2, W[_left(i), Y], W[i, Y],
-                                     W[_right(i, n), Y]) - friction(W[i, V], W[i, P], a, b)
+                a_end = spring_force(W[i, F0], tau + h, nu, l2, W[left(i), Y], W[i, Y],
+                                     W[right(i, n), Y]) - friction(W[i, V], W[i, P], a, b)
                 d0 = h * W[i, K1V]
                 d1 = h * a_end
                 lo = 0.0
@@ -212,7 +202,7 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
                     kind = 1
         for k in range(na):
             i = act[k]
-            for j in (_left(i), _right(i, n)):
+            for j in (left(i), right(i, n)):
                 if flag[j] == 1 or j == i:
                     continue
                 # Cheap filter first: the threshold of a resting block only grows,
@@ -295,7 +285,7 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
         na = m
         for k in range(na):
             i = act[k]
-            for j in (_left(i), _right(i, n)):
+            for j in (left(i), right(i, n)):
                 if flag[j] != 1 and j != i and _force_now(W, n, j, tau, l2, nu) > b * W[j, P]:
                     if _excess_now(W, n, j, tau, l2, nu, b) > 0.0:
                         na, nt, yrest = _start(W, act, na, flag, touched, nt, j, tau, yrest)
@@ -303,7 +293,7 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
         # loading: fold their analytic onset into t_far.
         for k in range(nstuck):
             i = stuck[k]
-            for j in (_left(i), i, _right(i, n)):
+            for j in (left(i), i, right(i, n)):
                 t = _loading_onset(W, flag, n, j, tau, l2, nu, b)
                 if t < t_far:
                     t_far = t

@@ -1,4 +1,4 @@
-"""The friction law and the equation of motion of one sliding block.
+"""The friction law, the chain's geometry and the equation of motion of one sliding block.
 
 This module is the only place to change for another friction law: the event
 integrators call `acceleration` and `state_rate` and nothing else of the law.
@@ -28,6 +28,18 @@ def state_rate(v, psi):
     """d psi / dt = 1/theta - v for the aging law theta' = 1 - v theta (v clamped at 0)."""
     vp = v if v > 0.0 else 0.0
     return math.exp(-psi) - vp
+
+
+@nb.njit(cache=True, inline="always")
+def left(i):
+    """Left neighbour of block i; at the free end the block itself (ghost u_{-1} = u_0)."""
+    return i - 1 if i > 0 else i
+
+
+@nb.njit(cache=True, inline="always")
+def right(i, n):
+    """Right neighbour of block i in a chain of n; at the free end the block itself."""
+    return i + 1 if i < n - 1 else i
 
 
 @nb.njit(cache=True, inline="always")

@@ -16,19 +16,9 @@ import math
 
 import numba as nb
 
-from .friction import friction, spring_force, state_rate
+from .friction import friction, left, right, spring_force, state_rate
 from .workspace import (ARK_A, ARK_G, ARK_V, F0, K1V, KP, KV, KY, P, P0, PS, SP, SV, SY, V, V0,
                         VS, Y, Y0, YS)
-
-
-@nb.njit(cache=True, inline="always")
-def _left(i):
-    return i - 1 if i > 0 else i
-
-
-@nb.njit(cache=True, inline="always")
-def _right(i, n):
-    return i + 1 if i < n - 1 else i
 
 
 @nb.njit(cache=True, error_model="numpy")
@@ -46,8 +36,8 @@ def stage_rates(W, act, na, n, tau, l2, nu, a, b, yrest):
         psi = W[i, PS]
         phi = friction(v, psi, a, b)
         W[i, KY] = v
-        W[i, KV] = spring_force(W[i, F0], tau, nu, l2, W[_left(i), YS], W[i, YS],
-                                W[_right(i, n), YS]) - phi
+        W[i, KV] = spring_force(W[i, F0], tau, nu, l2, W[left(i), YS], W[i, YS],
+                                W[right(i, n), YS]) - phi
         W[i, KP] = state_rate(v, psi)
         if v > 0.0:
             power += phi * v
