@@ -35,7 +35,7 @@ def pre_event_states(model, transient, seed=0):
     traj.advance(transient)
     found = {}
     while len(found) < 2:
-        force, psi = traj.ws.force.copy(), traj.ws.psi.copy()
+        force, psi = traj.state()
         _, _, diag = traj.advance(1)
         mu = np.log10(diag[0, 1])
         label = "small" if mu < 3 else "large" if mu >= 4 else None

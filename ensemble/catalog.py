@@ -22,7 +22,9 @@ killed at any moment leaves a file whose metadata is intact.
     /tasks/{point, seed_index, N, l, nu, a, b, c}    one row per task
     /tasks/events_written   events of the task stored so far
     /tasks/{rank, wall_time, events_per_second, seed_entropy, spawn_key}   provenance
-    /checkpoint/state   float64  per task two slots of [force (N), psi (N), clock (2)]
+    /checkpoint/state   float64  per task two slots of [force (N), psi (N), since (2N), clock (2)]:
+                                 block i's force and psi hold at the two-float time
+                                 since[i] = (since[2i], since[2i+1]); clock = (hi, lo) now
     /checkpoint/offset  int64    start of each task's slots in /checkpoint/state
     /checkpoint/commit  int64    per task [slot in use, events done incl. transient, events written]
     attributes of /: config (resolved TOML text), version, format
@@ -38,7 +40,7 @@ import numpy as np
 
 from . import __version__
 
-FORMAT = "bk-catalog-1"
+FORMAT = "bk-catalog-2"
 
 EVENT_FIELDS = {
     "task": np.int64, "t": np.float64, "epicenter": np.int64, "mu": np.float64,
@@ -71,22 +73,23 @@ def has_parallel_hdf5():
 
 
 def _state_size(n):
-    return 2 * n + 2
+    return 4 * n + 2
 
 
 class Checkpoint:
-    """A task's between-events state: forces, psi, compensated clock, events done."""
+    """A task's between-events state: forces, psi, their times (N x 2), compensated clock, events done."""
 
-    def __init__(self, force, psi, clock, done):
-        self.force, self.psi, self.clock, self.done = force, psi, clock, done
+    def __init__(self, force, psi, since, clock, done):
+        self.force, self.psi, self.since, self.clock, self.done = force, psi, since, clock, done
 
     def pack(self):
-        return np.concatenate([self.force, self.psi, self.clock])
+        return np.concatenate([self.force, self.psi, self.since.ravel(), self.clock])
 
     @classmethod
     def unpack(cls, flat, done):
-        n = (len(flat) - 2) // 2
-        return cls(flat[:n].copy(), flat[n:2 * n].copy(), flat[2 * n:].copy(), int(done))
+        n = (len(flat) - 2) // 4
+        return cls(flat[:n].copy(), flat[n:2 * n].copy(), flat[2 * n:4 * n].reshape(n, 2).copy(),
+                   flat[4 * n:].copy(), int(done))
 
 
 class _Layout:

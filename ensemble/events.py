@@ -6,6 +6,7 @@ import numpy as np
 from .integrators import kernel_args
 from .model.event import integrate_event
 from .model.chain import load_quietly, next_onset
+from .model.schedule import build_schedule
 from .model.workspace import (D_BLOCK_STEPS, D_DURATION, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX,
                                     D_WORK, OK,
                               STATUS_TEXT, Workspace)
@@ -69,13 +70,15 @@ def run_event(force, psi, epicenter, model, integrator, v_start=0.0):
     ws.load(force, psi)
     profile = np.zeros(n)
     l2, nu, a, b, method, dt, rtol, atol, h_max, max_duration, max_steps = kernel_args(model, integrator)
-    status = integrate_event(ws.W, ws.act, ws.flag, ws.touched, ws.stuck, n, epicenter, v_start, l2, nu,
-                             a, b, method, dt, rtol, atol, h_max, -np.inf, max_duration, max_steps,
-                             ws.diag, profile)
+    build_schedule(ws.W, ws.since, ws.tree, nu, b)
+    clock = np.zeros(2)
+    status = integrate_event(*ws.arrays[:7], clock, n, epicenter, v_start, l2, nu, a, b, method, dt,
+                             rtol, atol, h_max, max_duration, max_steps, ws.diag, profile)
+    force, psi = ws.state((ws.diag[D_DURATION], 0.0), nu)     # every block at the end
     d = ws.diag
     return EventResult(status, d[D_SLIP], d[D_DURATION], int(d[D_STEPS]), int(d[D_BLOCK_STEPS]),
                        d[D_VMAX], d[D_WORK],
-                       d[D_RESIDUAL], profile, ws.force.copy(), ws.psi.copy())
+                       d[D_RESIDUAL], profile, force, psi)
 
 
 def check(result, what="event"):

@@ -38,13 +38,18 @@ class Trajectory:
             self.clock = np.zeros(2)
             self.done = 0      # events completed, transient included
         else:
-            self.ws.load(checkpoint.force, checkpoint.psi)
+            self.ws.load(checkpoint.force, checkpoint.psi, checkpoint.since)
             self.clock = checkpoint.clock.copy()
             self.done = checkpoint.done
         self.args = kernel_args(task.model, cfg.integrator)
 
     def checkpoint(self):
-        return Checkpoint(self.ws.force.copy(), self.ws.psi.copy(), self.clock.copy(), self.done)
+        ws = self.ws
+        return Checkpoint(ws.force.copy(), ws.psi.copy(), ws.since.copy(), self.clock.copy(), self.done)
+
+    def state(self):
+        """(force, psi) of every block now (between events), c-free frame."""
+        return self.ws.state(self.clock, self.task.model.nu)
 
     def advance(self, n):
         """Run n events; returns (onset times, epicenters, diagnostics rows)."""
@@ -52,8 +57,7 @@ class Trajectory:
         epicenter = np.empty(n, dtype=np.int64)
         diag = np.empty((n, NDIAG))
         ws = self.ws
-        status, k = simulate(ws.W, ws.act, ws.flag, ws.touched, ws.stuck, ws.diag, self.clock,
-                                *self.args, n, t, epicenter, diag)
+        status, k = simulate(*ws.arrays, self.clock, *self.args, n, t, epicenter, diag)
         if status != OK:
             where = self.done + k
             phase = "transient " if where < self.cfg.run.transient else ""

@@ -23,10 +23,9 @@ def developed_state(model, events, seed=1, dt=1e-3):
     t = np.empty(events)
     epi = np.empty(events, dtype=np.int64)
     diag = np.empty((events, NDIAG))
-    status, k = simulate(ws.W, ws.act, ws.flag, ws.touched, ws.stuck, ws.diag, clock,
-                         *kernel_args(model, Integrator(dt=dt)), events, t, epi, diag)
+    status, k = simulate(*ws.arrays, clock, *kernel_args(model, Integrator(dt=dt)), events, t, epi, diag)
     assert status == 0
-    return ws.force.copy(), ws.psi.copy()
+    return ws.state(clock, model.nu)
 
 
 def next_event(force, psi, model, dt, v_start=0.0):

@@ -4,24 +4,18 @@
 workspace arrays and writes one row per event into caller-allocated arrays.
 Time is kept as a compensated sum (clock[0] + clock[1]) because a long run
 reaches t ~ 1e15, where a single float64 resolves only ~0.1; everything the
-physics uses is local (time since the onset, forces and states between events),
-so accuracy does not decay as the run goes on.
+physics uses is a time difference (time since the onset, since a block came to
+rest), so accuracy does not decay as the run goes on. Between events only the
+blocks an event touched are updated (schedule.py); `next_onset` and
+`load_quietly` are the plain O(N) versions, kept for preparing single events.
 """
 import numba as nb
 import numpy as np
 
-from .onset import grow_state, onset_delay
 from .event import integrate_event
+from .onset import grow_state, onset_delay
+from .schedule import advance_clock, build_schedule, materialize, tree_min
 from .workspace import D_DURATION, F0, OK, P
-
-
-@nb.njit(cache=True)
-def advance_clock(clock, dt):
-    """clock[0] + clock[1] += dt without losing the low-order bits (two-sum)."""
-    s = clock[0] + dt
-    bp = s - clock[0]
-    clock[1] += (clock[0] - (s - bp)) + (dt - bp)
-    clock[0] = s
 
 
 @nb.njit(cache=True)
@@ -50,26 +44,36 @@ def load_quietly(W, n, nu, dt):
 
 
 @nb.njit(cache=True)
-def simulate(W, act, flag, touched, stuck, diag, clock, l2, nu, a, b, method, dt, rtol, atol, h_max,
-             max_duration, max_steps, n_events, out_t, out_epicenter, out_diag):
-    """Run n_events events; returns (status, number of events completed).
+def simulate(W, act, flag, touched, stuck, since, tree, diag, clock, l2, nu, a, b, method, dt, rtol,
+             atol, h_max, max_duration, max_steps, n_events, out_t, out_epicenter, out_diag):
+    """Run n_events events from the time `clock`; returns (status, number of events completed).
 
+    Every block is at rest with its state at time since[i] (see schedule.py).
     out_t[k] is the onset time of event k, out_epicenter[k] its epicenter,
     out_diag[k] the event's diagnostics vector (workspace.D_*). On a status
     other than OK the state is that after the failed event, which is not counted.
     """
     n = W.shape[0]
     no_profile = np.empty(0)
+    build_schedule(W, since, tree, nu, b)
+    onset = np.empty(2)
     for k in range(n_events):
-        epicenter, delay, runner_up = next_onset(W, n, nu, b)
-        load_quietly(W, n, nu, delay)
-        # The onset is exact: put the epicenter on its threshold, not a
-        # round-off below it, so the event starts without a false stick.
+        _, epicenter = tree_min(tree)
+        # The onset, exactly: the epicenter's own delay from its state (the tree
+        # only orders the blocks), never before the end of the previous event.
+        onset[0] = since[epicenter, 0]
+        onset[1] = since[epicenter, 1]
+        advance_clock(onset, onset_delay(W[epicenter, F0], W[epicenter, P], nu, b))
+        if (onset[0] - clock[0]) + (onset[1] - clock[1]) > 0.0:
+            clock[0] = onset[0]
+            clock[1] = onset[1]
+        materialize(W, since, epicenter, clock, nu)
+        # Put the epicenter on its threshold, not a round-off below it, so the
+        # event starts without a false stick.
         W[epicenter, F0] = b * W[epicenter, P]
-        advance_clock(clock, delay)
-        status = integrate_event(W, act, flag, touched, stuck, n, epicenter, 0.0, l2, nu, a,
-                                 b, method, dt, rtol, atol, h_max, runner_up - delay, max_duration,
-                                 max_steps, diag, no_profile)
+        status = integrate_event(W, act, flag, touched, stuck, since, tree, clock, n, epicenter, 0.0,
+                                 l2, nu, a, b, method, dt, rtol, atol, h_max, max_duration, max_steps,
+                                 diag, no_profile)
         if status != OK:
             return status, k
         out_t[k] = clock[0] + clock[1]

@@ -21,6 +21,7 @@ import numpy as np
 
 from .friction import friction, left, right, spring_force
 from .onset import onset_delay
+from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
 from .steppers import ark3_step, rk4_step
 from .workspace import (D_BLOCK_STEPS, D_DURATION, D_FIRST, D_LAST, D_NSLIP, D_RESIDUAL, D_SLIP,
                         D_STEPS, D_VMAX, D_WORK, F0, HD0, HD1, K1V, NONFINITE, OK, P, P0, TOO_LONG,
@@ -92,20 +93,34 @@ def _loading_onset(W, flag, n, j, tau, l2, nu, b):
 
 
 @nb.njit(cache=True)
-def _earliest_loading_onset(W, flag, n, tau, l2, nu, b):
-    best = np.inf
-    who = -1
-    for j in range(n):
-        t = _loading_onset(W, flag, n, j, tau, l2, nu, b)
-        if t < best:
-            best = t
-            who = j
-    return best, who
+def _far_onset(W, flag, n, since, tree, t0, tau, l2, nu, b):
+    """(local time, block) of the earliest onset by loading alone of a block nobody watches.
+
+    The tree orders the candidates; the winner's onset is recomputed exactly:
+    from its current force and state if the event has touched it (its state
+    then holds at t0), else from its stored state without changing it.
+    """
+    key, j = tree_min(tree)
+    if key == np.inf:
+        return np.inf, -1
+    if since[j, 0] == t0[0] and since[j, 1] == t0[1]:
+        return _loading_onset(W, flag, n, j, tau, l2, nu, b), j
+    t = (since[j, 0] - t0[0]) + (since[j, 1] - t0[1]) + onset_delay(W[j, F0], W[j, P], nu, b)
+    return max(t, tau), j
 
 
 @nb.njit(cache=True)
-def _start(W, act, na, flag, touched, nt, j, tau, yrest):
+def _watch(W, since, tree, t0, nu, j):
+    """Block j starts or neighbours a sliding block: bring it to t0, take it off the schedule."""
+    materialize(W, since, j, t0, nu)
+    tree_set(tree, j, np.inf)
+
+
+@nb.njit(cache=True)
+def _start(W, act, na, flag, touched, nt, since, tree, t0, nu, j, tau, yrest):
     """Block j starts to slide at local time tau; returns (na, nt, yrest)."""
+    for k in (left(j), j, right(j, W.shape[0])):
+        _watch(W, since, tree, t0, nu, k)
     if flag[j] == 2:
         yrest -= W[j, Y]
     else:
@@ -126,22 +141,24 @@ def _step(method, W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol):
 
 
 @nb.njit(cache=True)
-def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu, a, b, method, dt,
-                    rtol, atol, h_max, t_far, max_duration, max_steps, diag, profile):
-    """Integrate one event from the onset of `epicenter` until every block is at rest.
+def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter, v_start, l2, nu, a,
+                    b, method, dt, rtol, atol, h_max, max_duration, max_steps, diag, profile):
+    """Integrate one event from the onset of `epicenter` at time t0 until every block is at rest.
 
-    On entry W[:, F0] holds the force and W[:, P] the state psi of every block at the
-    onset (all at rest, c-free frame), all other columns and `flag` are zero.
-    `v_start` is the epicenter's initial velocity (0 for a natural onset),
-    `t_far` a lower bound of the loading onset time of every other block.
-    method RK4 steps by dt; ARK3 starts with dt and controls the step (at most
-    h_max) so that the embedded error estimate stays below rtol, atol.
-    On return W[:, F0] and W[:, P] hold the state at the end of the event (all at
-    rest again), the other columns and `flag` are zero, and `diag` holds the event
-    summary (see workspace.D_*). If `profile` has n entries it receives the
-    slip of every block (else pass an empty array). Returns a status code.
+    On entry every block is at rest, block i with force W[i, F0] and state psi W[i, P]
+    at time since[i] (c-free frame; see schedule.py), `tree` holds every block's
+    onset key, the epicenter is on its threshold at t0 (two-float time), the
+    other columns and `flag` are zero. `v_start` is the epicenter's initial
+    velocity (0 for a natural onset). method RK4 steps by dt; ARK3 starts with dt
+    and controls the step (at most h_max) so that the embedded error estimate
+    stays below rtol, atol. On return the blocks the event touched hold the
+    state at its end (the schedule updated), the other columns and `flag` are
+    zero, and `diag` holds the event summary (see workspace.D_*). If `profile`
+    has n entries it receives the slip of every block (else pass an empty
+    array). Returns a status code.
     """
-    na, nt, yrest = _start(W, act, 0, flag, touched, 0, epicenter, 0.0, 0.0)
+    na, nt, yrest = _start(W, act, 0, flag, touched, 0, since, tree, t0, nu, epicenter, 0.0, 0.0)
+    t_far, far = _far_onset(W, flag, n, since, tree, t0, 0.0, l2, nu, b)
     W[epicenter, V] = v_start
     tau = 0.0
     work = 0.0
@@ -227,13 +244,11 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
                         who = j
                         kind = 2
         if t_far <= tau + h:
-            t_far, far = _earliest_loading_onset(W, flag, n, tau, l2, nu, b)
-            if t_far <= tau + h:
-                x = max(t_far - tau, 0.0) / h
-                if x < x_cut:
-                    x_cut = x
-                    who = far
-                    kind = 3
+            x = max(t_far - tau, 0.0) / h
+            if x < x_cut:
+                x_cut = x
+                who = far
+                kind = 3
         if kind != 0 and x_cut < 1.0:
             h = x_cut * h
             dwork, dslip, _ = _step(method, W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
@@ -257,10 +272,8 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
             break
         # Transitions at tau: the located one, then anything that crossed with it.
         if kind == 2 or kind == 3:
-            na, nt, yrest = _start(W, act, na, flag, touched, nt, who, tau, yrest)
+            na, nt, yrest = _start(W, act, na, flag, touched, nt, since, tree, t0, nu, who, tau, yrest)
             W[who, V] = 0.0
-            if kind == 3:
-                t_far = -np.inf  # recompute on the next step
         if kind == 1:
             W[who, V] = 0.0
         m = 0
@@ -288,20 +301,21 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
             for j in (left(i), right(i, n)):
                 if flag[j] != 1 and j != i and _force_now(W, n, j, tau, l2, nu) > b * W[j, P]:
                     if _excess_now(W, n, j, tau, l2, nu, b) > 0.0:
-                        na, nt, yrest = _start(W, act, na, flag, touched, nt, j, tau, yrest)
+                        na, nt, yrest = _start(W, act, na, flag, touched, nt, since, tree, t0, nu, j,
+                                               tau, yrest)
         # Blocks no longer watched by a sliding neighbour may only start by
-        # loading: fold their analytic onset into t_far.
+        # loading: back on the schedule with their analytic onset.
         for k in range(nstuck):
             i = stuck[k]
             for j in (left(i), i, right(i, n)):
-                t = _loading_onset(W, flag, n, j, tau, l2, nu, b)
-                if t < t_far:
-                    t_far = t
+                tree_set(tree, j, t0[0] + (t0[1] + _loading_onset(W, flag, n, j, tau, l2, nu, b)))
+        if kind != 0 or nstuck > 0 or na != m:
+            t_far, far = _far_onset(W, flag, n, since, tree, t0, tau, l2, nu, b)
     if profile.shape[0] == n:
         profile[:] = 0.0
         for k in range(nt):
             profile[touched[k]] = W[touched[k], Y]
-    _finish_event(W, flag, touched, nt, n, tau, l2, nu, work, slip_time, diag)
+    _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, l2, nu, b, work, slip_time, diag)
     diag[D_STEPS] = steps
     diag[D_VMAX] = vmax
     diag[D_BLOCK_STEPS] = block_steps
@@ -309,8 +323,8 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
 
 
 @nb.njit(cache=True)
-def _finish_event(W, flag, touched, nt, n, tau, l2, nu, work, slip_time, diag):
-    """Summarise the event, move every block's state to the end time, clear the work columns."""
+def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, l2, nu, b, work, slip_time, diag):
+    """Summarise the event, bring the touched blocks to its end, reschedule them and their neighbours."""
     slip = 0.0
     first = n
     last = -1
@@ -339,11 +353,16 @@ def _finish_event(W, flag, touched, nt, n, tau, l2, nu, work, slip_time, diag):
     diag[D_NSLIP] = nslip
     diag[D_WORK] = work
     diag[D_RESIDUAL] = e_change + work
-    # New forces: loading during the event for everybody, slip for the touched
-    # blocks and their neighbours (free ends: an end block has one spring).
-    for i in range(n):
+    # The touched blocks move to the end time (loading, state grown since they
+    # stopped); their untouched neighbours stay at t0, which is just as valid.
+    # Then the slip changes the forces (free ends: an end block has one spring).
+    for k in range(nt):
+        i = touched[k]
         W[i, F0] += nu * tau
         W[i, P] += math.log1p((tau - W[i, TR]) * math.exp(-W[i, P]))
+        since[i, 0] = t0[0]
+        since[i, 1] = t0[1]
+        advance_clock(since[i], tau)
     for k in range(nt):
         i = touched[k]
         y = W[i, Y]
@@ -360,3 +379,7 @@ def _finish_event(W, flag, touched, nt, n, tau, l2, nu, work, slip_time, diag):
         W[i, V] = 0.0
         W[i, TR] = 0.0
         flag[i] = 0
+    for k in range(nt):
+        i = touched[k]
+        for j in (left(i), i, right(i, n)):
+            tree_set(tree, j, onset_key(W, since, j, nu, b))

@@ -7,6 +7,8 @@ one block sits in one or two cache lines. Between events only two columns carry 
     W[:, F0]  force on each block, c-free frame: F_i = (nu t - u_i - c) + l^2 (lap u)_i
     W[:, P]   psi_i = ln(theta_i)
 
+both at the block's own time since[i] (lazy loading, see schedule.py).
+
 All other columns are scratch that the event integrator leaves zeroed.
 
 Energy balance of an event (c-free frame, x = u + c - nu t, slips y since onset,
@@ -39,8 +41,20 @@ STATUS_TEXT = {
 }
 
 
+def tree_size(n):
+    """Length of the onset tree (schedule.py) for n blocks: twice a power of two >= n."""
+    m = 1
+    while m < n:
+        m *= 2
+    return 2 * m
+
+
 class Workspace:
-    """Scratch arrays for one chain of n blocks (allocate once per task)."""
+    """Work arrays for one chain of n blocks (allocate once per task).
+
+    Between events the state is lazy (see schedule.py): block i holds W[i, F0]
+    and W[i, P] at the two-float time since[i]; `state` brings all of it to one time.
+    """
 
     def __init__(self, n):
         self.W = np.zeros((n, NCOLS))
@@ -48,19 +62,35 @@ class Workspace:
         self.flag = np.zeros(n, dtype=np.int8)
         self.touched = np.zeros(n, dtype=np.int64)
         self.stuck = np.zeros(n, dtype=np.int64)
+        self.since = np.zeros((n, 2))
+        self.tree = np.full(tree_size(n), np.inf)
         self.diag = np.zeros(NDIAG)
 
-    def load(self, force, psi):
-        """Set the between-events state (force and psi of every block)."""
+    @property
+    def arrays(self):
+        """The kernels' leading array arguments: W, act, flag, touched, stuck, since, tree, diag."""
+        return self.W, self.act, self.flag, self.touched, self.stuck, self.since, self.tree, self.diag
+
+    def load(self, force, psi, since=None):
+        """Set the between-events state: force and psi of every block (at time since, default 0)."""
         self.W[:] = 0.0
         self.flag[:] = 0
         self.W[:, F0] = force
         self.W[:, P] = psi
+        self.since[:] = 0.0 if since is None else since
+
+    def state(self, clock, nu):
+        """(force, psi) of every block at the two-float time `clock` (new arrays)."""
+        dt = np.maximum((clock[0] - self.since[:, 0]) + (clock[1] - self.since[:, 1]), 0.0)
+        psi = self.W[:, P]
+        return self.W[:, F0] + nu * dt, psi + np.log1p(dt * np.exp(-psi))
 
     @property
     def force(self):
+        """Stored forces (each at its block's `since` time; see `state`)."""
         return self.W[:, F0]
 
     @property
     def psi(self):
+        """Stored states psi (each at its block's `since` time; see `state`)."""
         return self.W[:, P]
