@@ -70,7 +70,7 @@ def run_event(force, psi, epicenter, model, integrator, v_start=0.0):
     ws.load(force, psi)
     profile = np.zeros(n)
     l2, nu, a, b, method, dt, rtol, atol, h_max, max_duration, max_steps = kernel_args(model, integrator)
-    build_schedule(ws.W, ws.since, ws.tree, nu, b)
+    build_schedule(ws.W, ws.since, ws.tree, nu, b)     # (simulate does this itself)
     clock = np.zeros(2)
     status = integrate_event(*ws.arrays[:7], clock, n, epicenter, v_start, l2, nu, a, b, method, dt,
                              rtol, atol, h_max, max_duration, max_steps, ws.diag, profile)

@@ -9,6 +9,8 @@ rest), so accuracy does not decay as the run goes on. Between events only the
 blocks an event touched are updated (schedule.py); `next_onset` and
 `load_quietly` are the plain O(N) versions, kept for preparing single events.
 """
+import math
+
 import numba as nb
 import numpy as np
 
@@ -48,14 +50,16 @@ def simulate(W, act, flag, touched, stuck, since, tree, diag, clock, l2, nu, a, 
              atol, h_max, max_duration, max_steps, n_events, out_t, out_epicenter, out_diag):
     """Run n_events events from the time `clock`; returns (status, number of events completed).
 
-    Every block is at rest with its state at time since[i] (see schedule.py).
+    Every block is at rest with its state at time since[i] (see schedule.py); `tree`
+    holds their onset keys, or NaN at the root after a new state was loaded.
     out_t[k] is the onset time of event k, out_epicenter[k] its epicenter,
     out_diag[k] the event's diagnostics vector (workspace.D_*). On a status
     other than OK the state is that after the failed event, which is not counted.
     """
     n = W.shape[0]
     no_profile = np.empty(0)
-    build_schedule(W, since, tree, nu, b)
+    if math.isnan(tree[1]):      # a freshly loaded state (Workspace.load): schedule every block
+        build_schedule(W, since, tree, nu, b)
     onset = np.empty(2)
     for k in range(n_events):
         _, epicenter = tree_min(tree)

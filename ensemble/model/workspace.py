@@ -63,7 +63,7 @@ class Workspace:
         self.touched = np.zeros(n, dtype=np.int64)
         self.stuck = np.zeros(n, dtype=np.int64)
         self.since = np.zeros((n, 2))
-        self.tree = np.full(tree_size(n), np.inf)
+        self.tree = np.full(tree_size(n), np.nan)
         self.diag = np.zeros(NDIAG)
 
     @property
@@ -78,6 +78,7 @@ class Workspace:
         self.W[:, F0] = force
         self.W[:, P] = psi
         self.since[:] = 0.0 if since is None else since
+        self.tree[:] = np.nan    # the kernels rebuild the schedule
 
     def state(self, clock, nu):
         """(force, psi) of every block at the two-float time `clock` (new arrays)."""
