@@ -20,7 +20,8 @@ The cost of each method at error `--target` is interpolated log-log between its 
 and the speed-up of the kernel's methods over the baselines is the ratio of those costs.
 Writes work_precision_N{N}_b{b}.{json,txt,png} per b; the figure has the errors against wall time
 (top row) and against block right-hand-side evaluations (bottom row).
-Default run: about 15-25 min (mostly the baselines, each capped by --max-seconds).
+Default run: about 5-10 min (mostly the baselines; at N = 800 the slowest, scipy BDF on the large
+event, takes ~40 s; each baseline run is capped by --max-seconds).
 """
 import argparse
 import time
