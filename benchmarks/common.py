@@ -156,6 +156,15 @@ def pyplot():
     return plt
 
 
+def save_figure(fig, axes, title, path):
+    """Legend in the first panel, title, tight layout; write to path and free the figure."""
+    axes[0, 0].legend(fontsize=6)
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    pyplot().close(fig)
+
+
 def minutes(seconds):
     return f"{seconds / 60:.1f} min" if seconds >= 60 else f"{seconds:.0f} s"
 

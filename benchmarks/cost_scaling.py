@@ -24,7 +24,8 @@ import numpy as np
 from ensemble.model.workspace import D_BLOCK_STEPS, D_NSLIP, D_SLIP
 from ensemble.runner import SimulationError
 
-from .common import Clock, minutes, parse_setting, pyplot, rough_events_per_second, trajectory, write_outputs
+from .common import (Clock, minutes, parse_setting, pyplot, rough_events_per_second, save_figure, trajectory,
+                     write_outputs)
 
 CLASSES = {"small": (-np.inf, 3.0), "mid": (3.0, 4.0), "large": (4.0, np.inf)}
 QUANTITIES = {"us_per_event": "us per event", "us_per_slid_block": "us per slid block",
@@ -114,11 +115,7 @@ def plot(points, sweeps, path):
             ax.set_xlabel(f"{var} ({other})", fontsize=8)
             ax.set_ylabel(label, fontsize=8)
             ax.tick_params(labelsize=7)
-    axes[0, 0].legend(fontsize=6)
-    fig.suptitle("cost per event by size class (flat in N = cost follows the event)", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, axes, "cost per event by size class (flat in N = cost follows the event)", path)
 
 
 def parse_args(argv=None):

@@ -34,7 +34,7 @@ from analysis.recurrence import RecurrenceScanner
 from ensemble.model.workspace import D_SLIP
 from ensemble.runner import SimulationError, event_rows
 
-from .common import (Clock, ks_distance, minutes, parse_setting, pyplot, rough_events_per_second,
+from .common import (Clock, ks_distance, minutes, parse_setting, pyplot, rough_events_per_second, save_figure,
                      trajectory, wasserstein1, write_outputs)
 
 RUNS = ["rk4:dt=1e-3", "rk4:dt=5e-4", "ark3:rtol=1e-4", "ark3:rtol=1e-5", "ark3:rtol=1e-6"]
@@ -147,11 +147,7 @@ def plot(rows, floor, path, title):
         ax.set_ylabel(f"{'KS' if name == 'ks' else 'Wasserstein-1'} distance of "
                       f"{'mu' if sample == 'mu' else 'T nu'}", fontsize=8)
         ax.tick_params(labelsize=7)
-    axes[0, 0].legend(fontsize=6)
-    fig.suptitle(f"statistical error against speed, {title}", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, axes, f"statistical error against speed, {title}", path)
 
 
 def parse_args(argv=None):

@@ -34,7 +34,7 @@ from ensemble.runner import Trajectory
 from ensemble.tasks import task_list
 
 from .baselines import BASELINES, Timeout, run_baseline
-from .common import STAGES, cost_at_error, minutes, parse_setting, pyplot, write_outputs
+from .common import STAGES, cost_at_error, minutes, parse_setting, pyplot, save_figure, write_outputs
 
 RUNS = (["rk4:dt=2e-3", "rk4:dt=1e-3", "rk4:dt=5e-4", "rk4:dt=2.5e-4"]
         + [f"ark3:rtol=1e-{k}" for k in range(4, 9)]
@@ -185,11 +185,7 @@ def plot(rows, path, title, target):
             mu = next(r["mu"] for r in rows if r["event"] == event)
             ax.set_title(f"{event} event (mu = {mu:.2f})", fontsize=8)
             ax.tick_params(labelsize=7)
-    axes[0, 0].legend(fontsize=6)
-    fig.suptitle(f"work-precision, single events, {title}", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, axes, f"work-precision, single events, {title}", path)
 
 
 def parse_args(argv=None):
