@@ -1,23 +1,30 @@
-"""Single-event work-precision: relative slip error against wall time and work.
+"""Single-event work-precision: relative error of slip and slip profile against wall time and work.
 
-    python benchmarks/work_precision.py [--N 800] [--b 20] [--out benchmarks/results]
+    python -m benchmarks.work_precision [--N 800] [--b 20 50] [--runs SETTING ...] [--target 1e-6]
+                                        [--max-seconds 120] [--out benchmarks/results]
 
-From fixed pre-event states of a developed chain (the next small event, mu < 3, and the next large
-one, mu >= 4), integrates the same event with
+For each b, from fixed pre-event states of a developed chain (the next small event, mu < 3, and
+the next large one, mu >= 4, after `--transient` events), integrates the same event with every
+setting of `--runs` (syntax in benchmarks/common.py):
 
-- the kernel's fixed-step RK4 (located stick and onset) over a range of dt,
-- the kernel's adaptive IMEX ARK3(2) over a range of rtol (the "dt" column holds rtol), and
-- a straightforward full-array numpy RK4 (every block every step, stick by clamping v at the end of
-  a step), the baseline a first implementation would be,
+- kernel integrators (`rk4:dt=...`, `ark3:rtol=...`, any other name in the registry): only
+  the sliding blocks, located stick and onset;
+- `numpy-rk4:dt=...`: full-chain numpy RK4, sticks and starts applied at step ends;
+- `scipy:method=LSODA|BDF|Radau,rtol=...[,atol=...]`: solve_ivp on all 3N unknowns with sticks
+  and starts located as terminal ODE events (limits in benchmarks/baselines.py).
 
-and measures the relative error of the event's total slip and of its slip profile against the
-kernel at a much smaller dt, the wall time, and the work (right-hand-side evaluations per block).
-Writes a JSON table and a work-precision diagram.
+Errors are measured against `--reference` (default: kernel RK4 at a quarter of the smallest RK4
+dt of the runs). A run that fails (e.g. RK4 beyond its stability limit: b = 50 needs
+dt <= 5e-4) is recorded as "failed"; a baseline run over `--max-seconds` as "timeout".
+The cost of each method at error `--target` is interpolated log-log between its measured points
+and the speed-up of the kernel's methods over the baselines is the ratio of those costs.
+Writes work_precision_N{N}_b{b}.{json,txt,png} per b; the figure has the errors against wall time
+(top row) and against block right-hand-side evaluations (bottom row).
+Default run: about 5-10 min (mostly the baselines; at N = 800 the slowest, scipy BDF on the large
+event, takes ~40 s; each baseline run is capped by --max-seconds).
 """
 import argparse
-import json
 import time
-from pathlib import Path
 
 import numpy as np
 
@@ -26,9 +33,22 @@ from ensemble.events import advance_to_onset, check, run_event
 from ensemble.runner import Trajectory
 from ensemble.tasks import task_list
 
+from .baselines import BASELINES, Timeout, run_baseline
+from .common import STAGES, cost_at_error, minutes, parse_setting, pyplot, save_figure, write_outputs
+
+RUNS = (["rk4:dt=2e-3", "rk4:dt=1e-3", "rk4:dt=5e-4", "rk4:dt=2.5e-4"]
+        + [f"ark3:rtol=1e-{k}" for k in range(4, 9)]
+        + ["numpy-rk4:dt=1e-3", "numpy-rk4:dt=5e-4"]
+        + [f"scipy:method=LSODA,rtol=1e-{k}" for k in (4, 6, 8)] + ["scipy:method=BDF,rtol=1e-6"])
+METRICS = ("slip_error", "profile_error")
+# what a ratio of costs means when a cost is only a bound ('bound': every run beat the target, the
+# cheapest one's time is an upper bound on the cost at the target)
+RATIO_IS = {("interpolated", "interpolated"): "=", ("interpolated", "bound"): ">=",
+            ("bound", "interpolated"): "<=", ("bound", "bound"): "?"}
+
 
 def pre_event_states(model, transient, seed=0):
-    """(label, force, psi, epicenter) of the next small (mu < 3) and large (mu >= 4) event."""
+    """{label: (force, psi, epicenter, mu)} at the onset of the next small (mu < 3) and large (mu >= 4) event."""
     cfg = Config(model=model, run=Run(events=1, transient=transient, seed=seed),
                  integrator=Integrator(dt=5e-4))
     traj = Trajectory(cfg, task_list(cfg)[0])
@@ -46,113 +66,162 @@ def pre_event_states(model, transient, seed=0):
     return found
 
 
-def kernel_event(f, p, epicenter, model, integrator):
-    run_event(f, p, epicenter, model, integrator)          # compile / warm caches
-    start = time.perf_counter()
+def kernel_event(f, p, epicenter, model, integrator, min_seconds=0.1):
+    """(EventResult, wall seconds) of one event: the fastest of >= 3 repeats lasting >= min_seconds
+    in all (events take down to 0.1 ms); the first call compiles and is not timed."""
     ev = check(run_event(f, p, epicenter, model, integrator))
-    return ev, time.perf_counter() - start
+    times = []
+    while len(times) < 3 or sum(times) < min_seconds:
+        start = time.perf_counter()
+        run_event(f, p, epicenter, model, integrator)
+        times.append(time.perf_counter() - start)
+    return ev, min(times)
 
 
-def numpy_rk4_event(f, p, epicenter, model, dt, max_steps=10**7):
-    """Full-chain RK4 in numpy on (slip y, v, psi), c-free frame; clamps v at step ends."""
-    n = len(f)
-    l2, nu, a, b = model.l ** 2, model.nu, model.a, model.b
-
-    def lap(y):
-        out = np.empty_like(y)
-        out[1:-1] = y[2:] - 2 * y[1:-1] + y[:-2]
-        out[0] = y[1] - y[0]
-        out[-1] = y[-2] - y[-1]
-        return out
-
-    def rates(t, y, v, psi, moving):
-        vp = np.maximum(v, 0.0)
-        acc = f + nu * t - y + l2 * lap(y) - a * np.log1p(vp) - b * psi
-        return np.where(moving, v, 0.0), np.where(moving, acc, 0.0), np.exp(-psi) - vp
-
-    y, v, psi = np.zeros(n), np.zeros(n), p.copy()
-    moving = np.zeros(n, dtype=bool)
-    moving[epicenter] = True
-    t, steps = 0.0, 0
-    start = time.perf_counter()
-    while moving.any() and steps < max_steps:
-        k1 = rates(t, y, v, psi, moving)
-        k2 = rates(t + dt / 2, y + dt / 2 * k1[0], v + dt / 2 * k1[1], psi + dt / 2 * k1[2], moving)
-        k3 = rates(t + dt / 2, y + dt / 2 * k2[0], v + dt / 2 * k2[1], psi + dt / 2 * k2[2], moving)
-        k4 = rates(t + dt, y + dt * k3[0], v + dt * k3[1], psi + dt * k3[2], moving)
-        y = y + dt / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
-        v = v + dt / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
-        psi = psi + dt / 6 * (k1[2] + 2 * k2[2] + 2 * k3[2] + k4[2])
-        t += dt
-        steps += 1
-        stuck = moving & (v <= 0)
-        v[stuck] = 0.0
-        moving &= ~stuck
-        excess = f + nu * t - y + l2 * lap(y) - b * psi
-        moving |= (~moving) & (excess > 0)
-    return y, time.perf_counter() - start, steps * n
+def measure(setting, f, p, epicenter, model, max_seconds):
+    """(profile, seconds, block RHS evaluations, block-steps, status) of one setting on one event."""
+    try:
+        if setting.is_kernel:
+            ev, wall = kernel_event(f, p, epicenter, model, setting.integrator())
+            stages = STAGES.get(setting.name)
+            return ev.profile, wall, stages and stages * ev.block_steps, ev.block_steps, "ok"
+        profile, wall, work = run_baseline(setting, f, p, epicenter, model, max_seconds)
+        return profile, wall, work, None, "ok"
+    except Timeout:
+        return None, None, None, None, "timeout"
+    except RuntimeError as err:
+        return None, None, None, None, f"failed: {err}"
 
 
-def main():
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--N", type=int, default=800)
-    p.add_argument("--b", type=float, default=20.0)
-    p.add_argument("--transient", type=int, default=300)
-    p.add_argument("--dts", type=float, nargs="+", default=[2e-3, 1e-3, 5e-4, 2.5e-4])
-    p.add_argument("--numpy-dts", type=float, nargs="+", default=[1e-3, 5e-4])
-    p.add_argument("--rtols", type=float, nargs="+", default=[1e-4, 1e-5, 1e-6, 1e-7, 1e-8])
-    p.add_argument("--out", default="benchmarks/results")
-    args = p.parse_args()
-    model = Model(N=args.N, b=args.b)
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+def curve(setting):
+    """Points of one curve share the method and its non-numeric options (e.g. scipy's method)."""
+    return " ".join([setting.name] + [str(v) for _, v in setting.params if isinstance(v, str)])
+
+
+def run_b(args, b, settings, reference):
+    model = Model(N=args.N, b=b)
     rows = []
-    for label, (f, psi, epicenter, mu) in pre_event_states(model, args.transient).items():
-        ref, _ = kernel_event(f, psi, epicenter, model, Integrator(dt=min(args.dts) / 4))
-
-        def record(method, dt, profile, wall, work):
-            slip_err = abs(profile.sum() - ref.slip) / ref.slip
-            prof_err = np.linalg.norm(profile - ref.profile) / np.linalg.norm(ref.profile)
-            rows.append({"event": label, "mu": mu, "method": method, "dt": dt, "slip_error": slip_err,
-                         "profile_error": prof_err, "seconds": wall, "block_rhs": work})
-            knob = "rtol" if method == "ark3" else "dt"
-            print(f"{label:5s} mu={mu:.2f} {method:9s} {knob}={dt:.0e}: slip error {slip_err:.1e}, "
-                  f"profile error {prof_err:.1e}, {wall:.3f} s, {work:.3g} block RHS evaluations")
-
-        for dt in args.dts:
-            ev, wall = kernel_event(f, psi, epicenter, model, Integrator(dt=dt))
-            record("rk4", dt, ev.profile, wall, 4 * ev.block_steps)
-        for rtol in args.rtols:
-            ev, wall = kernel_event(f, psi, epicenter, model, Integrator(method="ark3", rtol=rtol))
-            record("ark3", rtol, ev.profile, wall, 4 * ev.block_steps)
-        for dt in args.numpy_dts:
-            y, wall, work = numpy_rk4_event(f, psi, epicenter, model, dt)
-            record("numpy-rk4", dt, y, wall, 4 * work)
-    (out / f"work_precision_N{args.N}_b{args.b:g}.json").write_text(json.dumps(rows, indent=1))
-    plot(rows, out / f"work_precision_N{args.N}_b{args.b:g}.png", f"N = {args.N}, b = {args.b:g}")
+    for label, (f, psi, epicenter, mu) in pre_event_states(model, args.transient, args.seed).items():
+        ref = check(run_event(f, psi, epicenter, model, reference.integrator()))
+        for s in settings:
+            profile, wall, work, block_steps, status = measure(s, f, psi, epicenter, model, args.max_seconds)
+            row = {"b": b, "event": label, "mu": mu, "n_slipped": int(np.sum(ref.profile > 0)),
+                   "setting": s.label, "curve": curve(s), "kernel": s.is_kernel, "status": status,
+                   "seconds": wall, "block_rhs": work, "block_steps": block_steps,
+                   "slip_error": None, "profile_error": None}
+            if profile is not None:
+                row["slip_error"] = abs(profile.sum() - ref.slip) / ref.slip
+                row["profile_error"] = np.linalg.norm(profile - ref.profile) / np.linalg.norm(ref.profile)
+            rows.append(row)
+            print(f"b={b:g} {label} mu={mu:.2f} {s.label}: " + (
+                f"slip error {row['slip_error']:.1e}, profile error {row['profile_error']:.1e}, {wall:.3f} s"
+                if status == "ok" else status), flush=True)
+    return rows
 
 
-def plot(rows, path, title):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
-    for ax, label in zip(axes, ("small", "large")):
-        for k, method in enumerate(("rk4", "numpy-rk4", "ark3")):
-            sel = [r for r in rows if r["event"] == label and r["method"] == method]
-            if sel:
-                ax.loglog([r["seconds"] for r in sel], [max(r["slip_error"], 1e-17) for r in sel],
-                          "o-", color=f"C{k}", label=method)
-                for r in sel:
-                    ax.annotate(f"{r['dt']:.0e}", (r["seconds"], max(r["slip_error"], 1e-17)), fontsize=6)
-        mu = next((r["mu"] for r in rows if r["event"] == label), float("nan"))
-        ax.set_title(f"{label} event (mu = {mu:.2f})", fontsize=9)
-        ax.set_xlabel("wall time [s]")
-        ax.set_ylabel("relative slip error")
-        ax.legend(fontsize=8)
-    fig.suptitle(f"work-precision, single events, {title}", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
+def speedups(rows, target):
+    """Cost of every curve at the target error and the ratios baseline / kernel, per event and metric."""
+    costs, ratios = [], []
+    for event in dict.fromkeys(r["event"] for r in rows):
+        for metric in METRICS:
+            ok = [r for r in rows if r["event"] == event and r["status"] == "ok"]
+            here = {}
+            for c in dict.fromkeys(r["curve"] for r in ok):
+                pts = [r for r in ok if r["curve"] == c]
+                seconds, how = cost_at_error([r[metric] for r in pts], [r["seconds"] for r in pts], target)
+                here[c] = (seconds, how, pts[0]["kernel"])
+                costs.append({"event": event, "metric": metric, "curve": c, "seconds": seconds, "how": how})
+            for base, (tb, hb, kb) in here.items():
+                for kern, (tk, hk, kk) in here.items():
+                    if not kb and kk and tb and tk:
+                        ratios.append({"event": event, "metric": metric, "baseline": base, "kernel": kern,
+                                       "ratio": tb / tk, "ratio_is": RATIO_IS[hb, hk],
+                                       "baseline_how": hb, "kernel_how": hk})
+    return costs, ratios
+
+
+def table(rows, costs, ratios, title, target):
+    lines = [f"work-precision, single events, {title}",
+             f"{'event':6s} {'mu':>5s} {'setting':34s} {'slip err':>9s} {'prof err':>9s} {'seconds':>9s} {'block RHS':>10s}"]
+    for r in rows:
+        if r["status"] == "ok":
+            rhs = f"{r['block_rhs']:10.3g}" if r["block_rhs"] else f"{'?':>10s}"
+            lines.append(f"{r['event']:6s} {r['mu']:5.2f} {r['setting']:34s} {r['slip_error']:9.1e} "
+                         f"{r['profile_error']:9.1e} {r['seconds']:9.4f} {rhs}")
+        else:
+            lines.append(f"{r['event']:6s} {r['mu']:5.2f} {r['setting']:34s} {r['status'][:60]}")
+    lines.append(f"\nwall time at relative error {target:g} (interpolated log-log; 'bound': every run "
+                 f"was more accurate, cheapest shown)")
+    for c in costs:
+        sec = f"{c['seconds']:.4g} s" if c["seconds"] else "-"
+        lines.append(f"  {c['event']:6s} {c['metric']:14s} {c['curve']:16s} {sec:>12s} ({c['how']})")
+    lines.append(f"\nspeed-up of the kernel at equal error {target:g} (baseline seconds / kernel seconds; "
+                 f"'>=' a lower bound, '<=' an upper bound, '?' both costs are bounds)")
+    for q in ratios:
+        note = "" if q["ratio_is"] == "=" else f"  (baseline {q['baseline_how']}, kernel {q['kernel_how']})"
+        lines.append(f"  {q['event']:6s} {q['metric']:14s} {q['kernel']:6s} vs {q['baseline']:16s} "
+                     f"{q['ratio_is']:>2s} {q['ratio']:9.3g}x{note}")
+    return lines
+
+
+def plot(rows, path, title, target):
+    plt = pyplot()
+    events = list(dict.fromkeys(r["event"] for r in rows))
+    panels = [(e, m) for e in events for m in METRICS]
+    fig, axes = plt.subplots(2, len(panels), figsize=(3.6 * len(panels), 6.5), squeeze=False)
+    curves = list(dict.fromkeys(r["curve"] for r in rows))
+    for col, (event, metric) in enumerate(panels):
+        for row, xkey, xlabel in ((0, "seconds", "wall time [s]"), (1, "block_rhs", "block RHS evaluations")):
+            ax = axes[row, col]
+            for k, c in enumerate(curves):
+                pts = [r for r in rows if r["event"] == event and r["curve"] == c and r["status"] == "ok"
+                       and r[xkey]]
+                if pts:
+                    ax.loglog([r[xkey] for r in pts], [max(r[metric], 1e-17) for r in pts], "o-",
+                              color=f"C{k}", label=c, ms=4)
+            ax.axhline(target, color="0.6", ls=":", lw=1)
+            ax.set_xlabel(xlabel, fontsize=8)
+            ax.set_ylabel(f"relative {metric.replace('_', ' ')}", fontsize=8)
+            mu = next(r["mu"] for r in rows if r["event"] == event)
+            ax.set_title(f"{event} event (mu = {mu:.2f})", fontsize=8)
+            ax.tick_params(labelsize=7)
+    save_figure(fig, axes, f"work-precision, single events, {title}", path)
+
+
+def parse_args(argv=None):
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--N", type=int, default=800, help="blocks")
+    p.add_argument("--b", type=float, nargs="+", default=[20.0, 50.0], help="one figure and table per b")
+    p.add_argument("--transient", type=int, default=300, help="events before the pre-event states are taken")
+    p.add_argument("--seed", type=int, default=0, help="root seed of the developed chain")
+    p.add_argument("--runs", nargs="+", default=RUNS, help="settings to measure (see benchmarks/common.py)")
+    p.add_argument("--reference", default=None, help="kernel setting for the reference solution "
+                   "(default: rk4 at a quarter of the smallest rk4 dt of --runs, or 6.25e-5)")
+    p.add_argument("--target", type=float, default=1e-6, help="relative error at which speed-ups are compared")
+    p.add_argument("--max-seconds", type=float, default=120.0, help="wall-time cap of one baseline run")
+    p.add_argument("--out", default="benchmarks/results")
+    return p.parse_args(argv)
+
+
+def main(argv=None):
+    args = parse_args(argv)
+    settings = [parse_setting(text, BASELINES) for text in args.runs]
+    rk4_dts = [s.kwargs.get("dt", 1e-3) for s in settings if s.name == "rk4"] or [2.5e-4]
+    reference = parse_setting(args.reference or f"rk4:dt={min(rk4_dts) / 4:g}")
+    baselines = sum(not s.is_kernel for s in settings)
+    print(f"{len(settings)} settings x 2 events x {len(args.b)} b; the {baselines} baseline runs per event "
+          f"take up to {args.max_seconds:g} s each: at most about "
+          f"{minutes(2 * len(args.b) * baselines * args.max_seconds)} in all (reference {reference.label})",
+          flush=True)
+    for b in args.b:
+        rows = run_b(args, b, settings, reference)
+        costs, ratios = speedups(rows, args.target)
+        title = f"N = {args.N}, b = {b:g}, reference {reference.label}"
+        stem = f"work_precision_N{args.N}_b{b:g}"
+        data = {"config": {**vars(args), "b": b, "reference": reference.label}, "rows": rows,
+                "cost_at_target": costs, "speedups": ratios}
+        write_outputs(args.out, stem, data, table(rows, costs, ratios, title, args.target))
+        plot(rows, f"{args.out}/{stem}.png", title, args.target)
 
 
 if __name__ == "__main__":

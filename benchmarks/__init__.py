@@ -1,0 +1,1 @@
+"""Speed-against-error and scaling measurements (run as python -m benchmarks.NAME)."""

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# The benchmark report of "Speed against error", rerunnable with one command from the repository root:
+#
+#     bash benchmarks/report.sh [OUT]          # OUT defaults to benchmarks/results
+#
+# Runs every benchmark at its default (paper-setting) sizes, one after the other on one core, and
+# writes tables (.txt), data (.json) and figures (.png) into OUT. Expected duration on this
+# machine: about 50 min in all (work precision ~5-10 min, statistics ~25 min,
+# cost scaling ~15-20 min, throughput ~1 min). Environment: PY (python, default .venv/bin/python),
+# JOBS (processes for the statistics run, default 1; 2 halves its time but then two runs share
+# the machine's cores, so its events/s are per process under that load).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+OUT=${1:-benchmarks/results}
+PY=${PY:-.venv/bin/python}
+JOBS=${JOBS:-1}
+export NUMBA_CACHE_DIR=${NUMBA_CACHE_DIR:-$PWD/.numba_cache} OMP_NUM_THREADS=1 NUMBA_NUM_THREADS=1 \
+       OPENBLAS_NUM_THREADS=1 PYTHONPATH=$PWD${PYTHONPATH:+:$PYTHONPATH}
+mkdir -p "$OUT"
+start=$SECONDS
+step() { echo "== $* ($(( (SECONDS - start) / 60 )) min elapsed)"; }
+
+step "work precision, single events, b = 20 and 50"
+"$PY" -m benchmarks.work_precision --out "$OUT"
+step "statistical error against speed"
+"$PY" -m benchmarks.statistics --jobs "$JOBS" --out "$OUT"
+step "cost per event against N and b"
+"$PY" -m benchmarks.cost_scaling --out "$OUT"
+step "throughput of the paper setting"
+"$PY" benchmarks/throughput.py | tee "$OUT/throughput.txt"
+step "done: results in $OUT"

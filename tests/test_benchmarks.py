@@ -1,0 +1,101 @@
+"""The benchmark scripts at tiny sizes: their helpers against known answers, their outputs sane."""
+import json
+
+import numpy as np
+import pytest
+
+from benchmarks import cost_scaling, statistics, work_precision
+from benchmarks.baselines import BASELINES
+from benchmarks.common import cost_at_error, ks_distance, parse_setting, wasserstein1
+from ensemble.config import Model
+from ensemble.events import advance_to_onset
+
+from .conftest import developed_state
+
+
+def test_distances_agree_with_scipy():
+    stats = pytest.importorskip("scipy.stats")
+    rng = np.random.default_rng(3)
+    for n, m in ((50, 70), (400, 31), (1, 5)):
+        x = rng.normal(size=n)
+        y = np.round(rng.normal(0.3, 1.5, size=m), 1)    # ties within y and with x
+        x[: n // 3] = np.round(x[: n // 3], 1)
+        assert ks_distance(x, y) == pytest.approx(stats.ks_2samp(x, y).statistic, abs=1e-12)
+        assert wasserstein1(x, y) == pytest.approx(stats.wasserstein_distance(x, y), rel=1e-12)
+    assert ks_distance(x, x) == 0.0 and wasserstein1(x, x) == 0.0
+    assert wasserstein1(x, x + 2.5) == pytest.approx(2.5)
+
+
+def test_cost_at_error_known_answers():
+    errors, seconds = [1e-4, 1e-6, 1e-8], [1.0, 10.0, 100.0]     # error ~ seconds^-2
+    assert cost_at_error(errors, seconds, 1e-7) == (pytest.approx(10 ** 1.5), "interpolated")
+    assert cost_at_error(errors, seconds, 1e-6) == (pytest.approx(10.0), "interpolated")
+    assert cost_at_error(errors, seconds, 1e-2) == (1.0, "bound")
+    assert cost_at_error(errors, seconds, 1e-9) == (None, "not reached")
+    assert cost_at_error([None, 1e-5], [1.0, 2.0], 1e-6) == (None, "not reached")
+
+
+def test_settings_are_validated():
+    s = parse_setting("ark3:rtol=1e-5,atol=1e-12")
+    assert s.integrator().rtol == 1e-5 and s.integrator().atol == 1e-12
+    assert parse_setting("scipy:method=LSODA,rtol=1e-6", BASELINES).kwargs == {"method": "LSODA", "rtol": 1e-6}
+    for bad in ("rk5:dt=1e-3", "rk4:step=1e-3", "rk4:dt", "numpy-rk4:dt=1e-3"):
+        with pytest.raises(ValueError):
+            parse_setting(bad)
+
+
+def test_baseline_timeout_is_recorded():
+    model = Model(N=30)
+    epicenter, _, f, p = advance_to_onset(*developed_state(model, 50), model)
+    f[epicenter] = model.b * p[epicenter]
+    for text in ("scipy:method=LSODA", "numpy-rk4:dt=1e-3"):
+        assert work_precision.measure(parse_setting(text, BASELINES), f, p, epicenter, model, 0.0)[-1] == "timeout"
+
+
+def test_work_precision_tiny(tmp_path):
+    work_precision.main(["--N", "40", "--b", "20", "--transient", "60", "--max-seconds", "20", "--out",
+                         str(tmp_path), "--runs", "rk4:dt=2e-3", "rk4:dt=1e-3", "ark3:rtol=1e-4", "ark3:rtol=1e-7",
+                         "scipy:method=LSODA,rtol=1e-5", "scipy:method=LSODA,rtol=1e-8"])
+    data = json.loads((tmp_path / "work_precision_N40_b20.json").read_text())
+    assert (tmp_path / "work_precision_N40_b20.png").stat().st_size > 0
+    rows = data["rows"]
+    assert {r["event"] for r in rows} == {"small", "large"} and all(r["status"] == "ok" for r in rows)
+    for event in ("small", "large"):
+        by = {r["setting"]: r for r in rows if r["event"] == event}
+        # fourth order: halving dt cuts the slip error at least 8-fold
+        assert by["rk4:dt=1e-3"]["slip_error"] * 8 < by["rk4:dt=2e-3"]["slip_error"]
+        # the full-chain scipy baseline integrates the same event as the kernel
+        assert by["scipy:method=LSODA,rtol=1e-8"]["profile_error"] < 1e-5
+        assert by["ark3:rtol=1e-7"]["slip_error"] < by["ark3:rtol=1e-4"]["slip_error"] < 1e-3
+        assert all(r["seconds"] > 0 and r["block_rhs"] > 0 for r in by.values())
+    assert data["speedups"] and all(q["ratio"] > 0 and q["ratio_is"] in ("=", ">=", "<=", "?")
+                                    for q in data["speedups"])
+
+
+def test_statistics_tiny(tmp_path):
+    data = statistics.main(["--N", "40", "--seeds", "2", "--events", "120", "--transient", "40",
+                            "--reference", "rk4:dt=1e-3", "--runs", "ark3:rtol=1e-3", "--out", str(tmp_path)])
+    assert json.loads((tmp_path / "statistics_N40_b20.json").read_text())["rows"][1]["setting"] == "ark3:rtol=1e-3"
+    ref, cand = data["rows"]
+    assert ref["events"] == cand["events"] == 240 and cand["recurrences"] > 0
+    assert cand["events_per_second"] > 0
+    for key in ("ks_mu", "ks_tnu"):
+        assert 0 < cand[key] <= 1
+    for key in ("w1_mu", "w1_tnu"):
+        assert 0 < cand[key] < np.inf
+    for band in data["noise_floor"].values():
+        assert np.isfinite(band["mean"]) and 0 <= band["min"] <= band["mean"] <= band["max"]
+
+
+def test_cost_scaling_tiny(tmp_path):
+    data = cost_scaling.main(["--runs", "rk4:dt=1e-3", "--Ns", "40", "80", "--bs", "20", "30", "--N-at", "40",
+                              "--events", "60", "--min-transient", "40", "--out", str(tmp_path)])
+    assert (tmp_path / "cost_scaling.png").stat().st_size > 0
+    points = data["points"]
+    assert [(p["N"], p["b"]) for p in points] == [(40, 20.0), (80, 20.0), (40, 30.0)]
+    for p in points:
+        assert p["status"] == "ok" and p["events_per_second"] > 0
+        assert sum(p[c]["count"] for c in cost_scaling.CLASSES) == 60
+        for c in cost_scaling.CLASSES:
+            if p[c]["count"]:
+                assert p[c]["us_per_event"] > 0 and p[c]["block_steps_per_slid_block"] >= 1
