@@ -1,11 +1,11 @@
 """Registry of event integrators: config name -> kernel method and description.
 
-Both run through the same event kernel (ensemble.model.event.integrate_event),
+All run through the same event kernel (ensemble.model.event.integrate_event),
 which locates sticks and onsets inside a step the same way for each.
 """
 from dataclasses import dataclass
 
-from .model.event import ARK3, RK4
+from .model.event import ARK3, ARK4, RK4
 
 
 @dataclass(frozen=True)
@@ -20,6 +20,9 @@ INTEGRATORS = {
     "ark3": Integrator(ARK3, "adaptive IMEX Runge-Kutta ARK3(2)4L[2]SA: explicit in slip and "
                              "velocity, L-stable implicit in the state; step controlled by "
                              "integrator.rtol / atol, at most integrator.max_step"),
+    "ark4": Integrator(ARK4, "adaptive IMEX Runge-Kutta ARK4(3)6L[2]SA: fourth order, otherwise "
+                             "as ark3 (explicit in slip and velocity, L-stable implicit in the "
+                             "state, step controlled by integrator.rtol / atol, max_step)"),
 }
 
 

@@ -6,15 +6,19 @@ K1V (for the Hermite interpolant), and returns (friction work, time integral of
 the total slip, error estimate relative to the tolerances; 0 for fixed steps).
 
 - rk4_step: classical RK4, the paper's method; stable only while h / theta < 2.785.
-- ark3_step: the additive (IMEX) Runge-Kutta pair ARK3(2)4L[2]SA of Kennedy &
-  Carpenter (2003): explicit for slip and velocity, L-stable ESDIRK for the state
-  psi, whose relaxation at rate 1/theta (~ v while sliding) is the stiff part.
-  Each implicit stage is one scalar equation per block, solved by Newton. Third
-  order with a second-order embedded estimate for step-size control.
+- ark3_step, ark4_step: the additive (IMEX) Runge-Kutta pairs ARK3(2)4L[2]SA and
+  ARK4(3)6L[2]SA of Kennedy & Carpenter (2003): explicit for slip and velocity,
+  L-stable ESDIRK for the state psi, whose relaxation at rate 1/theta (~ v while
+  sliding) is the stiff part. Each implicit stage is one scalar equation per
+  block, solved by Newton. Order 3 (4) with an embedded estimate of order 2 (3)
+  for step-size control. Both run the same kernel `_ark_step` with their tableau.
 """
 import math
+from fractions import Fraction
+from typing import NamedTuple
 
 import numba as nb
+import numpy as np
 
 from .friction import friction, left, right, spring_force, state_rate
 from .workspace import (ARK_A, ARK_G, ARK_V, F0, K1V, KP, KV, KY, P, P0, PS, SP, SV, SY, V, V0,
@@ -97,26 +101,106 @@ def rk4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol):
     return pw * h / 6.0, ys * h / 6.0, 0.0
 
 
+class ArkPair(NamedTuple):
+    """An IMEX additive Runge-Kutta pair as published, in exact fractions ("p/q" strings).
+
+    Explicit and ESDIRK tableaux share the nodes c and the weights b (the
+    implicit one is stiffly accurate: its last row is b); bhat are the embedded
+    weights. `explicit[s]` and `implicit[s]` are row s left of the diagonal;
+    the implicit diagonal is gamma except for the explicit first stage.
+    """
+    name: str
+    order: int
+    embedded_order: int
+    c: tuple
+    explicit: tuple
+    implicit: tuple
+    gamma: str
+    b: tuple
+    bhat: tuple
+
+    def matrices(self):
+        """(c, A_E, A_I, b, bhat) as Fractions; A_E and A_I square, A_I with its diagonal."""
+        g = Fraction(self.gamma)
+        ai = _square(self.implicit)
+        for i in range(1, len(ai)):
+            ai[i][i] = g
+        return (_fractions(self.c), _square(self.explicit), ai, _fractions(self.b),
+                _fractions(self.bhat))
+
+    def kernel_arrays(self):
+        """What `_ark_step` takes: c, A_E, A_I left of the diagonal, b, b - bhat (float arrays), gamma.
+
+        b - bhat is the difference of the rounded weights, so that the error
+        estimate is exactly the difference of the two solutions as computed.
+        """
+        b, bhat = _fractions(self.b), _fractions(self.bhat)
+        return (np.array(_fractions(self.c), dtype=float),
+                np.array(_square(self.explicit), dtype=float),
+                np.array(_square(self.implicit), dtype=float),
+                np.array(b, dtype=float),
+                np.array([float(p) - float(q) for p, q in zip(b, bhat)]),
+                float(Fraction(self.gamma)))
 
 
-# ARK3(2)4L[2]SA (Kennedy & Carpenter 2003): c, explicit and implicit tableaux
-# (lower triangles), weights b (shared, stiffly accurate) and embedded weights.
-_G = 1767732205903.0 / 4055673282236.0
-_C = (0.0, 1767732205903.0 / 2027836641118.0, 0.6, 1.0)
-_AE = ((0.0, 0.0, 0.0),
-       (1767732205903.0 / 2027836641118.0, 0.0, 0.0),
-       (5535828885825.0 / 10492691773637.0, 788022342437.0 / 10882634858940.0, 0.0),
-       (6485989280629.0 / 16251701735622.0, -4246266847089.0 / 9704473918619.0,
-        10755448449292.0 / 10357097424841.0))
-_AI = ((0.0, 0.0, 0.0),
-       (_G, 0.0, 0.0),
-       (2746238789719.0 / 10658868560708.0, -640167445237.0 / 6845629431997.0, 0.0),
-       (1471266399579.0 / 7840856788654.0, -4482444167858.0 / 7529755066697.0,
-        11266239266428.0 / 11593286722821.0))
-_B = (1471266399579.0 / 7840856788654.0, -4482444167858.0 / 7529755066697.0,
-      11266239266428.0 / 11593286722821.0, _G)
-_BHAT = (2756255671327.0 / 12835298489170.0, -10771552573575.0 / 22201958757719.0,
-         9247589265047.0 / 10645013368117.0, 2193209047091.0 / 5459859503100.0)
+def _fractions(xs):
+    return [Fraction(x) for x in xs]
+
+
+def _square(rows):
+    """Strictly lower triangular square matrix (Fractions) from rows left of the diagonal."""
+    s = len(rows)
+    return [_fractions(row) + [Fraction(0)] * (s - len(row)) for row in rows]
+
+
+# Kennedy & Carpenter (2003), Appl. Numer. Math. 44, 139, with the coefficients as SUNDIALS
+# ARKODE ships them (ARK324L2SA_{ERK,DIRK}_4_2_3, ARK436L2SA_{ERK,DIRK}_6_3_4). Many are
+# 13-digit rational approximations, so order conditions hold to ~1e-13, not exactly.
+ARK324 = ArkPair(
+    "ARK3(2)4L[2]SA", 3, 2,
+    c=("0", "1767732205903/2027836641118", "3/5", "1"),
+    explicit=((),
+              ("1767732205903/2027836641118",),
+              ("5535828885825/10492691773637", "788022342437/10882634858940"),
+              ("6485989280629/16251701735622", "-4246266847089/9704473918619",
+               "10755448449292/10357097424841")),
+    implicit=((),
+              ("1767732205903/4055673282236",),
+              ("2746238789719/10658868560708", "-640167445237/6845629431997"),
+              ("1471266399579/7840856788654", "-4482444167858/7529755066697",
+               "11266239266428/11593286722821")),
+    gamma="1767732205903/4055673282236",
+    b=("1471266399579/7840856788654", "-4482444167858/7529755066697",
+       "11266239266428/11593286722821", "1767732205903/4055673282236"),
+    bhat=("2756255671327/12835298489170", "-10771552573575/22201958757719",
+          "9247589265047/10645013368117", "2193209047091/5459859503100"))
+
+ARK436 = ArkPair(
+    "ARK4(3)6L[2]SA", 4, 3,
+    c=("0", "1/2", "83/250", "31/50", "17/20", "1"),
+    explicit=((),
+              ("1/2",),
+              ("13861/62500", "6889/62500"),
+              ("-116923316275/2393684061468", "-2731218467317/15368042101831",
+               "9408046702089/11113171139209"),
+              ("-451086348788/2902428689909", "-2682348792572/7519795681897",
+               "12662868775082/11960479115383", "3355817975965/11060851509271"),
+              ("647845179188/3216320057751", "73281519250/8382639484533",
+               "552539513391/3454668386233", "3354512671639/8306763924573", "4040/17871")),
+    implicit=((),
+              ("1/4",),
+              ("8611/62500", "-1743/31250"),
+              ("5012029/34652500", "-654441/2922500", "174375/388108"),
+              ("15267082809/155376265600", "-71443401/120774400", "730878875/902184768",
+               "2285395/8070912"),
+              ("82889/524892", "0", "15625/83664", "69875/102672", "-2260/8211")),
+    gamma="1/4",
+    b=("82889/524892", "0", "15625/83664", "69875/102672", "-2260/8211", "1/4"),
+    bhat=("4586570599/29645900160", "0", "178811875/945068544", "814220225/1159782912",
+          "-3700637/11593932", "61727/225920"))
+
+_C3, _AE3, _AI3, _B3, _D3, _G3 = ARK324.kernel_arrays()
+_C4, _AE4, _AI4, _B4, _D4, _G4 = ARK436.kernel_arrays()
 
 
 @nb.njit(cache=True, inline="always")
@@ -137,28 +221,32 @@ def _implicit_state(rhs, hg, v, guess):
     return psi
 
 
-@nb.njit(cache=True, error_model="numpy")
-def ark3_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol):
-    """ARK3(2)4L[2]SA step of the active blocks; see the module docstring."""
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _ark_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol, c, ae, ai, bw, bd, gamma):
+    """One step of the IMEX pair (c, ae, ai, gamma; weights bw, error weights bd = b - bhat).
+
+    Stage s: slip and velocity explicit from the earlier stages' rates, psi
+    implicit (one scalar Newton per block) with diagonal gamma.
+    """
     pw = 0.0
     ys = 0.0
-    for s in range(4):
+    for s in range(c.shape[0]):
         for k in range(na):
             i = act[k]
             y = W[i, Y0]
             v = W[i, V0]
             r = W[i, P0]
             for j in range(s):
-                y += h * _AE[s][j] * W[i, ARK_V + j]
-                v += h * _AE[s][j] * W[i, ARK_A + j]
-                r += h * _AI[s][j] * W[i, ARK_G + j]
+                y += h * ae[s, j] * W[i, ARK_V + j]
+                v += h * ae[s, j] * W[i, ARK_A + j]
+                r += h * ai[s, j] * W[i, ARK_G + j]
             W[i, YS] = y
             W[i, VS] = v
             # the previous stage's psi (still in PS) starts Newton close to the root
-            W[i, PS] = r if s == 0 else _implicit_state(r, h * _G, v, W[i, PS])
-        power, ysum = stage_rates(W, act, na, n, tau + _C[s] * h, l2, nu, a, b, yrest)
-        pw += _B[s] * power
-        ys += _B[s] * ysum
+            W[i, PS] = r if s == 0 else _implicit_state(r, h * gamma, v, W[i, PS])
+        power, ysum = stage_rates(W, act, na, n, tau + c[s] * h, l2, nu, a, b, yrest)
+        pw += bw[s] * power
+        ys += bw[s] * ysum
         for k in range(na):
             i = act[k]
             W[i, ARK_V + s] = W[i, KY]
@@ -170,14 +258,13 @@ def ark3_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol):
         W[i, K1V] = W[i, ARK_A]
         dy = dv = dp = 0.0
         ey = ev = ep = 0.0
-        for s in range(4):
-            dy += _B[s] * W[i, ARK_V + s]
-            dv += _B[s] * W[i, ARK_A + s]
-            dp += _B[s] * W[i, ARK_G + s]
-            d = _B[s] - _BHAT[s]
-            ey += d * W[i, ARK_V + s]
-            ev += d * W[i, ARK_A + s]
-            ep += d * W[i, ARK_G + s]
+        for s in range(c.shape[0]):
+            dy += bw[s] * W[i, ARK_V + s]
+            dv += bw[s] * W[i, ARK_A + s]
+            dp += bw[s] * W[i, ARK_G + s]
+            ey += bd[s] * W[i, ARK_V + s]
+            ev += bd[s] * W[i, ARK_A + s]
+            ep += bd[s] * W[i, ARK_G + s]
         W[i, Y] = W[i, Y0] + h * dy
         W[i, V] = W[i, V0] + h * dv
         W[i, P] = W[i, P0] + h * dp
@@ -187,3 +274,17 @@ def ark3_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol):
         e3 = abs(h * ep) / (atol + rtol * max(abs(W[i, P0]), abs(W[i, P]), 1.0))
         err = max(err, e1, e2, e3)
     return pw * h, ys * h, err
+
+
+@nb.njit(cache=True, error_model="numpy")
+def ark3_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol):
+    """ARK3(2)4L[2]SA step of the active blocks; see the module docstring."""
+    return _ark_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol,
+                     _C3, _AE3, _AI3, _B3, _D3, _G3)
+
+
+@nb.njit(cache=True, error_model="numpy")
+def ark4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol):
+    """ARK4(3)6L[2]SA step of the active blocks; see the module docstring."""
+    return _ark_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol,
+                     _C4, _AE4, _AI4, _B4, _D4, _G4)
