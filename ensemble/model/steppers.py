@@ -26,8 +26,10 @@ from .workspace import (ARK_A, ARK_G, ARK_V, F0, K1V, KP, KV, KY, P, P0, PS, SP,
 
 
 @nb.njit(cache=True, error_model="numpy")
-def stage_rates(W, act, na, n, tau, l2, nu, a, b, yrest):
+def stage_rates(W, act, na, n, tau, l2, nu, a, b, yrest, with_state=True):
     """Derivatives of all active blocks at stage state (YS, VS, PS) into KY, KV, KP.
+
+    with_state=False leaves KP alone (an implicit stage already knows it).
 
     Returns the friction power sum(Phi v) and the total slip sum(y) at the stage
     (for the energy balance).
@@ -42,7 +44,8 @@ def stage_rates(W, act, na, n, tau, l2, nu, a, b, yrest):
         W[i, KY] = v
         W[i, KV] = spring_force(W[i, F0], tau, nu, l2, W[left(i), YS], W[i, YS],
                                 W[right(i, n), YS]) - phi
-        W[i, KP] = state_rate(v, psi)
+        if with_state:
+            W[i, KP] = state_rate(v, psi)
         if v > 0.0:
             power += phi * v
         ysum += W[i, YS]
@@ -233,6 +236,7 @@ def _ark_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol, c, ae, ai,
     """
     pw = 0.0
     ys = 0.0
+    hg = h * gamma
     for s in range(c.shape[0]):
         for k in range(na):
             i = act[k]
@@ -245,9 +249,15 @@ def _ark_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol, c, ae, ai,
                 r += h * ai[s, j] * W[i, ARK_G + j]
             W[i, YS] = y
             W[i, VS] = v
-            # the previous stage's psi (still in PS) starts Newton close to the root
-            W[i, PS] = r if s == 0 else _implicit_state(r, h * gamma, v, W[i, PS])
-        power, ysum = stage_rates(W, act, na, n, tau + c[s] * h, l2, nu, a, b, yrest)
+            if s == 0:
+                W[i, PS] = r
+            else:
+                # Newton starts from the explicit guess with the previous stage's rate (in KP);
+                # the stage's state rate follows from the solved equation without an exp
+                psi = _implicit_state(r, hg, v, r + hg * W[i, KP])
+                W[i, PS] = psi
+                W[i, KP] = (psi - r) / hg
+        power, ysum = stage_rates(W, act, na, n, tau + c[s] * h, l2, nu, a, b, yrest, s == 0)
         pw += bw[s] * power
         ys += bw[s] * ysum
         for k in range(na):
