@@ -6,7 +6,8 @@ import pytest
 
 from ensemble.config import Integrator
 from ensemble.events import check, run_event
-from ensemble.model.steppers import ARK324, ARK436
+from ensemble.model.steppers import ARK324, ARK436, ark3_step, ark4_step
+from ensemble.model.workspace import P, P0, V, V0, Y, Y0, YS, Workspace
 
 from .conftest import run_cli, write_config
 from .test_ark3 import events  # noqa: F401  (the fixture: next events of a developed chain, RK4 references)
@@ -128,6 +129,23 @@ def test_kernel_arrays_are_the_tableau():
     np.testing.assert_array_equal(ae, np.array(aef, dtype=float))
     np.testing.assert_allclose(ai + g * np.diag([0.0] + [1.0] * 5), np.array(aif, dtype=float), rtol=1e-15)
     np.testing.assert_allclose(bd, np.array(bf, dtype=float) - np.array(bhatf, dtype=float), atol=1e-16)
+
+
+@pytest.mark.parametrize("step", [ark3_step, ark4_step])
+def test_zero_step_keeps_the_state(step):
+    """The event kernel redoes a step with h = 0 when an onset is located at its start."""
+    rng = np.random.default_rng(0)
+    ws = Workspace(8)
+    ws.load(rng.normal(size=8), rng.normal(size=8))
+    act = np.array([2, 3, 4, 0, 0, 0, 0, 0])
+    W = ws.W
+    W[:, Y0] = W[:, Y] = W[:, YS] = rng.random(8)
+    W[:, V0] = rng.random(8) * 100
+    W[:, P0] = W[:, P]
+    _, _, err = step(W, act, 3, 8, 0.5, 0.0, 9.0, 1e-8, 0.0, 20.0, 0.0, 1e-6, 1e-12)
+    assert err == 0.0
+    for new, old in ((Y, Y0), (V, V0), (P, P0)):
+        np.testing.assert_array_equal(W[act[:3], new], W[act[:3], old])
 
 
 def test_slip_error_follows_the_tolerance(events):

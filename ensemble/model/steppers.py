@@ -214,17 +214,19 @@ def _implicit_state(rhs, hg, v, guess):
     the root from below after the first step and never overshoot it; after a
     step s the distance to the root is below s^2 / 2 (|f''| < f'), so the
     iteration ends once that is below 1e-16 (1 + |psi|), one exp earlier than
-    waiting for a negligible step.
+    waiting for a negligible step. The root lies above `target`, and far below
+    it Newton only climbs by about 1 per iteration, so the guess is raised to
+    at least `target`; NaN (a loud failure) if it has not converged.
     """
     target = rhs - hg * (v if v > 0.0 else 0.0)
-    psi = guess
+    psi = max(guess, target)
     for _ in range(60):
         e = hg * math.exp(-psi)
         step = (psi - e - target) / (1.0 + e)
         psi -= step
         if step * step <= 2e-16 * (1.0 + abs(psi)):
-            break
-    return psi
+            return psi
+    return math.nan
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
@@ -254,9 +256,10 @@ def _ark_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol, c, ae, ai,
             else:
                 # Newton starts from the explicit guess with the previous stage's rate (in KP);
                 # the stage's state rate follows from the solved equation without an exp
+                # (the event kernel may redo a step with h = 0)
                 psi = _implicit_state(r, hg, v, r + hg * W[i, KP])
                 W[i, PS] = psi
-                W[i, KP] = (psi - r) / hg
+                W[i, KP] = (psi - r) / hg if hg > 0.0 else state_rate(v, psi)
         power, ysum = stage_rates(W, act, na, n, tau + c[s] * h, l2, nu, a, b, yrest, s == 0)
         pw += bw[s] * power
         ys += bw[s] * ysum
