@@ -220,12 +220,18 @@ def _implicit_state(rhs, hg, v, guess):
     """
     target = rhs - hg * (v if v > 0.0 else 0.0)
     psi = max(guess, target)
+    ex = math.exp(-psi)
     for _ in range(60):
-        e = hg * math.exp(-psi)
+        e = hg * ex
         step = (psi - e - target) / (1.0 + e)
         psi -= step
         if step * step <= 2e-16 * (1.0 + abs(psi)):
             return psi
+        if abs(step) < 1e-3:
+            # exp(-psi) from the previous one: exp(step) by Taylor (error < step^5 / 120)
+            ex *= 1.0 + step * (1.0 + step * (0.5 + step * (1.0 / 6.0 + step / 24.0)))
+        else:
+            ex = math.exp(-psi)
     return math.nan
 
 
