@@ -5,7 +5,7 @@ which locates sticks and onsets inside a step the same way for each.
 """
 from dataclasses import dataclass
 
-from .model.event import ARK3, ARK4, RK4
+from .model.event import ARK3, ARK4, ARK5, RK4
 
 
 @dataclass(frozen=True)
@@ -23,6 +23,8 @@ INTEGRATORS = {
     "ark4": Integrator(ARK4, "adaptive IMEX Runge-Kutta ARK4(3)6L[2]SA: fourth order, otherwise "
                              "as ark3 (explicit in slip and velocity, L-stable implicit in the "
                              "state, step controlled by integrator.rtol / atol, max_step)"),
+    "ark5": Integrator(ARK5, "adaptive IMEX Runge-Kutta ARK5(4)8L[2]SA: fifth order, otherwise "
+                             "as ark3"),
 }
 
 

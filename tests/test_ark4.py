@@ -6,7 +6,7 @@ import pytest
 
 from ensemble.config import Integrator
 from ensemble.events import check, run_event
-from ensemble.model.steppers import ARK324, ARK436, ark3_step, ark4_step
+from ensemble.model.steppers import ARK324, ARK436, ARK548, ark3_step, ark4_step, ark5_step
 from ensemble.model.workspace import P, P0, V, V0, Y, Y0, YS, Workspace
 
 from .conftest import run_cli, write_config
@@ -30,7 +30,7 @@ def power(x, k):
 
 
 def order_residuals(b, c, tableaux, order):
-    """Residuals of the order conditions up to `order` (at most 4) of an additive RK method.
+    """Residuals of the order conditions up to `order` (at most 5) of an additive RK method.
 
     All tableaux share b and c (row sums), so the conditions are those of the
     trees with every colouring of their inner nodes by a tableau.
@@ -49,6 +49,20 @@ def order_residuals(b, c, tableaux, order):
             out[f"b.{p}c2"] = dot(b, mul(A, power(c, 2))) - Fraction(1, 12)
             for q, B in tableaux.items():
                 out[f"b.{p}{q}c"] = dot(b, mul(A, mul(B, c))) - Fraction(1, 24)
+    if order >= 5:
+        times = lambda u, w: [x * y for x, y in zip(u, w)]   # noqa: E731
+        out["b.c4"] = dot(b, power(c, 4)) - Fraction(1, 5)
+        for p, A in tableaux.items():
+            out[f"b.(c2*{p}c)"] = dot(b, times(power(c, 2), mul(A, c))) - Fraction(1, 10)
+            out[f"b.(c*{p}c2)"] = dot(b, times(c, mul(A, power(c, 2)))) - Fraction(1, 15)
+            out[f"b.{p}c3"] = dot(b, mul(A, power(c, 3))) - Fraction(1, 20)
+            for q, B in tableaux.items():
+                out[f"b.(c*{p}{q}c)"] = dot(b, times(c, mul(A, mul(B, c)))) - Fraction(1, 30)
+                out[f"b.({p}c*{q}c)"] = dot(b, times(mul(A, c), mul(B, c))) - Fraction(1, 20)
+                out[f"b.{p}(c*{q}c)"] = dot(b, mul(A, times(c, mul(B, c)))) - Fraction(1, 40)
+                out[f"b.{p}{q}c2"] = dot(b, mul(A, mul(B, power(c, 2)))) - Fraction(1, 60)
+                for r, C in tableaux.items():
+                    out[f"b.{p}{q}{r}c"] = dot(b, mul(A, mul(B, mul(C, c)))) - Fraction(1, 120)
     return out
 
 
@@ -75,7 +89,7 @@ def violations(pair):
     return out
 
 
-@pytest.mark.parametrize("pair", [ARK324, ARK436], ids=lambda p: p.name)
+@pytest.mark.parametrize("pair", [ARK324, ARK436, ARK548], ids=lambda p: p.name)
 def test_tableau_order_conditions(pair):
     """Exact-fraction check of the coefficients the kernels use."""
     assert violations(pair) == []
@@ -98,7 +112,7 @@ def _with_last_digit_changed(pair, field, *index):
     return pair._replace(**{field: tuple(tuple(r) if isinstance(r, list) else r for r in rows)})
 
 
-@pytest.mark.parametrize("pair", [ARK324, ARK436], ids=lambda p: p.name)
+@pytest.mark.parametrize("pair", [ARK324, ARK436, ARK548], ids=lambda p: p.name)
 def test_a_mistyped_digit_is_caught(pair):
     mutants = [_with_last_digit_changed(pair, "gamma")]
     for field in ("c", "b", "bhat"):
@@ -110,7 +124,7 @@ def test_a_mistyped_digit_is_caught(pair):
     assert all(violations(m) for m in mutants)
 
 
-@pytest.mark.parametrize("pair", [ARK324, ARK436], ids=lambda p: p.name)
+@pytest.mark.parametrize("pair", [ARK324, ARK436, ARK548], ids=lambda p: p.name)
 def test_implicit_part_is_l_stable_at_infinity(pair):
     """R(z) = 1 + z b^T (I - z A_I)^-1 1 vanishes as z -> -inf (stiff decay of the state)."""
     _, _, ai, b, _ = pair.matrices()
@@ -131,7 +145,7 @@ def test_kernel_arrays_are_the_tableau():
     np.testing.assert_allclose(bd, np.array(bf, dtype=float) - np.array(bhatf, dtype=float), atol=1e-16)
 
 
-@pytest.mark.parametrize("step", [ark3_step, ark4_step])
+@pytest.mark.parametrize("step", [ark3_step, ark4_step, ark5_step])
 def test_zero_step_keeps_the_state(step):
     """The event kernel redoes a step with h = 0 when an onset is located at its start."""
     rng = np.random.default_rng(0)

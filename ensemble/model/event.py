@@ -21,15 +21,15 @@ import numpy as np
 
 from .friction import friction, left, right, spring_force
 from .onset import onset_delay
-from .steppers import ARK324, ARK436, ark3_step, ark4_step, rk4_step
+from .steppers import ARK324, ARK436, ARK548, ark3_step, ark4_step, ark5_step, rk4_step
 from .workspace import (D_BLOCK_STEPS, D_DURATION, D_FIRST, D_LAST, D_NSLIP, D_RESIDUAL, D_SLIP,
                         D_STEPS, D_VMAX, D_WORK, F0, HD0, HD1, K1V, NONFINITE, OK, P, P0, TOO_LONG,
                         TR, UNSTABLE, V, V0, Y, Y0, YS)
 
-# integrators (see ensemble.integrators): fixed-step RK4, adaptive IMEX ARK3(2) and ARK4(3)
-RK4, ARK3, ARK4 = 0, 1, 2
+# integrators (see ensemble.integrators): fixed-step RK4, adaptive IMEX ARK3(2), ARK4(3), ARK5(4)
+RK4, ARK3, ARK4, ARK5 = 0, 1, 2, 3
 # step-size control exponent -1 / (q + 1), q the order of the embedded method (unused for RK4)
-_CONTROL_EXPONENT = (0.0, -1.0 / (ARK324.embedded_order + 1), -1.0 / (ARK436.embedded_order + 1))
+_CONTROL_EXPONENT = (0.0,) + tuple(-1.0 / (pair.embedded_order + 1) for pair in (ARK324, ARK436, ARK548))
 
 # Stability limit of classical RK4 on the negative real axis: the state equation
 # relaxes at rate 1/theta (= v in steady sliding), so dt / theta must stay below it.
@@ -126,7 +126,9 @@ def _step(method, W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol):
         return rk4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
     if method == ARK3:
         return ark3_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
-    return ark4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
+    if method == ARK4:
+        return ark4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
+    return ark5_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
 
 
 @nb.njit(cache=True)
@@ -138,7 +140,7 @@ def integrate_event(W, act, flag, touched, stuck, n, epicenter, v_start, l2, nu,
     onset (all at rest, c-free frame), all other columns and `flag` are zero.
     `v_start` is the epicenter's initial velocity (0 for a natural onset),
     `t_far` a lower bound of the loading onset time of every other block.
-    method RK4 steps by dt; ARK3, ARK4 start with dt and controls the step (at most
+    method RK4 steps by dt; ARK3, ARK4, ARK5 start with dt and controls the step (at most
     h_max) so that the embedded error estimate stays below rtol, atol.
     On return W[:, F0] and W[:, P] hold the state at the end of the event (all at
     rest again), the other columns and `flag` are zero, and `diag` holds the event

@@ -6,12 +6,12 @@ K1V (for the Hermite interpolant), and returns (friction work, time integral of
 the total slip, error estimate relative to the tolerances; 0 for fixed steps).
 
 - rk4_step: classical RK4, the paper's method; stable only while h / theta < 2.785.
-- ark3_step, ark4_step: the additive (IMEX) Runge-Kutta pairs ARK3(2)4L[2]SA and
-  ARK4(3)6L[2]SA of Kennedy & Carpenter (2003): explicit for slip and velocity,
+- ark3_step, ark4_step, ark5_step: the additive (IMEX) Runge-Kutta pairs ARK3(2)4L[2]SA,
+  ARK4(3)6L[2]SA and ARK5(4)8L[2]SA of Kennedy & Carpenter (2003): explicit for slip and velocity,
   L-stable ESDIRK for the state psi, whose relaxation at rate 1/theta (~ v while
   sliding) is the stiff part. Each implicit stage is one scalar equation per
-  block, solved by Newton. Order 3 (4) with an embedded estimate of order 2 (3)
-  for step-size control. Both run the same kernel `_ark_step` with their tableau.
+  block, solved by Newton. Order p with an embedded estimate of order p - 1 for
+  step-size control. All run the same kernel `_ark_step` with their tableau.
 """
 import math
 from fractions import Fraction
@@ -157,8 +157,9 @@ def _square(rows):
 
 
 # Kennedy & Carpenter (2003), Appl. Numer. Math. 44, 139, with the coefficients as SUNDIALS
-# ARKODE ships them (ARK324L2SA_{ERK,DIRK}_4_2_3, ARK436L2SA_{ERK,DIRK}_6_3_4). Many are
-# 13-digit rational approximations, so order conditions hold to ~1e-13, not exactly.
+# ARKODE ships them (ARK324L2SA_{ERK,DIRK}_4_2_3, ARK436L2SA_{ERK,DIRK}_6_3_4,
+# ARK548L2SA_{ERK,DIRK}_8_4_5). Many are 13-digit rational approximations of irrational
+# values; they satisfy the order conditions to about 1e-26, not exactly.
 ARK324 = ArkPair(
     "ARK3(2)4L[2]SA", 3, 2,
     c=("0", "1767732205903/2027836641118", "3/5", "1"),
@@ -202,7 +203,47 @@ ARK436 = ArkPair(
     bhat=("4586570599/29645900160", "0", "178811875/945068544", "814220225/1159782912",
           "-3700637/11593932", "61727/225920"))
 
+ARK548 = ArkPair(
+    "ARK5(4)8L[2]SA", 5, 4,
+    c=("0", "41/100", "2935347310677/11292855782101", "1426016391358/7196633302097", "92/100",
+       "24/100", "3/5", "1"),
+    explicit=((),
+              ("41/100",),
+              ("367902744464/2072280473677", "677623207551/8224143866563"),
+              ("1268023523408/10340822734521", "0", "1029933939417/13636558850479"),
+              ("14463281900351/6315353703477", "0", "66114435211212/5879490589093",
+               "-54053170152839/4284798021562"),
+              ("14090043504691/34967701212078", "0", "15191511035443/11219624916014",
+               "-18461159152457/12425892160975", "-281667163811/9011619295870"),
+              ("19230459214898/13134317526959", "0", "21275331358303/2942455364971",
+               "-38145345988419/4862620318723", "-1/8", "-1/8"),
+              ("-19977161125411/11928030595625", "0", "-40795976796054/6384907823539",
+               "177454434618887/12078138498510", "782672205425/8267701900261",
+               "-69563011059811/9646580694205", "7356628210526/4942186776405")),
+    implicit=((),
+              ("41/200",),
+              ("41/400", "-567603406766/11931857230679"),
+              ("683785636431/9252920307686", "0", "-110385047103/1367015193373"),
+              ("3016520224154/10081342136671", "0", "30586259806659/12414158314087",
+               "-22760509404356/11113319521817"),
+              ("218866479029/1489978393911", "0", "638256894668/5436446318841",
+               "-1179710474555/5321154724896", "-60928119172/8023461067671"),
+              ("1020004230633/5715676835656", "0", "25762820946817/25263940353407",
+               "-2161375909145/9755907335909", "-211217309593/5846859502534",
+               "-4269925059573/7827059040749"),
+              ("-872700587467/9133579230613", "0", "0", "22348218063261/9555858737531",
+               "-1143369518992/8141816002931", "-39379526789629/19018526304540",
+               "32727382324388/42900044865799")),
+    gamma="41/200",
+    b=("-872700587467/9133579230613", "0", "0", "22348218063261/9555858737531",
+       "-1143369518992/8141816002931", "-39379526789629/19018526304540",
+       "32727382324388/42900044865799", "41/200"),
+    bhat=("-975461918565/9796059967033", "0", "0", "78070527104295/32432590147079",
+          "-548382580838/3424219808633", "-33438840321285/15594753105479",
+          "3629800801594/4656183773603", "4035322873751/18575991585200"))
+
 _C3, _AE3, _AI3, _B3, _D3, _G3 = ARK324.kernel_arrays()
+_C5, _AE5, _AI5, _B5, _D5, _G5 = ARK548.kernel_arrays()
 _C4, _AE4, _AI4, _B4, _D4, _G4 = ARK436.kernel_arrays()
 
 
@@ -317,3 +358,10 @@ def ark4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol):
     """ARK4(3)6L[2]SA step of the active blocks; see the module docstring."""
     return _ark_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol,
                      _C4, _AE4, _AI4, _B4, _D4, _G4)
+
+
+@nb.njit(cache=True, error_model="numpy")
+def ark5_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol):
+    """ARK5(4)8L[2]SA step of the active blocks; see the module docstring."""
+    return _ark_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol,
+                     _C5, _AE5, _AI5, _B5, _D5, _G5)

@@ -23,7 +23,7 @@ import numpy as np
 Y, V, P, TR, F0, YS, VS, PS, Y0, V0, P0, KY, KV, KP, SY, SV, SP, K1V, HD0, HD1 = range(20)
 # stage derivatives of the ARK steppers: ARK_STAGES columns each from ARK_V (dy/dt), ARK_A (dv/dt),
 # ARK_G (dpsi/dt)
-ARK_STAGES = 6
+ARK_STAGES = 8
 ARK_V = 20
 ARK_A = ARK_V + ARK_STAGES
 ARK_G = ARK_A + ARK_STAGES
