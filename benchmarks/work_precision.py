@@ -6,7 +6,7 @@ From fixed pre-event states of a developed chain (the next small event, mu < 3, 
 one, mu >= 4), integrates the same event with
 
 - the kernel's fixed-step RK4 (located stick and onset) over a range of dt,
-- the kernel's adaptive IMEX ARK3(2) and ARK4(3) over a range of rtol (the "dt" column holds rtol), and
+- the kernel's adaptive IMEX ARK3(2), ARK4(3) and ARK5(4) over a range of rtol (the "dt" column holds rtol), and
 - a straightforward full-array numpy RK4 (every block every step, stick by clamping v at the end of
   a step), the baseline a first implementation would be,
 
@@ -27,7 +27,7 @@ from ensemble.events import advance_to_onset, check, run_event
 from ensemble.runner import Trajectory
 from ensemble.tasks import task_list
 
-STAGES = {"ark3": 4, "ark4": 6}   # adaptive methods and their stages per step
+STAGES = {"ark3": 4, "ark4": 6, "ark5": 8}   # adaptive methods and their stages per step
 
 
 def pre_event_states(model, transient, seed=0):

@@ -162,12 +162,38 @@ def test_zero_step_keeps_the_state(step):
         np.testing.assert_array_equal(W[act[:3], new], W[act[:3], old])
 
 
-def test_slip_error_follows_the_tolerance(events):
+def _slide(step, steps, duration=0.5):
+    """(y, v, psi) of one block sliding between two at rest, `steps` fixed steps of `step`."""
+    n, psi0 = 3, 0.5
+    ws = Workspace(n)
+    ws.load(np.array([0.0, 20.0 * psi0 + 3.0, 0.0]), np.full(n, psi0))
+    W = ws.W
+    act = np.array([1, 0, 0])
+    W[1, V] = 5.0
+    h = duration / steps
+    for k in range(steps):
+        W[1, Y0], W[1, V0], W[1, P0] = W[1, Y], W[1, V], W[1, P]
+        step(W, act, 1, n, k * h, h, 9.0, 1e-8, 2.0, 20.0, 0.0, 1e-6, 1e-12)
+    return np.array([W[1, Y], W[1, V], W[1, P]])
+
+
+@pytest.mark.parametrize("step, order", [(ark3_step, 3), (ark4_step, 4), (ark5_step, 5)])
+def test_convergence_order_with_fixed_steps(step, order):
+    """Errors of slip, velocity and state fall as h^p (the block keeps sliding: smooth)."""
+    ref = _slide(ark5_step, 4000)
+    errors = [np.abs(_slide(step, m) - ref) for m in (20, 40, 80)]
+    observed = np.log2(errors[1] / errors[2])
+    print(f"observed orders (y, v, psi): {observed.round(2)}")
+    assert np.all(np.abs(observed - order) < 0.3)
+
+
+@pytest.mark.parametrize("method", ["ark4", "ark5"])
+def test_slip_error_follows_the_tolerance(events, method):
     model, evs = events
     for f, p, epicenter, ref in evs:
         errors = []
         for rtol in (1e-5, 1e-7):
-            ev = check(run_event(f, p, epicenter, model, Integrator(method="ark4", rtol=rtol)))
+            ev = check(run_event(f, p, epicenter, model, Integrator(method=method, rtol=rtol)))
             errors.append(abs(ev.slip - ref.slip) / ref.slip)
             assert np.linalg.norm(ev.profile - ref.profile) <= 100 * rtol * np.linalg.norm(ref.profile)
             assert ev.relative_energy_residual < 100 * rtol
