@@ -6,7 +6,8 @@ From fixed pre-event states of a developed chain (the next small event, mu < 3, 
 one, mu >= 4), integrates the same event with
 
 - the kernel's fixed-step RK4 (located stick and onset) over a range of dt,
-- the kernel's adaptive IMEX ARK3(2), ARK4(3) and ARK5(4) over a range of rtol (the "dt" column holds rtol), and
+- the kernel's adaptive IMEX ARK3(2), ARK4(3) and ARK5(4) over a range of rtol (the "dt" column
+  holds rtol), and
 - a straightforward full-array numpy RK4 (every block every step, stick by clamping v at the end of
   a step), the baseline a first implementation would be,
 

@@ -10,7 +10,8 @@ from ensemble.model.steppers import ARK324, ARK436, ARK548, ark3_step, ark4_step
 from ensemble.model.workspace import P, P0, V, V0, Y, Y0, YS, Workspace
 
 from .conftest import run_cli, write_config
-from .test_ark3 import events  # noqa: F401  (the fixture: next events of a developed chain, RK4 references)
+# the fixture: next events of a developed chain with RK4 references
+from .test_ark3 import events  # noqa: F401
 
 # The published 13-digit fractions satisfy the conditions to about 1e-26;
 # a change of one unit in the last digit of any coefficient shows at 1e-14 or more.
@@ -141,7 +142,8 @@ def test_kernel_arrays_are_the_tableau():
     cf, aef, aif, bf, bhatf = ARK436.matrices()
     assert g == 0.25 and np.all(np.diag(ai) == 0)
     np.testing.assert_array_equal(ae, np.array(aef, dtype=float))
-    np.testing.assert_allclose(ai + g * np.diag([0.0] + [1.0] * 5), np.array(aif, dtype=float), rtol=1e-15)
+    diagonal = g * np.diag([0.0] + [1.0] * 5)
+    np.testing.assert_allclose(ai + diagonal, np.array(aif, dtype=float), rtol=1e-15)
     np.testing.assert_allclose(bd, np.array(bf, dtype=float) - np.array(bhatf, dtype=float), atol=1e-16)
 
 
