@@ -338,10 +338,6 @@ def _ark_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol, c, ae, ai,
         e1 = abs(h * ey) / (atol + rtol * max(abs(W[i, Y0]), abs(W[i, Y]), 1.0))
         e2 = abs(h * ev) / (atol + rtol * max(abs(W[i, V0]), abs(W[i, V])))
         e3 = abs(h * ep) / (atol + rtol * max(abs(W[i, P0]), abs(W[i, P]), 1.0))
-        if W[i, V] <= 0.0 and W[i, V0] > 0.0:
-            # the event kernel cuts this step at the block's stick, before the kink
-            # of max(v, 0) in the state rate that dominates its psi error estimate
-            e3 = 0.0
         err = max(err, e1, e2, e3)
     return pw * h, ys * h, err
 
