@@ -20,9 +20,8 @@ from ensemble.integrators import INTEGRATORS
 from ensemble.runner import Trajectory
 from ensemble.tasks import task_list
 
-# right-hand-side evaluations per block-step of the kernel's methods (stages); a method missing
-# here is reported with block-steps only
-STAGES = {"rk4": 4, "ark3": 4}
+# right-hand-side evaluations per block-step of the kernel's methods
+STAGES = {name: method.stages for name, method in INTEGRATORS.items()}
 
 
 @dataclass(frozen=True)

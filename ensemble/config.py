@@ -49,10 +49,10 @@ class Run:
 @dataclass(frozen=True)
 class Integrator:
     method: str = "rk4"            # event integrator (see ensemble.integrators.INTEGRATORS)
-    dt: float = 1e-3               # time step of "rk4"; first step of "ark3"
-    rtol: float = 1e-6             # "ark3": relative tolerance of the local error per step
-    atol: float = 1e-12            # "ark3": absolute tolerance (slip, velocity)
-    max_step: float = 0.5          # "ark3": largest step
+    dt: float = 1e-3               # time step of "rk4"; first step of the adaptive methods
+    rtol: float = 1e-6             # adaptive methods (ark3, ark4, ark5): relative tolerance of the local error per step
+    atol: float = 1e-12            # adaptive methods: absolute tolerance (slip, velocity)
+    max_step: float = 0.5          # adaptive methods: largest step
     max_duration: float = 1e5      # an event lasting longer than this is an error
 
 

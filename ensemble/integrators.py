@@ -1,25 +1,31 @@
 """Registry of event integrators: config name -> kernel method and description.
 
-Both run through the same event kernel (ensemble.model.event.integrate_event),
+All run through the same event kernel (ensemble.model.event.integrate_event),
 which locates sticks and onsets inside a step the same way for each.
 """
 from dataclasses import dataclass
 
-from .model.event import ARK3, RK4
+from .model.event import ARK3, ARK4, ARK5, RK4
 
 
 @dataclass(frozen=True)
 class Integrator:
     code: int             # method id understood by the kernels
+    stages: int           # right-hand-side evaluations per block and step
     description: str
 
 
 INTEGRATORS = {
-    "rk4": Integrator(RK4, "classical fourth-order Runge-Kutta with fixed step integrator.dt "
+    "rk4": Integrator(RK4, 4, "classical fourth-order Runge-Kutta with fixed step integrator.dt "
                            "(the paper's method); stable only while dt / theta < 2.785"),
-    "ark3": Integrator(ARK3, "adaptive IMEX Runge-Kutta ARK3(2)4L[2]SA: explicit in slip and "
+    "ark3": Integrator(ARK3, 4, "adaptive IMEX Runge-Kutta ARK3(2)4L[2]SA: explicit in slip and "
                              "velocity, L-stable implicit in the state; step controlled by "
                              "integrator.rtol / atol, at most integrator.max_step"),
+    "ark4": Integrator(ARK4, 6, "adaptive IMEX Runge-Kutta ARK4(3)6L[2]SA: fourth order, otherwise "
+                             "as ark3 (explicit in slip and velocity, L-stable implicit in the "
+                             "state, step controlled by integrator.rtol / atol, max_step)"),
+    "ark5": Integrator(ARK5, 8, "adaptive IMEX Runge-Kutta ARK5(4)8L[2]SA: fifth order, otherwise "
+                             "as ark3"),
 }
 
 

@@ -54,7 +54,7 @@ def test_baseline_timeout_is_recorded():
 
 def test_work_precision_tiny(tmp_path):
     work_precision.main(["--N", "40", "--b", "20", "--transient", "60", "--max-seconds", "20", "--out",
-                         str(tmp_path), "--runs", "rk4:dt=2e-3", "rk4:dt=1e-3", "ark3:rtol=1e-4", "ark3:rtol=1e-7",
+                         str(tmp_path), "--runs", "rk4:dt=1e-3", "rk4:dt=5e-4", "ark3:rtol=1e-4", "ark3:rtol=1e-7",
                          "scipy:method=LSODA,rtol=1e-5", "scipy:method=LSODA,rtol=1e-8"])
     data = json.loads((tmp_path / "work_precision_N40_b20.json").read_text())
     assert (tmp_path / "work_precision_N40_b20.png").stat().st_size > 0
@@ -62,8 +62,9 @@ def test_work_precision_tiny(tmp_path):
     assert {r["event"] for r in rows} == {"small", "large"} and all(r["status"] == "ok" for r in rows)
     for event in ("small", "large"):
         by = {r["setting"]: r for r in rows if r["event"] == event}
-        # fourth order: halving dt cuts the slip error at least 8-fold
-        assert by["rk4:dt=1e-3"]["slip_error"] * 8 < by["rk4:dt=2e-3"]["slip_error"]
+        # fourth order: halving dt cuts the slip error at least 8-fold (unless at round-off already)
+        coarse, fine = by["rk4:dt=1e-3"]["slip_error"], by["rk4:dt=5e-4"]["slip_error"]
+        assert fine * 8 < coarse or coarse < 1e-12
         # the full-chain scipy baseline integrates the same event as the kernel
         assert by["scipy:method=LSODA,rtol=1e-8"]["profile_error"] < 1e-5
         assert by["ark3:rtol=1e-7"]["slip_error"] < by["ark3:rtol=1e-4"]["slip_error"] < 1e-3

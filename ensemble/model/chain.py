@@ -17,7 +17,7 @@ import numpy as np
 from .event import integrate_event
 from .onset import grow_state, onset_delay
 from .schedule import advance_clock, build_schedule, materialize, tree_min
-from .workspace import D_DURATION, F0, OK, P
+from .workspace import D_DURATION, D_SLIP, F0, OK, P
 
 
 @nb.njit(cache=True)
@@ -61,7 +61,8 @@ def simulate(W, act, flag, touched, stuck, since, tree, diag, clock, l2, nu, a, 
     if math.isnan(tree[1]):      # a freshly loaded state (Workspace.load): schedule every block
         build_schedule(W, since, tree, nu, b)
     onset = np.empty(2)
-    for k in range(n_events):
+    k = 0
+    while k < n_events:
         _, epicenter = tree_min(tree)
         # The onset, exactly: the epicenter's own delay from its state (the tree
         # only orders the blocks), never before the end of the previous event.
@@ -73,15 +74,20 @@ def simulate(W, act, flag, touched, stuck, since, tree, diag, clock, l2, nu, a, 
             clock[1] = onset[1]
         materialize(W, since, epicenter, clock, nu)
         # Put the epicenter on its threshold, not a round-off below it, so the
-        # event starts without a false stick.
-        W[epicenter, F0] = b * W[epicenter, P]
+        # event starts without a false stick (a force above it stays as it is).
+        if W[epicenter, F0] < b * W[epicenter, P]:
+            W[epicenter, F0] = b * W[epicenter, P]
         status = integrate_event(W, act, flag, touched, stuck, since, tree, clock, n, epicenter, 0.0,
                                  l2, nu, a, b, method, dt, rtol, atol, h_max, max_duration, max_steps,
                                  diag, no_profile)
         if status != OK:
             return status, k
-        out_t[k] = clock[0] + clock[1]
+        t_onset = clock[0] + clock[1]
+        advance_clock(clock, diag[D_DURATION])
+        if diag[D_SLIP] == 0.0:
+            continue    # nothing moved (an onset within round-off of the threshold): no event
+        out_t[k] = t_onset
         out_epicenter[k] = epicenter
         out_diag[k, :] = diag
-        advance_clock(clock, diag[D_DURATION])
+        k += 1
     return OK, n_events

@@ -22,13 +22,15 @@ import numpy as np
 from .friction import friction, left, right, spring_force
 from .onset import onset_delay
 from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
-from .steppers import ark3_step, rk4_step
+from .steppers import ARK324, ARK436, ARK548, ark3_step, ark4_step, ark5_step, rk4_step
 from .workspace import (D_BLOCK_STEPS, D_DURATION, D_FIRST, D_LAST, D_NSLIP, D_RESIDUAL, D_SLIP,
                         D_STEPS, D_VMAX, D_WORK, F0, HD0, HD1, K1V, NONFINITE, OK, P, P0, TOO_LONG,
                         TR, UNSTABLE, V, V0, Y, Y0, YS)
 
-# integrators (see ensemble.integrators): fixed-step RK4, adaptive IMEX ARK3(2)
-RK4, ARK3 = 0, 1
+# integrators (see ensemble.integrators): fixed-step RK4, adaptive IMEX ARK3(2), ARK4(3), ARK5(4)
+RK4, ARK3, ARK4, ARK5 = 0, 1, 2, 3
+# step-size control exponent -1 / (q + 1), q the order of the embedded method (unused for RK4)
+_CONTROL_EXPONENT = (0.0,) + tuple(-1.0 / (pair.embedded_order + 1) for pair in (ARK324, ARK436, ARK548))
 
 # Stability limit of classical RK4 on the negative real axis: the state equation
 # relaxes at rate 1/theta (= v in steady sliding), so dt / theta must stay below it.
@@ -77,6 +79,27 @@ def _force_now(W, n, j, tau, l2, nu):
 def _excess_now(W, n, j, tau, l2, nu, b):
     """Force above the static threshold of resting block j at the current time."""
     return _force_now(W, n, j, tau, l2, nu) - b * _rest_psi(W, j, tau)
+
+
+@nb.njit(cache=True)
+def _above_threshold(W, flag, n, j, tau, l2, nu, b):
+    """Block j is at rest and its force exceeds the static threshold at local time tau."""
+    # Cheap filter first: the threshold of a resting block only grows, so a
+    # force below b * (psi when it came to rest) cannot start it.
+    return (flag[j] != 1 and _force_now(W, n, j, tau, l2, nu) > b * W[j, P]
+            and _excess_now(W, n, j, tau, l2, nu, b) > 0.0)
+
+
+@nb.njit(cache=True)
+def _pressed(W, n, i, tau, l2, nu, b):
+    """Sliding block i has not moved in this step but is still at or above its threshold.
+
+    A block that starts exactly on its threshold gains force at the rate
+    nu - b / theta (> 0 at an onset), which for small nu can stay below the
+    rounding of the force for a step: it has not stopped, it has not started yet.
+    """
+    return (W[i, V0] == 0.0 and W[i, V] == 0.0
+            and _force_now(W, n, i, tau, l2, nu) - b * W[i, P] >= 0.0)
 
 
 @nb.njit(cache=True)
@@ -137,7 +160,11 @@ def _start(W, act, na, flag, touched, nt, since, tree, t0, nu, j, tau, yrest):
 def _step(method, W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol):
     if method == RK4:
         return rk4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
-    return ark3_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
+    if method == ARK3:
+        return ark3_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
+    if method == ARK4:
+        return ark4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
+    return ark5_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
 
 
 @nb.njit(cache=True)
@@ -149,9 +176,9 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
     at time since[i] (c-free frame; see schedule.py), `tree` holds every block's
     onset key, the epicenter is on its threshold at t0 (two-float time), the
     other columns and `flag` are zero. `v_start` is the epicenter's initial
-    velocity (0 for a natural onset). method RK4 steps by dt; ARK3 starts with dt
-    and controls the step (at most h_max) so that the embedded error estimate
-    stays below rtol, atol. On return the blocks the event touched hold the
+    velocity (0 for a natural onset). method RK4 steps by dt; ARK3, ARK4 and ARK5
+    start with dt and control the step (at most h_max) so that the embedded
+    error estimate stays below rtol, atol. On return the blocks the event touched hold the
     state at its end (the schedule updated), the other columns and `flag` are
     zero, and `diag` holds the event summary (see workspace.D_*). If `profile`
     has n entries it receives the slip of every block (else pass an empty
@@ -170,6 +197,7 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
     v_limit = RK4_STABILITY / dt
     psi_limit = -math.log(v_limit)
     h_next = dt
+    expo = _CONTROL_EXPONENT[method]
     while na > 0:
         if steps >= max_steps or tau > max_duration:
             status = TOO_LONG
@@ -184,10 +212,10 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
             dwork, dslip, err = _step(method, W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
             if method == RK4 or err <= 1.0 or h < 1e-12:
                 break
-            h *= max(0.2, 0.9 * err ** (-1.0 / 3.0))    # rejected: retry from (Y0, V0, P0)
+            h *= max(0.2, 0.9 * err ** expo)    # rejected: retry from (Y0, V0, P0)
             steps += 1
         if method != RK4:
-            grow = 5.0 if err == 0.0 else min(5.0, max(0.2, 0.9 * err ** (-1.0 / 3.0)))
+            grow = 5.0 if err == 0.0 else min(5.0, max(0.2, 0.9 * err ** expo))
             h_next = min(h_max, h * grow)
         # Earliest transition inside the step, as a fraction x of it; the slip
         # of a sliding block inside the step is the Hermite cubic with these slopes.
@@ -220,13 +248,7 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
         for k in range(na):
             i = act[k]
             for j in (left(i), right(i, n)):
-                if flag[j] == 1 or j == i:
-                    continue
-                # Cheap filter first: the threshold of a resting block only grows,
-                # so a force below b * (psi when it came to rest) cannot start it.
-                if _force_now(W, n, j, tau + h, l2, nu) <= b * W[j, P]:
-                    continue
-                if _excess_now(W, n, j, tau + h, l2, nu, b) > 0.0:
+                if j != i and _above_threshold(W, flag, n, j, tau + h, l2, nu, b):
                     lo = 0.0
                     hi = 1.0
                     if _excess(W, flag, n, j, tau, h, 0.0, l2, nu, b) >= 0.0:
@@ -280,7 +302,7 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
         nstuck = 0
         for k in range(na):
             i = act[k]
-            if W[i, V] <= 0.0 and not (i == who and kind >= 2):
+            if W[i, V] <= 0.0 and not (i == who and kind >= 2) and not _pressed(W, n, i, tau, l2, nu, b):
                 # Blocks never move backward: a block that started this step
                 # but could not move keeps its slip.
                 if W[i, Y] < W[i, Y0]:
@@ -296,13 +318,15 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
                 act[m] = i
                 m += 1
         na = m
-        for k in range(na):
-            i = act[k]
+        # Resting neighbours of the sliding blocks and of those that just stopped
+        # (a step redone up to a located stick differs from the interpolant of the
+        # longer step, so a neighbour may have crossed its threshold in the redo).
+        for k in range(m + nstuck):
+            i = act[k] if k < m else stuck[k - m]
             for j in (left(i), right(i, n)):
-                if flag[j] != 1 and j != i and _force_now(W, n, j, tau, l2, nu) > b * W[j, P]:
-                    if _excess_now(W, n, j, tau, l2, nu, b) > 0.0:
-                        na, nt, yrest = _start(W, act, na, flag, touched, nt, since, tree, t0, nu, j,
-                                               tau, yrest)
+                if j != i and _above_threshold(W, flag, n, j, tau, l2, nu, b):
+                    na, nt, yrest = _start(W, act, na, flag, touched, nt, since, tree, t0, nu, j,
+                                           tau, yrest)
         # Blocks no longer watched by a sliding neighbour may only start by
         # loading: back on the schedule with their analytic onset.
         for k in range(nstuck):

@@ -23,9 +23,13 @@ import numpy as np
 
 # columns of W
 Y, V, P, TR, F0, YS, VS, PS, Y0, V0, P0, KY, KV, KP, SY, SV, SP, K1V, HD0, HD1 = range(20)
-# stage derivatives of the ARK3 stepper: 4 columns each from ARK_V (dy/dt), ARK_A (dv/dt), ARK_G (dpsi/dt)
-ARK_V, ARK_A, ARK_G = 20, 24, 28
-NCOLS = 32
+# stage derivatives of the ARK steppers: ARK_STAGES columns each from ARK_V (dy/dt), ARK_A (dv/dt),
+# ARK_G (dpsi/dt)
+ARK_STAGES = 8
+ARK_V = 20
+ARK_A = ARK_V + ARK_STAGES
+ARK_G = ARK_A + ARK_STAGES
+NCOLS = ARK_G + ARK_STAGES
 
 # entries of the per-event diagnostics vector
 (D_DURATION, D_SLIP, D_FIRST, D_LAST, D_NSLIP, D_WORK, D_RESIDUAL, D_STEPS, D_VMAX,

@@ -1,0 +1,221 @@
+"""The adaptive IMEX integrator ARK4(3): its tableau, error against the tolerance, energy, CLI."""
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+from ensemble.config import Integrator
+from ensemble.events import check, run_event
+from ensemble.model.steppers import ARK324, ARK436, ARK548, ark3_step, ark4_step, ark5_step
+from ensemble.model.workspace import P, P0, V, V0, Y, Y0, YS, Workspace
+
+from .conftest import run_cli, write_config
+# the fixture: next events of a developed chain with RK4 references
+from .test_ark3 import events  # noqa: F401
+
+# The published 13-digit fractions satisfy the conditions to about 1e-26;
+# a change of one unit in the last digit of any coefficient shows at 1e-14 or more.
+TOL = 1e-20
+
+
+def dot(u, w):
+    return sum(x * y for x, y in zip(u, w))
+
+
+def mul(A, x):
+    return [dot(row, x) for row in A]
+
+
+def power(x, k):
+    return [xi ** k for xi in x]
+
+
+def order_residuals(b, c, tableaux, order):
+    """Residuals of the order conditions up to `order` (at most 5) of an additive RK method.
+
+    All tableaux share b and c (row sums), so the conditions are those of the
+    trees with every colouring of their inner nodes by a tableau.
+    """
+    out = {"b.1": dot(b, [1] * len(b)) - 1}
+    if order >= 2:
+        out["b.c"] = dot(b, c) - Fraction(1, 2)
+    if order >= 3:
+        out["b.c2"] = dot(b, power(c, 2)) - Fraction(1, 3)
+        for p, A in tableaux.items():
+            out[f"b.{p}c"] = dot(b, mul(A, c)) - Fraction(1, 6)
+    if order >= 4:
+        out["b.c3"] = dot(b, power(c, 3)) - Fraction(1, 4)
+        for p, A in tableaux.items():
+            out[f"b.(c*{p}c)"] = dot(b, [ci * x for ci, x in zip(c, mul(A, c))]) - Fraction(1, 8)
+            out[f"b.{p}c2"] = dot(b, mul(A, power(c, 2))) - Fraction(1, 12)
+            for q, B in tableaux.items():
+                out[f"b.{p}{q}c"] = dot(b, mul(A, mul(B, c))) - Fraction(1, 24)
+    if order >= 5:
+        times = lambda u, w: [x * y for x, y in zip(u, w)]   # noqa: E731
+        out["b.c4"] = dot(b, power(c, 4)) - Fraction(1, 5)
+        for p, A in tableaux.items():
+            out[f"b.(c2*{p}c)"] = dot(b, times(power(c, 2), mul(A, c))) - Fraction(1, 10)
+            out[f"b.(c*{p}c2)"] = dot(b, times(c, mul(A, power(c, 2)))) - Fraction(1, 15)
+            out[f"b.{p}c3"] = dot(b, mul(A, power(c, 3))) - Fraction(1, 20)
+            for q, B in tableaux.items():
+                out[f"b.(c*{p}{q}c)"] = dot(b, times(c, mul(A, mul(B, c)))) - Fraction(1, 30)
+                out[f"b.({p}c*{q}c)"] = dot(b, times(mul(A, c), mul(B, c))) - Fraction(1, 20)
+                out[f"b.{p}(c*{q}c)"] = dot(b, mul(A, times(c, mul(B, c)))) - Fraction(1, 40)
+                out[f"b.{p}{q}c2"] = dot(b, mul(A, mul(B, power(c, 2)))) - Fraction(1, 60)
+                for r, C in tableaux.items():
+                    out[f"b.{p}{q}{r}c"] = dot(b, mul(A, mul(B, mul(C, c)))) - Fraction(1, 120)
+    return out
+
+
+def violations(pair):
+    """What is wrong with an ArkPair's coefficients, in exact fractions (empty if nothing)."""
+    c, ae, ai, b, bhat = pair.matrices()
+    s = len(c)
+    out = []
+    for A, name in ((ae, "explicit"), (ai, "implicit")):
+        out += [f"{name} row {i} does not sum to c" for i in range(s) if abs(sum(A[i]) - c[i]) > TOL]
+    if any(ae[i][j] != 0 for i in range(s) for j in range(i, s)):
+        out.append("explicit tableau not strictly lower")
+    if ai[0][0] != 0 or any(ai[i][i] != Fraction(pair.gamma) for i in range(1, s)):
+        out.append("implicit tableau not ESDIRK")
+    if ai[-1] != b:
+        out.append("implicit tableau not stiffly accurate")
+    tableaux = {"E": ae, "I": ai}
+    for weights, order in ((b, pair.order), (bhat, pair.embedded_order)):
+        out += [f"order {order}: {k} = {float(r):.1e}"
+                for k, r in order_residuals(weights, c, tableaux, order).items() if abs(r) > TOL]
+    # the embedded method is of order q, not q + 1 (else the estimate would vanish)
+    if max(abs(r) for r in order_residuals(bhat, c, tableaux, pair.order).values()) < 1e-4:
+        out.append("embedded method of the same order")
+    return out
+
+
+@pytest.mark.parametrize("pair", [ARK324, ARK436, ARK548], ids=lambda p: p.name)
+def test_tableau_order_conditions(pair):
+    """Exact-fraction check of the coefficients the kernels use."""
+    assert violations(pair) == []
+
+
+def _with_last_digit_changed(pair, field, *index):
+    """A copy of `pair` with the numerator of one coefficient changed by one unit."""
+    def change(x):
+        num, _, den = x.partition("/")
+        return f"{int(num) + 1}/{den}" if den else str(int(num) + 1)
+
+    value = getattr(pair, field)
+    if not index:
+        return pair._replace(**{field: change(value)})
+    rows = [list(r) if isinstance(r, tuple) else r for r in value]
+    if len(index) == 1:
+        rows[index[0]] = change(rows[index[0]])
+    else:
+        rows[index[0]][index[1]] = change(rows[index[0]][index[1]])
+    return pair._replace(**{field: tuple(tuple(r) if isinstance(r, list) else r for r in rows)})
+
+
+@pytest.mark.parametrize("pair", [ARK324, ARK436, ARK548], ids=lambda p: p.name)
+def test_a_mistyped_digit_is_caught(pair):
+    mutants = [_with_last_digit_changed(pair, "gamma")]
+    for field in ("c", "b", "bhat"):
+        mutants += [_with_last_digit_changed(pair, field, i) for i in range(len(getattr(pair, field)))]
+    for field in ("explicit", "implicit"):
+        rows = getattr(pair, field)
+        mutants += [_with_last_digit_changed(pair, field, i, j) for i in range(len(rows))
+                    for j in range(len(rows[i]))]
+    assert all(violations(m) for m in mutants)
+
+
+@pytest.mark.parametrize("pair", [ARK324, ARK436, ARK548], ids=lambda p: p.name)
+def test_implicit_part_is_l_stable_at_infinity(pair):
+    """R(z) = 1 + z b^T (I - z A_I)^-1 1 vanishes as z -> -inf (stiff decay of the state)."""
+    _, _, ai, b, _ = pair.matrices()
+    A = np.array(ai, dtype=float)
+    bw = np.array(b, dtype=float)
+    one = np.ones(len(bw))
+    for z in (-1e6, -1e9):
+        r = 1 + z * bw @ np.linalg.solve(np.eye(len(bw)) - z * A, one)
+        assert abs(r) < 1e-5
+
+
+def test_kernel_arrays_are_the_tableau():
+    c, ae, ai, b, bd, g = ARK436.kernel_arrays()
+    cf, aef, aif, bf, bhatf = ARK436.matrices()
+    assert g == 0.25 and np.all(np.diag(ai) == 0)
+    np.testing.assert_array_equal(ae, np.array(aef, dtype=float))
+    diagonal = g * np.diag([0.0] + [1.0] * 5)
+    np.testing.assert_allclose(ai + diagonal, np.array(aif, dtype=float), rtol=1e-15)
+    np.testing.assert_allclose(bd, np.array(bf, dtype=float) - np.array(bhatf, dtype=float), atol=1e-16)
+
+
+@pytest.mark.parametrize("step", [ark3_step, ark4_step, ark5_step])
+def test_zero_step_keeps_the_state(step):
+    """The event kernel redoes a step with h = 0 when an onset is located at its start."""
+    rng = np.random.default_rng(0)
+    ws = Workspace(8)
+    ws.load(rng.normal(size=8), rng.normal(size=8))
+    act = np.array([2, 3, 4, 0, 0, 0, 0, 0])
+    W = ws.W
+    W[:, Y0] = W[:, Y] = W[:, YS] = rng.random(8)
+    W[:, V0] = rng.random(8) * 100
+    W[:, P0] = W[:, P]
+    _, _, err = step(W, act, 3, 8, 0.5, 0.0, 9.0, 1e-8, 0.0, 20.0, 0.0, 1e-6, 1e-12)
+    assert err == 0.0
+    for new, old in ((Y, Y0), (V, V0), (P, P0)):
+        np.testing.assert_array_equal(W[act[:3], new], W[act[:3], old])
+
+
+def _slide(step, steps, duration=0.5):
+    """(y, v, psi) of one block sliding between two at rest, `steps` fixed steps of `step`."""
+    n, psi0 = 3, 0.5
+    ws = Workspace(n)
+    ws.load(np.array([0.0, 20.0 * psi0 + 3.0, 0.0]), np.full(n, psi0))
+    W = ws.W
+    act = np.array([1, 0, 0])
+    W[1, V] = 5.0
+    h = duration / steps
+    for k in range(steps):
+        W[1, Y0], W[1, V0], W[1, P0] = W[1, Y], W[1, V], W[1, P]
+        step(W, act, 1, n, k * h, h, 9.0, 1e-8, 2.0, 20.0, 0.0, 1e-6, 1e-12)
+    return np.array([W[1, Y], W[1, V], W[1, P]])
+
+
+@pytest.mark.parametrize("step, order", [(ark3_step, 3), (ark4_step, 4), (ark5_step, 5)])
+def test_convergence_order_with_fixed_steps(step, order):
+    """Errors of slip, velocity and state fall as h^p (the block keeps sliding: smooth)."""
+    ref = _slide(ark5_step, 4000)
+    errors = [np.abs(_slide(step, m) - ref) for m in (20, 40, 80)]
+    observed = np.log2(errors[1] / errors[2])
+    print(f"observed orders (y, v, psi): {observed.round(2)}")
+    assert np.all(np.abs(observed - order) < 0.3)
+
+
+@pytest.mark.parametrize("method", ["ark4", "ark5"])
+def test_slip_error_follows_the_tolerance(events, method):
+    model, evs = events
+    for f, p, epicenter, ref in evs:
+        errors = []
+        for rtol in (1e-5, 1e-7):
+            ev = check(run_event(f, p, epicenter, model, Integrator(method=method, rtol=rtol)))
+            errors.append(abs(ev.slip - ref.slip) / ref.slip)
+            assert np.linalg.norm(ev.profile - ref.profile) <= 100 * rtol * np.linalg.norm(ref.profile)
+            assert ev.relative_energy_residual < 100 * rtol
+        print(f"slip {ref.slip:.3g}: relative errors at rtol 1e-5, 1e-7: {errors[0]:.1e}, {errors[1]:.1e}")
+        assert errors[0] < 1e-4 and errors[1] < 1e-6
+        assert errors[1] < errors[0] / 10 or errors[1] < 1e-9
+
+
+def test_fewer_steps_than_ark3_at_the_same_tolerance(events):
+    model, evs = events
+    f, p, epicenter, ref = evs[0]
+    ark3 = check(run_event(f, p, epicenter, model, Integrator(method="ark3", rtol=1e-6)))
+    ark4 = check(run_event(f, p, epicenter, model, Integrator(method="ark4", rtol=1e-6)))
+    print(f"block-steps at rtol 1e-6: ark3 {ark3.block_steps}, ark4 {ark4.block_steps}")
+    assert ark4.block_steps < ark3.block_steps / 2
+    assert abs(ark4.slip - ref.slip) < abs(ark3.slip - ref.slip)
+
+
+def test_run_with_ark4(tmp_path):
+    cfg = write_config(tmp_path / "c.toml", integrator={"method": "ark4", "rtol": 1e-6},
+                       run={"seeds": 1, "events": 30, "transient": 10})
+    res = run_cli("run", cfg, "-o", tmp_path / "a.h5")
+    assert res.returncode == 0, res.stderr
