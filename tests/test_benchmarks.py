@@ -4,7 +4,7 @@ import json
 import numpy as np
 import pytest
 
-from benchmarks import cost_scaling, statistics, work_precision
+from benchmarks import cost_scaling, hard_cases, statistics, work_precision
 from benchmarks.baselines import BASELINES
 from benchmarks.common import cost_at_error, ks_distance, parse_setting, wasserstein1
 from ensemble.config import Model
@@ -100,3 +100,22 @@ def test_cost_scaling_tiny(tmp_path):
         for c in cost_scaling.CLASSES:
             if p[c]["count"]:
                 assert p[c]["us_per_event"] > 0 and p[c]["block_steps_per_slid_block"] >= 1
+
+
+def test_hard_cases_tiny(tmp_path):
+    data = hard_cases.main(["--runs", "rk4", "ark3", "--cases", "b100", "long", "--N", "30", "--transient", "10",
+                            "--events", "15", "--long-t", "1e14", "--late-events", "5", "--probe-events", "10",
+                            "--long-max-seconds", "1", "--out", str(tmp_path)])
+    assert json.loads((tmp_path / "hard_cases.json").read_text())["long_nu"] == data["long_nu"] == 1e-10
+    assert "long run rk4 (nu = 1e-10)" in (tmp_path / "hard_cases.txt").read_text()
+    points = {(p["case"], p["setting"]): p for p in data["points"]}
+    assert points["b100", "rk4"]["dt"] == 2e-4 and points["b100", "ark3"]["dt"] == 1e-3   # untuned ark3
+    for p in points.values():
+        assert p["status"] == "ok" and p["nonfinite"] == p["zero_slip"] == p["non_increasing_onsets"] == 0
+        assert p["events_per_second"] > 0 and 0 < p["residual_median"] <= p["residual_max"] < 1e-3
+    for method in ("rk4", "ark3"):
+        long = points["long", method]
+        assert long["final_time"] > 1e14 and long["long"]["after"]["events"] >= 5
+        assert long["events"] == long["long"]["before"]["events"] + long["long"]["after"]["events"]
+    assert [r["setting"] for r in data["probe"]] == ["rk4", "ark3"]
+    assert all(r["status"] == "ok" and r["events_to_target"] > 0 for r in data["probe"])
