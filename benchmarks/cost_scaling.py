@@ -121,7 +121,7 @@ def plot(points, sweeps, path):
 
 def parse_args(argv=None):
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--runs", nargs="+", default=["rk4:dt=5e-4"], help="kernel settings")
+    p.add_argument("--runs", nargs="+", default=["ark4:rtol=1e-5", "rk4:dt=5e-4"], help="kernel settings")
     p.add_argument("--Ns", type=int, nargs="*", default=[200, 400, 800, 1600, 3200, 6400], help="N sweep")
     p.add_argument("--b-at", type=float, default=20.0, help="b of the N sweep")
     p.add_argument("--bs", type=float, nargs="*", default=[20.0, 30.0, 40.0, 50.0], help="b sweep")

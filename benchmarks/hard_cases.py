@@ -221,7 +221,7 @@ def table(points, probe, long_nu):
 
 def parse_args(argv=None):
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--runs", nargs="+", default=["rk4", "ark3"],
+    p.add_argument("--runs", nargs="+", default=["rk4", "ark4"],
                    help="settings; a bare name is untuned (rk4 at the case's dt, adaptive at defaults)")
     p.add_argument("--cases", nargs="+", default=list(CASES), choices=list(CASES))
     p.add_argument("--N", type=int, default=800, help="blocks of every case but N6400")

@@ -37,7 +37,8 @@ from ensemble.runner import SimulationError, event_rows
 from .common import (Clock, ks_distance, minutes, parse_setting, pyplot, rough_events_per_second, save_figure,
                      trajectory, wasserstein1, write_outputs)
 
-RUNS = ["rk4:dt=1e-3", "rk4:dt=5e-4", "ark3:rtol=1e-4", "ark3:rtol=1e-5", "ark3:rtol=1e-6"]
+RUNS = ["rk4:dt=1e-3", "ark3:rtol=1e-5", "ark4:rtol=1e-4", "ark4:rtol=1e-5", "ark4:rtol=1e-6",
+        "ark5:rtol=1e-5"]
 DISTANCES = {"ks": ks_distance, "w1": wasserstein1}
 SAMPLES = ("mu", "tnu")
 MAX_SPLITS = 10
