@@ -62,7 +62,7 @@ CHUNK = 20           # events per kernel call (the clocks are checked between ca
 def integrator(setting, rk4_dt):
     """The setting's Integrator: a bare "rk4" at the case's step, a bare adaptive name at its defaults."""
     if setting.name == "rk4" and "dt" not in setting.kwargs:
-        return Integrator(dt=rk4_dt, **setting.kwargs)
+        return Integrator(method="rk4", dt=rk4_dt, **setting.kwargs)
     return setting.integrator()
 
 

@@ -52,7 +52,7 @@ RATIO_IS = {("interpolated", "interpolated"): "=", ("interpolated", "bound"): ">
 def pre_event_states(model, transient, seed=0):
     """{label: (force, psi, epicenter, mu)} at the onset of the next small (mu < 3) and large (mu >= 4) event."""
     cfg = Config(model=model, run=Run(events=1, transient=transient, seed=seed),
-                 integrator=Integrator(dt=5e-4))
+                 integrator=Integrator(method="rk4", dt=5e-4))
     traj = Trajectory(cfg, task_list(cfg)[0])
     traj.advance(transient)
     found = {}

@@ -48,7 +48,7 @@ class Run:
 
 @dataclass(frozen=True)
 class Integrator:
-    method: str = "rk4"            # event integrator (see ensemble.integrators.INTEGRATORS)
+    method: str = "ark4"           # event integrator (see ensemble.integrators.INTEGRATORS)
     dt: float = 1e-3               # time step of "rk4"; first step of the adaptive methods
     rtol: float = 1e-6             # adaptive methods (ark3, ark4, ark5): relative tolerance of the local error per step
     atol: float = 1e-12            # adaptive methods: absolute tolerance (slip, velocity)

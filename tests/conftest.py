@@ -23,7 +23,7 @@ def developed_state(model, events, seed=1, dt=1e-3):
     t = np.empty(events)
     epi = np.empty(events, dtype=np.int64)
     diag = np.empty((events, NDIAG))
-    status, k = simulate(*ws.arrays, clock, *kernel_args(model, Integrator(dt=dt)), events, t, epi, diag)
+    status, k = simulate(*ws.arrays, clock, *kernel_args(model, Integrator(method="rk4", dt=dt)), events, t, epi, diag)
     assert status == 0
     return ws.state(clock, model.nu)
 
@@ -32,7 +32,7 @@ def next_event(force, psi, model, dt, v_start=0.0):
     """Jump to the next onset and integrate that event with fixed-step RK4 at dt."""
     epicenter, _, f, p = advance_to_onset(force, psi, model)
     f[epicenter] = model.b * p[epicenter]
-    return epicenter, check(run_event(f, p, epicenter, model, Integrator(dt=dt), v_start))
+    return epicenter, check(run_event(f, p, epicenter, model, Integrator(method="rk4", dt=dt), v_start))
 
 
 def run_cli(*args, cwd=None):
@@ -44,7 +44,7 @@ def run_cli(*args, cwd=None):
 def write_config(path, **sections):
     """A small config file: sections given as dicts override the test defaults."""
     base = {"model": {"N": 60, "b": 20.0}, "run": {"events": 40, "transient": 20, "seeds": 2},
-            "integrator": {"dt": 1e-3}, "output": {"path": str(path.with_suffix(".h5"))}}
+            "integrator": {"method": "rk4", "dt": 1e-3}, "output": {"path": str(path.with_suffix(".h5"))}}
     for name, values in sections.items():
         base.setdefault(name, {}).update(values)
     lines = []

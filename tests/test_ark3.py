@@ -17,7 +17,7 @@ def events():
     for _ in range(4):
         epicenter, _, f, p = advance_to_onset(force, psi, model)
         f[epicenter] = model.b * p[epicenter]
-        ref = check(run_event(f, p, epicenter, model, Integrator(dt=1.25e-4)))
+        ref = check(run_event(f, p, epicenter, model, Integrator(method="rk4", dt=1.25e-4)))
         out.append((f, p, epicenter, ref))
         force, psi = ref.force, ref.psi
     return model, out
@@ -43,7 +43,7 @@ def test_takes_far_fewer_steps_than_rk4_in_slow_nucleation(events):
     force, psi = developed_state(model, 5)
     epicenter, _, f, p = advance_to_onset(force, psi, model)
     f[epicenter] = model.b * p[epicenter]
-    rk4 = check(run_event(f, p, epicenter, model, Integrator(dt=1e-3)))
+    rk4 = check(run_event(f, p, epicenter, model, Integrator(method="rk4", dt=1e-3)))
     ark = check(run_event(f, p, epicenter, model, Integrator(method="ark3", rtol=1e-7)))
     print(f"a = 30 event of duration {rk4.duration:.0f}: RK4 {rk4.steps} steps, ARK3 {ark.steps}")
     assert ark.slip == pytest.approx(rk4.slip, rel=1e-5)

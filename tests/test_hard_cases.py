@@ -32,7 +32,7 @@ CASES = {
 
 def integrator(method, rk4_dt=1e-3):
     """RK4 at the step the case needs; an adaptive method exactly at its defaults."""
-    return Integrator(dt=rk4_dt) if method == "rk4" else Integrator(method=method)
+    return Integrator(method="rk4", dt=rk4_dt) if method == "rk4" else Integrator(method=method)
 
 
 def residual_bounds(method):

@@ -14,7 +14,7 @@ def kicked_block(model, block, v0=1e-6, margin=5.0, psi0=20.0):
     psi = np.full(model.N, psi0)
     force = model.b * psi - margin
     force[block] = model.b * psi0
-    return check(run_event(force, psi, block, model, Integrator(dt=1e-3), v_start=v0))
+    return check(run_event(force, psi, block, model, Integrator(method="rk4", dt=1e-3), v_start=v0))
 
 
 @pytest.mark.parametrize("block,stiffness", [(10, 19.0), (0, 10.0), (20, 10.0)])
@@ -77,7 +77,7 @@ def test_kernel_agrees_with_independent_full_chain_reference():
     psi = rng.uniform(10.0, 14.0, model.N)
     force = model.b * psi - rng.uniform(0.5, 3.0, model.N)
     force[7] = model.b * psi[7]
-    ours = check(run_event(force, psi, 7, model, Integrator(dt=2e-4), v_start=0.05))
+    ours = check(run_event(force, psi, 7, model, Integrator(method="rk4", dt=2e-4), v_start=0.05))
     ref = reference_event(force, psi, 7, model, dt=2e-5, v_start=0.05)
     assert ours.slip > 1.0 and np.count_nonzero(ours.profile) > 3
     # The reference clamps v at step ends (second order, error ~1e-6 of the slip at

@@ -32,7 +32,7 @@ def run_lazy(model, force, psi, events):
     ws.load(force, psi)
     clock = np.zeros(2)
     t, epi, diag = np.empty(events), np.empty(events, dtype=np.int64), np.empty((events, NDIAG))
-    status, _ = simulate(*ws.arrays, clock, *kernel_args(model, Integrator()), events, t, epi, diag)
+    status, _ = simulate(*ws.arrays, clock, *kernel_args(model, Integrator(method="rk4")), events, t, epi, diag)
     assert status == 0
     return ws, clock, t, epi, diag
 
@@ -48,7 +48,7 @@ def test_lazy_schedule_equals_loading_every_block_every_event():
     for k in range(12):
         epicenter, delay, f, p = advance_to_onset(f, p, model)
         f[epicenter] = model.b * p[epicenter]
-        ev = check(run_event(f, p, epicenter, model, Integrator()))
+        ev = check(run_event(f, p, epicenter, model, Integrator(method="rk4")))
         assert epicenter == epi[k]
         # An onset is where the force (rate nu) overtakes the threshold (rate b / theta,
         # often close to nu): nearly tangent, so a round-off difference of the forces
@@ -77,7 +77,7 @@ def test_an_event_updates_only_the_blocks_it_touched():
     ws.load(force, psi)
     clock = np.zeros(2)
     t, epi, diag = np.empty(1), np.empty(1, dtype=np.int64), np.empty((1, NDIAG))
-    args = kernel_args(model, Integrator())
+    args = kernel_args(model, Integrator(method="rk4"))
     small = 0
     for _ in range(60):
         before = ws.W.copy(), ws.since.copy()
