@@ -4,8 +4,9 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
-from ensemble.config import Integrator
+from ensemble.config import Integrator, Model
 from ensemble.events import advance_to_onset, check, run_event
 from ensemble.integrators import kernel_args
 from ensemble.model.chain import simulate
@@ -60,3 +61,18 @@ def write_config(path, **sections):
         lines.append("")
     path.write_text("\n".join(lines))
     return path
+
+
+@pytest.fixture(scope="module")
+def events():
+    """Pre-event states of the next few events of a developed chain, and RK4 references."""
+    model = Model(N=100, b=20.0, a=2.0)
+    force, psi = developed_state(model, 200)
+    out = []
+    for _ in range(4):
+        epicenter, _, f, p = advance_to_onset(force, psi, model)
+        f[epicenter] = model.b * p[epicenter]
+        ref = check(run_event(f, p, epicenter, model, Integrator(method="rk4", dt=1.25e-4)))
+        out.append((f, p, epicenter, ref))
+        force, psi = ref.force, ref.psi
+    return model, out

@@ -10,8 +10,6 @@ from ensemble.model.steppers import ARK324, ARK436, ARK548, ark3_step, ark4_step
 from ensemble.model.workspace import P, P0, V, V0, Y, Y0, YS, Workspace
 
 from .conftest import run_cli, write_config
-# the fixture: next events of a developed chain with RK4 references
-from .test_ark3 import events  # noqa: F401
 
 # The published 13-digit fractions satisfy the conditions to about 1e-26;
 # a change of one unit in the last digit of any coefficient shows at 1e-14 or more.
@@ -189,7 +187,11 @@ def test_convergence_order_with_fixed_steps(step, order):
     assert np.all(np.abs(observed - order) < 0.3)
 
 
-@pytest.mark.parametrize("method", ["ark4", "ark5"])
+# relative slip error bounds at rtol 1e-5 and 1e-7 (measured 0.05-0.2 rtol for ark3, less for the others)
+ERROR_BOUNDS = {"ark3": (1e-3, 1e-5), "ark4": (1e-4, 1e-6), "ark5": (1e-4, 1e-6)}
+
+
+@pytest.mark.parametrize("method", sorted(ERROR_BOUNDS))
 def test_slip_error_follows_the_tolerance(events, method):
     model, evs = events
     for f, p, epicenter, ref in evs:
@@ -200,7 +202,7 @@ def test_slip_error_follows_the_tolerance(events, method):
             assert np.linalg.norm(ev.profile - ref.profile) <= 100 * rtol * np.linalg.norm(ref.profile)
             assert ev.relative_energy_residual < 100 * rtol
         print(f"slip {ref.slip:.3g}: relative errors at rtol 1e-5, 1e-7: {errors[0]:.1e}, {errors[1]:.1e}")
-        assert errors[0] < 1e-4 and errors[1] < 1e-6
+        assert errors[0] < ERROR_BOUNDS[method][0] and errors[1] < ERROR_BOUNDS[method][1]
         assert errors[1] < errors[0] / 10 or errors[1] < 1e-9
 
 
