@@ -316,8 +316,12 @@ def _open_for_reading(path):
         h5 = h5py.File(path, "r")
     except OSError as err:
         raise CatalogError(f"{path}: cannot read catalog ({err})") from None
-    if h5.attrs.get("format") != FORMAT:
+    found = h5.attrs.get("format")
+    if found != FORMAT:
         h5.close()
+        if isinstance(found, str) and found.startswith("bk-catalog-"):
+            raise CatalogError(f"{path}: catalog format {found}, this version reads {FORMAT} "
+                               "(the checkpoint layout changed; rerun, or read it with the older version)")
         raise CatalogError(f"{path}: not an event catalog of this package")
     return h5
 
