@@ -6,7 +6,8 @@ import pytest
 
 from ensemble.config import Integrator
 from ensemble.events import check, run_event
-from ensemble.model.steppers import ARK324, ARK436, ARK548, ark3_step, ark4_step, ark5_step
+from ensemble.model.steppers import ark3_step, ark4_step, ark5_step
+from ensemble.model.tableaux import ARK324, ARK436, ARK548
 from ensemble.model.workspace import P, P0, V, V0, Y, Y0, YS, Workspace
 
 from .conftest import run_cli, write_config

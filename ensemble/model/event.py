@@ -22,7 +22,8 @@ import numpy as np
 from .friction import friction, left, right, spring_force
 from .onset import onset_delay
 from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
-from .steppers import ARK324, ARK436, ARK548, ark3_step, ark4_step, ark5_step, rk4_step
+from .steppers import ark3_step, ark4_step, ark5_step, rk4_step
+from .tableaux import ARK324, ARK436, ARK548
 from .workspace import (D_BLOCK_STEPS, D_DURATION, D_FIRST, D_LAST, D_NSLIP, D_RESIDUAL, D_SLIP,
                         D_STEPS, D_VMAX, D_WORK, F0, HD0, HD1, K1V, NONFINITE, OK, P, P0, TOO_LONG,
                         TR, UNSTABLE, V, V0, Y, Y0, YS)
