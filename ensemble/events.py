@@ -5,8 +5,8 @@ import numpy as np
 
 from .integrators import kernel_args
 from .model.event import integrate_event
-from .model.chain import load_quietly, next_onset
-from .model.schedule import build_schedule
+from .model.onset import onset_delay
+from .model.schedule import build_schedule, tree_min
 from .model.workspace import (D_BLOCK_STEPS, D_DURATION, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX,
                                     D_WORK, OK,
                               STATUS_TEXT, Workspace)
@@ -58,9 +58,10 @@ def advance_to_onset(force, psi, model):
     """Load quietly until the next onset: (epicenter, delay, force, psi) at the onset."""
     ws = Workspace(len(force))
     ws.load(force, psi)
-    epicenter, delay, _ = next_onset(ws.W, len(force), model.nu, model.b)
-    load_quietly(ws.W, len(force), model.nu, delay)
-    return epicenter, delay, ws.force.copy(), ws.psi.copy()
+    build_schedule(ws.W, ws.since, ws.tree, model.nu, model.b)
+    _, epicenter = tree_min(ws.tree)
+    delay = onset_delay(force[epicenter], psi[epicenter], model.nu, model.b)
+    return (epicenter, delay, *ws.state((delay, 0.0), model.nu))
 
 
 def run_event(force, psi, epicenter, model, integrator, v_start=0.0):

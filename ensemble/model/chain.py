@@ -6,8 +6,7 @@ Time is kept as a compensated sum (clock[0] + clock[1]) because a long run
 reaches t ~ 1e15, where a single float64 resolves only ~0.1; everything the
 physics uses is a time difference (time since the onset, since a block came to
 rest), so accuracy does not decay as the run goes on. Between events only the
-blocks an event touched are updated (schedule.py); `next_onset` and
-`load_quietly` are the plain O(N) versions, kept for preparing single events.
+blocks an event touched are updated (schedule.py).
 """
 import math
 
@@ -15,34 +14,9 @@ import numba as nb
 import numpy as np
 
 from .event import integrate_event
-from .onset import grow_state, onset_delay
+from .onset import onset_delay
 from .schedule import advance_clock, build_schedule, materialize, tree_min
 from .workspace import D_DURATION, D_SLIP, F0, OK, P
-
-
-@nb.njit(cache=True)
-def next_onset(W, n, nu, b):
-    """Epicenter, delay until its onset, and the delay of the runner-up block."""
-    best = np.inf
-    second = np.inf
-    epicenter = -1
-    for i in range(n):
-        d = onset_delay(W[i, F0], W[i, P], nu, b)
-        if d < best:
-            second = best
-            best = d
-            epicenter = i
-        elif d < second:
-            second = d
-    return epicenter, best, second
-
-
-@nb.njit(cache=True)
-def load_quietly(W, n, nu, dt):
-    """All blocks at rest for a time dt: the driver pulls, every theta grows."""
-    for i in range(n):
-        W[i, F0] += nu * dt
-        W[i, P] = grow_state(W[i, P], dt)
 
 
 @nb.njit(cache=True)

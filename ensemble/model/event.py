@@ -1,9 +1,9 @@
-"""One event of the chain, integrated on the active set (fixed-step RK4 or adaptive ARK3).
+"""One event of the chain, integrated on the active set (fixed-step RK4 or adaptive IMEX).
 
 Only sliding blocks are integrated. Blocks at rest that neighbour a sliding
 block are checked for onset after every step; all other blocks at rest can only
-start by loading, and their earliest analytic onset time `t_far` is tracked so
-that it is only recomputed when the event actually reaches it.
+start by loading, and the earliest such onset `t_far` comes from the onset tree
+(schedule.py), looked at again only when a block starts or stops.
 
 A step in which a block sticks (v reaches 0) or starts (its force reaches the
 static threshold) is cut at that instant, located on the cubic Hermite
