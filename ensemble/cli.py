@@ -6,10 +6,13 @@ at once, instead of leaving the others hanging in MPI.
 """
 import argparse
 import sys
+import time
 
 from . import __version__
 from .catalog import CatalogError
 from .config import ConfigError, load, replace
+
+ABORT_GRACE_SECONDS = 1.0
 
 
 def _parser():
@@ -72,6 +75,10 @@ def _run(args):
     except Exception as err:  # noqa: BLE001 - the guard that turns any failure into an abort
         print(f"error: rank {rank}: {err}", file=sys.stderr, flush=True)
         if comm.Get_size() > 1:
+            # MPI_Abort makes the process manager kill every rank, and what a rank
+            # wrote to its stderr pipe but the manager has not yet forwarded is lost
+            # (seen with MPICH's Hydra): give the message a moment to get out.
+            time.sleep(ABORT_GRACE_SECONDS)
             comm.Abort(1)
         return 1
 
