@@ -24,7 +24,7 @@ from .onset import onset_delay
 from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
 from .steppers import ark3_step, ark4_step, ark5_step, rk4_step
 from .tableaux import ARK324, ARK436, ARK548
-from .workspace import (D_BLOCK_STEPS, D_DURATION, D_FIRST, D_LAST, D_NSLIP, D_RESIDUAL, D_SLIP,
+from .workspace import (D_BLOCK_STEPS, D_CUTS, D_DURATION, D_FIRST, D_LAST, D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP,
                         D_STEPS, D_VMAX, D_WORK, F0, HD0, HD1, K1V, NONFINITE, OK, P, P0, TOO_LONG,
                         TR, UNSTABLE, V, V0, Y, Y0, YS)
 
@@ -193,6 +193,8 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
     slip_time = 0.0
     steps = 0
     block_steps = 0
+    rejected = 0
+    cuts = 0
     vmax = v_start
     status = OK
     v_limit = RK4_STABILITY / dt
@@ -215,6 +217,7 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
                 break
             h *= max(0.2, 0.9 * err ** expo)    # rejected: retry from (Y0, V0, P0)
             steps += 1
+            rejected += 1
         if method != RK4:
             grow = 5.0 if err == 0.0 else min(5.0, max(0.2, 0.9 * err ** expo))
             h_next = min(h_max, h * grow)
@@ -274,6 +277,7 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
                 kind = 3
         if kind != 0 and x_cut < 1.0:
             h = x_cut * h
+            cuts += 1
             dwork, dslip, _ = _step(method, W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
         tau += h
         steps += 1
@@ -344,6 +348,8 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
     diag[D_STEPS] = steps
     diag[D_VMAX] = vmax
     diag[D_BLOCK_STEPS] = block_steps
+    diag[D_REJECTED] = rejected
+    diag[D_CUTS] = cuts
     return status
 
 

@@ -33,8 +33,8 @@ NCOLS = ARK_G + ARK_STAGES
 
 # entries of the per-event diagnostics vector
 (D_DURATION, D_SLIP, D_FIRST, D_LAST, D_NSLIP, D_WORK, D_RESIDUAL, D_STEPS, D_VMAX,
- D_BLOCK_STEPS) = range(10)
-NDIAG = 10
+ D_BLOCK_STEPS, D_REJECTED, D_CUTS) = range(12)
+NDIAG = 12
 
 # status codes of the kernels
 OK, NONFINITE, UNSTABLE, TOO_LONG = 0, 1, 2, 3
