@@ -49,18 +49,23 @@ RATIO_IS = {("interpolated", "interpolated"): "=", ("interpolated", "bound"): ">
             ("bound", "interpolated"): "<=", ("bound", "bound"): "?"}
 
 
-def pre_event_states(model, transient, seed=0):
-    """{label: (force, psi, epicenter, mu)} at the onset of the next small (mu < 3) and large (mu >= 4) event."""
+# event classes by magnitude: label -> [lowest mu, highest mu)
+SIZES = {"small": (-np.inf, 3.0), "large": (4.0, np.inf)}
+
+
+def pre_event_states(model, transient, seed=0, sizes=SIZES):
+    """{label: (force, psi, epicenter, mu)} at the onset of the next event of each size class
+    (default: small, mu < 3, and large, mu >= 4)."""
     cfg = Config(model=model, run=Run(events=1, transient=transient, seed=seed),
                  integrator=Integrator(method="rk4", dt=5e-4))
     traj = Trajectory(cfg, task_list(cfg)[0])
     traj.advance(transient)
     found = {}
-    while len(found) < 2:
+    while len(found) < len(sizes):
         force, psi = traj.state()
         _, _, diag = traj.advance(1)
         mu = np.log10(diag[0, 1])
-        label = "small" if mu < 3 else "large" if mu >= 4 else None
+        label = next((k for k, (lo, hi) in sizes.items() if lo <= mu < hi), None)
         if label and label not in found:
             epicenter, _, f, p = advance_to_onset(force, psi, model)
             f[epicenter] = model.b * p[epicenter]

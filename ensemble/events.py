@@ -7,9 +7,8 @@ from .integrators import kernel_args
 from .model.event import integrate_event
 from .model.onset import onset_delay
 from .model.schedule import build_schedule, tree_min
-from .model.workspace import (D_BLOCK_STEPS, D_DURATION, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX,
-                                    D_WORK, OK,
-                              STATUS_TEXT, Workspace)
+from .model.workspace import (D_BLOCK_STEPS, D_CUTS, D_DURATION, D_REJECTED, D_RESIDUAL, D_SLIP,
+                              D_STEPS, D_VMAX, D_WORK, OK, STATUS_TEXT, Workspace)
 
 
 @dataclass
@@ -19,6 +18,8 @@ class EventResult:
     duration: float
     steps: int
     block_steps: int        # sum over steps of the number of sliding blocks
+    rejected: int           # steps rejected by the error control (counted in steps)
+    cuts: int               # steps cut at a located stick or onset and redone
     vmax: float
     friction_work: float    # int sum(Phi v) dt, c-free frame
     energy_residual: float  # dE_elastic + friction work - loading work
@@ -78,7 +79,7 @@ def run_event(force, psi, epicenter, model, integrator, v_start=0.0):
     force, psi = ws.state((ws.diag[D_DURATION], 0.0), nu)     # every block at the end
     d = ws.diag
     return EventResult(status, d[D_SLIP], d[D_DURATION], int(d[D_STEPS]), int(d[D_BLOCK_STEPS]),
-                       d[D_VMAX], d[D_WORK],
+                       int(d[D_REJECTED]), int(d[D_CUTS]), d[D_VMAX], d[D_WORK],
                        d[D_RESIDUAL], profile, force, psi)
 
 

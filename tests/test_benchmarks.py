@@ -4,7 +4,7 @@ import json
 import numpy as np
 import pytest
 
-from benchmarks import cost_scaling, hard_cases, statistics, work_precision
+from benchmarks import cost_scaling, hard_cases, statistics, step_budget, work_precision
 from benchmarks.baselines import BASELINES
 from benchmarks.common import cost_at_error, ks_distance, parse_setting, wasserstein1
 from ensemble.config import Model
@@ -119,3 +119,26 @@ def test_hard_cases_tiny(tmp_path):
         assert long["events"] == long["long"]["before"]["events"] + long["long"]["after"]["events"]
     assert [r["setting"] for r in data["probe"]] == ["rk4", "ark3"]
     assert all(r["status"] == "ok" and r["events_to_target"] > 0 for r in data["probe"])
+
+
+def test_step_budget_tiny(tmp_path):
+    data = step_budget.main(["--N", "40", "--transient", "60", "--sizes", "small:-inf:2", "large:2:inf",
+                             "--runs", "rk4:dt=1e-3", "ark4:rtol=1e-4", "ark4:rtol=1e-7",
+                             "--out", str(tmp_path)])
+    assert json.loads((tmp_path / "step_budget_N40_b20.json").read_text())["rows"] == data["rows"]
+    rows = {(r["event"], r["setting"]): r for r in data["rows"]}
+    assert {e for e, _ in rows} == {"small", "large"}
+    for (event, setting), r in rows.items():
+        assert r["n_slid"] >= 1 and r["block_steps_per_slid"] * r["n_slid"] == pytest.approx(r["block_steps"])
+        assert 0 <= r["rejected"] < r["steps"] and r["cuts"] >= 2 * (r["n_slid"] - 1)  # each block starts, stops
+        if setting.startswith("rk4"):
+            assert r["rejected"] == 0 and r["slip_error"] < 1e-6
+    for event in ("small", "large"):
+        loose, tight = rows[event, "ark4:rtol=1e-4"], rows[event, "ark4:rtol=1e-7"]
+        assert tight["slip_error"] < max(loose["slip_error"], 1e-9) and tight["steps"] > loose["steps"]
+        # the error control, not a fixed step, sets ark4's steps: far fewer than RK4's
+        assert loose["block_steps"] * 5 < rows[event, "rk4:dt=1e-3"]["block_steps"]
+    assert set(data["step_alone_ns"]) == {"rk4:dt=1e-3", "ark4:rtol=1e-4", "ark4:rtol=1e-7"}
+    assert all(ns > 0 for ns in data["step_alone_ns"].values())
+    text = (tmp_path / "step_budget_N40_b20.txt").read_text()
+    assert "speed-up over rk4:dt=1e-3" in text and "one step alone" in text

@@ -158,7 +158,8 @@ def _start(W, act, na, flag, touched, nt, since, tree, t0, nu, j, tau, yrest):
 
 
 @nb.njit(cache=True)
-def _step(method, W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol):
+def take_step(method, W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol):
+    """One step of `method` (RK4, ARK3, ARK4, ARK5) of the active blocks; see steppers.py."""
     if method == RK4:
         return rk4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
     if method == ARK3:
@@ -211,15 +212,21 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
             W[i, V0] = W[i, V]
             W[i, P0] = W[i, P]
         h = h_next
+        retried = False
         while True:
-            dwork, dslip, err = _step(method, W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
+            dwork, dslip, err = take_step(method, W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
             if method == RK4 or err <= 1.0 or h < 1e-12:
                 break
             h *= max(0.2, 0.9 * err ** expo)    # rejected: retry from (Y0, V0, P0)
             steps += 1
             rejected += 1
+            retried = True
         if method != RK4:
             grow = 5.0 if err == 0.0 else min(5.0, max(0.2, 0.9 * err ** expo))
+            if retried:
+                # no growth right after a rejection (the step just failed at a larger h):
+                # 4% fewer steps, 20% fewer rejections for ark4 on large events
+                grow = min(grow, 1.0)
             h_next = min(h_max, h * grow)
         # Earliest transition inside the step, as a fraction x of it; the slip
         # of a sliding block inside the step is the Hermite cubic with these slopes.
@@ -278,7 +285,7 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
         if kind != 0 and x_cut < 1.0:
             h = x_cut * h
             cuts += 1
-            dwork, dslip, _ = _step(method, W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
+            dwork, dslip, _ = take_step(method, W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
         tau += h
         steps += 1
         block_steps += na
