@@ -26,7 +26,7 @@ import numpy as np
 
 from ensemble.config import Model
 from ensemble.events import check, run_event
-from ensemble.integrators import INTEGRATORS, kernel_args
+from ensemble.integrators import kernel_args
 from ensemble.model.event import take_step
 from ensemble.model.workspace import F0, NCOLS, P, P0, V, V0, Y, Y0, YS
 

@@ -1,4 +1,5 @@
 """Single events from a given state: the entry point for tests and benchmarks."""
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,6 +27,7 @@ class EventResult:
     profile: np.ndarray     # slip of every block
     force: np.ndarray       # state after the event (c-free frame)
     psi: np.ndarray
+    seconds: float          # wall time of the event kernel alone (no set-up: what a run pays)
 
     @property
     def relative_energy_residual(self):
@@ -74,13 +76,15 @@ def run_event(force, psi, epicenter, model, integrator, v_start=0.0):
     l2, nu, a, b, method, dt, rtol, atol, h_max, max_duration, max_steps = kernel_args(model, integrator)
     build_schedule(ws.W, ws.since, ws.tree, nu, b)     # (simulate does this itself)
     clock = np.zeros(2)
+    start = time.perf_counter()
     status = integrate_event(*ws.arrays[:7], clock, n, epicenter, v_start, l2, nu, a, b, method, dt,
                              rtol, atol, h_max, max_duration, max_steps, ws.diag, profile)
+    seconds = time.perf_counter() - start
     force, psi = ws.state((ws.diag[D_DURATION], 0.0), nu)     # every block at the end
     d = ws.diag
     return EventResult(status, d[D_SLIP], d[D_DURATION], int(d[D_STEPS]), int(d[D_BLOCK_STEPS]),
                        int(d[D_REJECTED]), int(d[D_CUTS]), d[D_VMAX], d[D_WORK],
-                       d[D_RESIDUAL], profile, force, psi)
+                       d[D_RESIDUAL], profile, force, psi, seconds)
 
 
 def check(result, what="event"):
