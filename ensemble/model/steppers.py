@@ -107,19 +107,28 @@ _C4, _AE4, _AI4, _B4, _D4, _G4 = ARK436.kernel_arrays()
 
 
 @nb.njit(cache=True, inline="always")
-def _implicit_state(rhs, hg, v, guess):
-    """psi with psi - hg (exp(-psi) - max(v, 0)) = rhs, Newton from `guess`.
+def _newton_state(psi, ex, target, hg):
+    """psi with psi - hg exp(-psi) = target, Newton from psi (>= target) with ex = exp(-psi).
 
     The left side is increasing and concave in psi, so Newton's iterates reach
     the root from below after the first step and never overshoot it; after a
     step s the distance to the root is below s^2 / 2 (|f''| < f'), so the
     iteration ends once that is below 1e-16 (1 + |psi|), one exp earlier than
     waiting for a negligible step. The root lies above `target`, and far below
-    it Newton only climbs by about 1 per iteration, so the guess is raised to
-    at least `target`; NaN (a loud failure) if it has not converged.
+    it Newton only climbs by about 1 per iteration, so the caller starts at or
+    above `target`; NaN (a loud failure) if it has not converged.
     """
-    target = rhs - hg * (v if v > 0.0 else 0.0)
-    psi = max(guess, target)
+    # the usual case first, without data-dependent branches: two steps, the first
+    # small enough for the Taylor update of the exp
+    e = hg * ex
+    step1 = (psi - e - target) / (1.0 + e)
+    psi -= step1
+    ex *= 1.0 + step1 * (1.0 + step1 * (0.5 + step1 * (1.0 / 6.0 + step1 / 24.0)))
+    e = hg * ex
+    step = (psi - e - target) / (1.0 + e)
+    psi -= step
+    if abs(step1) < 1e-3 and step * step <= 2e-16 * (1.0 + abs(psi)):
+        return psi
     ex = math.exp(-psi)
     for _ in range(60):
         e = hg * ex
@@ -160,12 +169,27 @@ def _ark_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol, c, ae, ai,
             if s == 0:
                 W[i, PS] = r
             else:
-                # Newton starts from the explicit guess with the previous stage's rate (in KP);
-                # the stage's state rate follows from the solved equation without an exp
-                # (the event kernel may redo a step with h = 0)
-                psi = _implicit_state(r, hg, v, r + hg * W[i, KP])
+                # the implicit stage psi - hg (exp(-psi) - max(v, 0)) = r: Newton starts from
+                # the explicit guess with the previous stage's rate (in KP), raised to at least
+                # the root's lower bound `target` (SY, SV, SP are free scratch here)
+                target = r - hg * (v if v > 0.0 else 0.0)
+                W[i, PS] = max(r + hg * W[i, KP], target)
+                W[i, SY] = target
+                W[i, SV] = r
+        if s > 0:
+            # the blocks' exps are independent: one pass for all of them keeps them out of
+            # each solve's chain of dependent operations (a quarter less time per step)
+            for k in range(na):
+                i = act[k]
+                W[i, SP] = math.exp(-W[i, PS])
+            for k in range(na):
+                i = act[k]
+                r = W[i, SV]
+                psi = _newton_state(W[i, PS], W[i, SP], W[i, SY], hg)
                 W[i, PS] = psi
-                W[i, KP] = (psi - r) / hg if hg > 0.0 else state_rate(v, psi)
+                # the stage's state rate from the solved equation, without an exp (the event
+                # kernel may redo a step with h = 0)
+                W[i, KP] = (psi - r) / hg if hg > 0.0 else state_rate(W[i, VS], psi)
         power, ysum = stage_rates(W, act, na, n, tau + c[s] * h, l2, nu, a, b, yrest, s == 0)
         pw += bw[s] * power
         ys += bw[s] * ysum
