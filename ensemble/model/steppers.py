@@ -106,29 +106,45 @@ _C5, _AE5, _AI5, _B5, _D5, _G5 = ARK548.kernel_arrays()
 _C4, _AE4, _AI4, _B4, _D4, _G4 = ARK436.kernel_arrays()
 
 
-@nb.njit(cache=True, inline="always")
-def _newton_state(psi, ex, target, hg):
-    """psi with psi - hg exp(-psi) = target, Newton from psi (>= target) with ex = exp(-psi).
+# The implicit stage equation of every block: psi - hg exp(-psi) = target. Its left
+# side is increasing and concave in psi, so Newton's iterates reach the root from
+# below after the first step and never overshoot it; after a step s the distance
+# to the root is below s^2 / 2 (|f''| < f'), so a solve ends once that is below
+# 1e-16 (1 + |psi|), one exp earlier than waiting for a negligible step. The root
+# lies above `target`, and far below it Newton only climbs by about 1 per
+# iteration, so solves start at or above `target`.
 
-    The left side is increasing and concave in psi, so Newton's iterates reach
-    the root from below after the first step and never overshoot it; after a
-    step s the distance to the root is below s^2 / 2 (|f''| < f'), so the
-    iteration ends once that is below 1e-16 (1 + |psi|), one exp earlier than
-    waiting for a negligible step. The root lies above `target`, and far below
-    it Newton only climbs by about 1 per iteration, so the caller starts at or
-    above `target`; NaN (a loud failure) if it has not converged.
+
+@nb.njit(cache=True, inline="always")
+def _two_steps(psi, ex, target, hg):
+    """(psi, converged): a Halley then a Newton step from psi with ex = exp(-psi), the usual case.
+
+    Halley (f'' = -hg exp(-psi)) converges cubically, so the pair solves to
+    round-off from guesses up to ~3e-3 off (two Newton steps: ~3e-4; the
+    fallback is then needed for 6% of ark4's and 15% of ark5's solves instead
+    of several times more, measured on large events). The exp after the first step comes from
+    Taylor (error < step^7 / 5040), valid while that step is below 1e-2;
+    `converged` says whether both held.
     """
-    # the usual case first, without data-dependent branches: two steps, the first
-    # small enough for the Taylor update of the exp
     e = hg * ex
-    step1 = (psi - e - target) / (1.0 + e)
+    f = psi - e - target
+    d = 1.0 + e
+    step1 = f * d / (d * d + 0.5 * f * e)
     psi -= step1
-    ex *= 1.0 + step1 * (1.0 + step1 * (0.5 + step1 * (1.0 / 6.0 + step1 / 24.0)))
+    ex *= 1.0 + step1 * (1.0 + step1 * (0.5 + step1 * (1.0 / 6.0 + step1 * (1.0 / 24.0 + step1 * (
+        1.0 / 120.0 + step1 / 720.0)))))
     e = hg * ex
     step = (psi - e - target) / (1.0 + e)
     psi -= step
-    if abs(step1) < 1e-3 and step * step <= 2e-16 * (1.0 + abs(psi)):
-        return psi
+    return psi, abs(step1) < 1e-2 and step * step <= 2e-16 * (1.0 + abs(psi))
+
+
+@nb.njit(cache=True)
+def _newton_state(psi, target, hg):
+    """Newton from psi until converged (the rare case); NaN, a loud failure, if it does not.
+
+    Not inlined: the rare case stays out of the stage loop.
+    """
     ex = math.exp(-psi)
     for _ in range(60):
         e = hg * ex
@@ -137,7 +153,6 @@ def _newton_state(psi, ex, target, hg):
         if step * step <= 2e-16 * (1.0 + abs(psi)):
             return psi
         if abs(step) < 1e-3:
-            # exp(-psi) from the previous one: exp(step) by Taylor (error < step^5 / 120)
             ex *= 1.0 + step * (1.0 + step * (0.5 + step * (1.0 / 6.0 + step / 24.0)))
         else:
             ex = math.exp(-psi)
@@ -178,18 +193,28 @@ def _ark_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol, c, ae, ai,
                 W[i, SV] = r
         if s > 0:
             # the blocks' exps are independent: one pass for all of them keeps them out of
-            # each solve's chain of dependent operations (a quarter less time per step)
+            # each solve's chain of dependent operations (~10% less time per step on large events)
             for k in range(na):
                 i = act[k]
                 W[i, SP] = math.exp(-W[i, PS])
+            unsolved = False
             for k in range(na):
                 i = act[k]
-                r = W[i, SV]
-                psi = _newton_state(W[i, PS], W[i, SP], W[i, SY], hg)
+                psi, converged = _two_steps(W[i, PS], W[i, SP], W[i, SY], hg)
                 W[i, PS] = psi
+                W[i, SP] = 0.0 if converged else 1.0
+                unsolved |= not converged
+            if unsolved:
+                for k in range(na):
+                    i = act[k]
+                    if W[i, SP] != 0.0:
+                        W[i, PS] = _newton_state(W[i, PS], W[i, SY], hg)
+            for k in range(na):
+                i = act[k]
                 # the stage's state rate from the solved equation, without an exp (the event
                 # kernel may redo a step with h = 0)
-                W[i, KP] = (psi - r) / hg if hg > 0.0 else state_rate(W[i, VS], psi)
+                psi = W[i, PS]
+                W[i, KP] = (psi - W[i, SV]) / hg if hg > 0.0 else state_rate(W[i, VS], psi)
         power, ysum = stage_rates(W, act, na, n, tau + c[s] * h, l2, nu, a, b, yrest, s == 0)
         pw += bw[s] * power
         ys += bw[s] * ysum
