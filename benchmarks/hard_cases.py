@@ -37,7 +37,7 @@ import numpy as np
 
 from ensemble.config import Config, Integrator, Model, Run
 from ensemble.events import relative_energy_residual
-from ensemble.model.workspace import D_RESIDUAL, D_SLIP, D_VMAX, D_WORK, NDIAG
+from ensemble.model.workspace import D_ENERGY_SCALE, D_RESIDUAL, D_SLIP, D_VMAX, NDIAG
 from ensemble.runner import SimulationError, Trajectory
 from ensemble.tasks import task_list
 
@@ -105,7 +105,7 @@ def summary(t, diag, seconds, mu_c):
     """Health and statistics of recorded events (zero-slip events are counted, not measured)."""
     slip = diag[:, D_SLIP]
     ok = slip > 0
-    residual = relative_energy_residual(diag[ok, D_RESIDUAL], diag[ok, D_WORK])
+    residual = relative_energy_residual(diag[ok, D_RESIDUAL], diag[ok, D_ENERGY_SCALE])
     mu = np.log10(slip[ok])
     out = {"events": len(t), "events_per_second": len(t) / seconds if seconds > 0 else None,
            "nonfinite": int((~np.isfinite(diag)).sum() + (~np.isfinite(t)).sum() + (~np.isfinite(residual)).sum()),

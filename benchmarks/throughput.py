@@ -14,7 +14,7 @@ import numpy as np
 
 from ensemble.config import Config, Integrator, Model, Run
 from ensemble.events import relative_energy_residual
-from ensemble.model.workspace import D_BLOCK_STEPS, D_RESIDUAL, D_SLIP, D_STEPS, D_WORK
+from ensemble.model.workspace import D_BLOCK_STEPS, D_ENERGY_SCALE, D_RESIDUAL, D_SLIP, D_STEPS
 from ensemble.runner import Trajectory
 from ensemble.tasks import task_list
 
@@ -40,7 +40,7 @@ def main():
     _, _, diag = traj.advance(args.events)
     elapsed = time.perf_counter() - start
     mu = np.log10(diag[:, D_SLIP])
-    residual = relative_energy_residual(diag[:, D_RESIDUAL], diag[:, D_WORK])
+    residual = relative_energy_residual(diag[:, D_RESIDUAL], diag[:, D_ENERGY_SCALE])
     how = f"dt={args.dt}" if args.method == "rk4" else f"rtol={args.rtol:g}"
     print(f"N={args.N} b={args.b} a={args.a} {args.method} {how}: {args.events / elapsed:.1f} events/s "
           f"({args.events} events in {elapsed:.1f} s after {args.transient} transient)")

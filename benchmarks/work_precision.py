@@ -52,15 +52,17 @@ RATIO_IS = {("interpolated", "interpolated"): "=", ("interpolated", "bound"): ">
 SIZES = {"small": (-np.inf, 3.0), "large": (4.0, np.inf)}
 
 
-def pre_event_states(model, transient, seed=0, sizes=SIZES):
+def pre_event_states(model, transient, seed=0, sizes=SIZES, max_events=50_000):
     """{label: (force, psi, epicenter, mu)} at the onset of the next event of each size class
-    (default: small, mu < 3, and large, mu >= 4)."""
+    (default: small, mu < 3, and large, mu >= 4); SystemExit if one has not come in max_events."""
     cfg = Config(model=model, run=Run(events=1, transient=transient, seed=seed),
                  integrator=Integrator(method="rk4", dt=5e-4))
     traj = Trajectory(cfg, task_list(cfg)[0])
     traj.advance(transient)
     found = {}
-    while len(found) < len(sizes):
+    for _ in range(max_events):
+        if len(found) == len(sizes):
+            break
         force, psi = traj.state()
         _, _, diag = traj.advance(1)
         mu = np.log10(diag[0, 1])
@@ -69,6 +71,9 @@ def pre_event_states(model, transient, seed=0, sizes=SIZES):
             epicenter, _, f, p = advance_to_onset(force, psi, model)
             f[epicenter] = model.b * p[epicenter]
             found[label] = (f, p, epicenter, mu)
+    missing = [f"{k} ({lo:g} <= mu < {hi:g})" for k, (lo, hi) in sizes.items() if k not in found]
+    if missing:
+        raise SystemExit(f"no event of size class {', '.join(missing)} in {max_events} events after the transient")
     return found
 
 

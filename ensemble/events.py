@@ -8,7 +8,7 @@ from .integrators import kernel_args
 from .model.event import integrate_event
 from .model.onset import onset_delay
 from .model.schedule import build_schedule, tree_min
-from .model.workspace import (D_BLOCK_STEPS, D_CUTS, D_DURATION, D_REJECTED, D_RESIDUAL, D_SLIP,
+from .model.workspace import (D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ENERGY_SCALE, D_REJECTED, D_RESIDUAL, D_SLIP,
                               D_STEPS, D_VMAX, D_WORK, OK, STATUS_TEXT, Workspace)
 
 
@@ -24,6 +24,7 @@ class EventResult:
     vmax: float
     friction_work: float    # int sum(Phi v) dt, c-free frame
     energy_residual: float  # dE_elastic + friction work - loading work
+    energy_scale: float     # sum of the magnitudes of the terms of that balance
     profile: np.ndarray     # slip of every block
     force: np.ndarray       # state after the event (c-free frame)
     psi: np.ndarray
@@ -31,17 +32,17 @@ class EventResult:
 
     @property
     def relative_energy_residual(self):
-        return relative_energy_residual(self.energy_residual, self.friction_work)
+        return relative_energy_residual(self.energy_residual, self.energy_scale)
 
 
-def relative_energy_residual(residual, friction_work):
-    """|residual| / (|friction work| + |elastic energy change - loading work|), c-free frame.
+def relative_energy_residual(residual, scale):
+    """|residual| / scale, the sum of the magnitudes of the energy balance's terms (D_ENERGY_SCALE).
 
-    In the c-free frame friction b psi can be negative (theta < 1), so the
-    friction work alone is not a safe scale; the two terms balance each other.
-    Works elementwise on arrays of events.
+    In the c-free frame friction b psi changes sign while a block slides, so the
+    friction work of an event can nearly cancel and is no scale (one such event:
+    work -19 against an energy turnover of ~1e5). Works elementwise on arrays of events.
     """
-    return abs(residual) / (abs(friction_work) + abs(residual - friction_work))
+    return abs(residual) / scale
 
 
 def physical_state(u, theta, t, model):
@@ -84,7 +85,7 @@ def run_event(force, psi, epicenter, model, integrator, v_start=0.0):
     d = ws.diag
     return EventResult(status, d[D_SLIP], d[D_DURATION], int(d[D_STEPS]), int(d[D_BLOCK_STEPS]),
                        int(d[D_REJECTED]), int(d[D_CUTS]), d[D_VMAX], d[D_WORK],
-                       d[D_RESIDUAL], profile, force, psi, seconds)
+                       d[D_RESIDUAL], d[D_ENERGY_SCALE], profile, force, psi, seconds)
 
 
 def check(result, what="event"):

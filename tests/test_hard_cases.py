@@ -11,7 +11,7 @@ import pytest
 from ensemble.catalog import Checkpoint
 from ensemble.config import Config, Integrator, Model, Run
 from ensemble.events import relative_energy_residual
-from ensemble.model.workspace import D_RESIDUAL, D_SLIP, D_VMAX, D_WORK
+from ensemble.model.workspace import D_ENERGY_SCALE, D_RESIDUAL, D_SLIP, D_VMAX
 from ensemble.runner import Trajectory
 from ensemble.tasks import task_list
 
@@ -54,7 +54,7 @@ def check_events(label, method, t, diag):
     """Finite, strictly increasing onsets, every event slipped, energy balance; prints the numbers."""
     assert np.all(np.isfinite(diag)) and np.all(np.isfinite(t)) and np.all(np.diff(t) > 0)
     assert np.all(diag[:, D_SLIP] > 0)
-    residual = relative_energy_residual(diag[:, D_RESIDUAL], diag[:, D_WORK])
+    residual = relative_energy_residual(diag[:, D_RESIDUAL], diag[:, D_ENERGY_SCALE])
     mu = np.log10(diag[:, D_SLIP])
     print(f"{label} [{method}]: relative energy residual max {residual.max():.1e} median "
           f"{np.median(residual):.1e}, v_max {diag[:, D_VMAX].max():.0f}, mu {mu.min():.2f}..{mu.max():.2f}, "

@@ -24,7 +24,7 @@ from .onset import onset_delay
 from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
 from .steppers import ark3_step, ark4_step, ark5_step, rk4_step
 from .tableaux import ARK324, ARK436, ARK548
-from .workspace import (D_BLOCK_STEPS, D_CUTS, D_DURATION, D_FIRST, D_LAST, D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP,
+from .workspace import (D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ENERGY_SCALE, D_FIRST, D_LAST, D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP,
                         D_STEPS, D_VMAX, D_WORK, F0, HD0, HD1, K1V, NONFINITE, OK, P, P0, TOO_LONG,
                         TR, UNSTABLE, V, V0, Y, Y0, YS)
 
@@ -370,6 +370,7 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, l2, nu, b, work
     # Energy balance in the c-free frame (derivation in docs of workspace.py):
     # dE - W_load = -sum(y F0) + sum(y^2)/2 + l2 sum(dy^2)/2 - nu tau sum(y) + nu int(sum y)
     e_change = 0.0
+    gross = abs(work)     # the magnitudes of all the terms: the scale of the residual
     for k in range(nt):
         i = touched[k]
         y = W[i, Y]
@@ -379,11 +380,15 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, l2, nu, b, work
             first = min(first, i)
             last = max(last, i)
         e_change += -y * W[i, F0] + 0.5 * y * y
+        gross += abs(y * W[i, F0]) + 0.5 * y * y
         if i + 1 < n:
             e_change += 0.5 * l2 * (W[i + 1, Y] - y) ** 2
+            gross += 0.5 * l2 * (W[i + 1, Y] - y) ** 2
         if i - 1 >= 0 and flag[i - 1] == 0:
             e_change += 0.5 * l2 * (y - W[i - 1, Y]) ** 2
+            gross += 0.5 * l2 * (y - W[i - 1, Y]) ** 2
     e_change += -nu * tau * slip + nu * slip_time
+    gross += nu * tau * slip + nu * slip_time
     diag[D_DURATION] = tau
     diag[D_SLIP] = slip
     diag[D_FIRST] = first
@@ -391,6 +396,7 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, l2, nu, b, work
     diag[D_NSLIP] = nslip
     diag[D_WORK] = work
     diag[D_RESIDUAL] = e_change + work
+    diag[D_ENERGY_SCALE] = gross
     # The touched blocks move to the end time (loading, state grown since they
     # stopped); their untouched neighbours stay at t0, which is just as valid.
     # Then the slip changes the forces (free ends: an end block has one spring).

@@ -17,7 +17,9 @@ duration tau, W_f = int sum(Phi v) dt the friction work, W_load the work of the 
     dE_elastic - W_load = -sum(y F0) + sum(y^2)/2 + l^2 sum((dy)^2)/2
                           - nu tau sum(y) + nu int_0^tau sum(y) dt
 
-so residual = dE_elastic + W_f - W_load needs only the blocks that slipped.
+so residual = dE_elastic + W_f - W_load needs only the blocks that slipped. Its scale
+(D_ENERGY_SCALE) is the sum of the magnitudes of all these terms and of W_f: in the c-free frame
+W_f alone can nearly cancel (b psi changes sign while a block slides), so it is no scale.
 """
 import numpy as np
 
@@ -33,8 +35,8 @@ NCOLS = ARK_G + ARK_STAGES
 
 # entries of the per-event diagnostics vector
 (D_DURATION, D_SLIP, D_FIRST, D_LAST, D_NSLIP, D_WORK, D_RESIDUAL, D_STEPS, D_VMAX,
- D_BLOCK_STEPS, D_REJECTED, D_CUTS) = range(12)
-NDIAG = 12
+ D_BLOCK_STEPS, D_REJECTED, D_CUTS, D_ENERGY_SCALE) = range(13)
+NDIAG = 13
 
 # status codes of the kernels
 OK, NONFINITE, UNSTABLE, TOO_LONG = 0, 1, 2, 3
