@@ -1,7 +1,7 @@
 """Events per second of a developed chain, one core.
 
     python benchmarks/throughput.py [--N 800] [--b 20] [--dt 1e-3] [--method rk4|ark3|ark4|ark5]
-                                    [--rtol 1e-6] [--transient 1000] [--events 2000]
+                                    [--rtol 3e-6] [--transient 1000] [--events 2000]
 
 Runs the transient (not timed, includes compilation), then times `events`
 recorded events and prints events/s, cost per block-step, the magnitude range
@@ -26,7 +26,8 @@ def main():
     p.add_argument("--a", type=float, default=0.0)
     p.add_argument("--dt", type=float, default=1e-3)
     p.add_argument("--method", default="rk4", help="rk4, ark3, ark4 or ark5")
-    p.add_argument("--rtol", type=float, default=1e-6, help="tolerance of the adaptive methods")
+    p.add_argument("--rtol", type=float, default=Integrator().rtol,
+                   help="tolerance of the adaptive methods (default: the config default)")
     p.add_argument("--transient", type=int, default=1000)
     p.add_argument("--events", type=int, default=2000)
     p.add_argument("--seed", type=int, default=0)
