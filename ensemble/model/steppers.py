@@ -10,7 +10,8 @@ the total slip, error estimate relative to the tolerances; 0 for fixed steps).
   ARK4(3)6L[2]SA and ARK5(4)8L[2]SA of Kennedy & Carpenter (2003): explicit for slip and velocity,
   L-stable ESDIRK for the state psi, whose relaxation at rate 1/theta (~ v while
   sliding) is the stiff part. Each implicit stage is one scalar equation per
-  block, solved by Newton. Order p with an embedded estimate of order p - 1 for
+  block, solved by a Halley and a Newton step (more Newton steps in the rare
+  case that is not enough). Order p with an embedded estimate of order p - 1 for
   step-size control. All run the same kernel `_ark_step` with their tableau.
 """
 import math
@@ -120,11 +121,10 @@ def _two_steps(psi, ex, target, hg):
     """(psi, converged): a Halley then a Newton step from psi with ex = exp(-psi), the usual case.
 
     Halley (f'' = -hg exp(-psi)) converges cubically, so the pair solves to
-    round-off from guesses up to ~3e-3 off (two Newton steps: ~3e-4; the
-    fallback is then needed for 6% of ark4's and 15% of ark5's solves instead
-    of several times more, measured on large events). The exp after the first step comes from
-    Taylor (error < step^7 / 5040), valid while that step is below 1e-2;
-    `converged` says whether both held.
+    round-off from guesses up to ~3e-3 off (two Newton steps: ~3e-4); the
+    fallback then takes 6% of ark4's and 15% of ark5's solves on large events.
+    The exp after the first step comes from Taylor (error < step^7 / 5040),
+    valid while that step is below 1e-2; `converged` says whether both held.
     """
     e = hg * ex
     f = psi - e - target
@@ -164,7 +164,7 @@ def _ark_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol, c, ae, ai,
     """One step of the IMEX pair (c, ae, ai, gamma; weights bw, error weights bd = b - bhat).
 
     Stage s: slip and velocity explicit from the earlier stages' rates, psi
-    implicit (one scalar Newton per block) with diagonal gamma.
+    implicit (one scalar solve per block) with diagonal gamma.
     """
     pw = 0.0
     ys = 0.0
@@ -184,7 +184,7 @@ def _ark_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol, c, ae, ai,
             if s == 0:
                 W[i, PS] = r
             else:
-                # the implicit stage psi - hg (exp(-psi) - max(v, 0)) = r: Newton starts from
+                # the implicit stage psi - hg (exp(-psi) - max(v, 0)) = r: the solve starts from
                 # the explicit guess with the previous stage's rate (in KP), raised to at least
                 # the root's lower bound `target` (SY, SV, SP are free scratch here)
                 target = r - hg * (v if v > 0.0 else 0.0)
