@@ -24,9 +24,9 @@ from .onset import onset_delay
 from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
 from .steppers import ark3_step, ark4_step, ark5_step, rk4_step
 from .tableaux import ARK324, ARK436, ARK548
-from .workspace import (D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ENERGY_SCALE, D_FIRST, D_LAST, D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP,
-                        D_STEPS, D_VMAX, D_WORK, F0, HD0, HD1, K1V, NONFINITE, OK, P, P0, TOO_LONG,
-                        TR, UNSTABLE, V, V0, Y, Y0, YS)
+from .workspace import (D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ENERGY_SCALE, D_FIRST, D_LAST, D_NSLIP,
+                        D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK, F0, HD0, HD1, K1V,
+                        NONFINITE, OK, P, P0, TOO_LONG, TR, UNSTABLE, V, V0, Y, Y0, YS)
 
 # integrators (see ensemble.integrators): fixed-step RK4, adaptive IMEX ARK3(2), ARK4(3), ARK5(4)
 RK4, ARK3, ARK4, ARK5 = 0, 1, 2, 3
@@ -379,14 +379,14 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, l2, nu, b, work
             nslip += 1
             first = min(first, i)
             last = max(last, i)
-        e_change += -y * W[i, F0] + 0.5 * y * y
-        gross += abs(y * W[i, F0]) + 0.5 * y * y
+        # the non-negative terms (own and spring energies) count alike in both sums
+        stored = 0.5 * y * y
         if i + 1 < n:
-            e_change += 0.5 * l2 * (W[i + 1, Y] - y) ** 2
-            gross += 0.5 * l2 * (W[i + 1, Y] - y) ** 2
+            stored += 0.5 * l2 * (W[i + 1, Y] - y) ** 2
         if i - 1 >= 0 and flag[i - 1] == 0:
-            e_change += 0.5 * l2 * (y - W[i - 1, Y]) ** 2
-            gross += 0.5 * l2 * (y - W[i - 1, Y]) ** 2
+            stored += 0.5 * l2 * (y - W[i - 1, Y]) ** 2
+        e_change += stored - y * W[i, F0]
+        gross += stored + abs(y * W[i, F0])
     e_change += -nu * tau * slip + nu * slip_time
     gross += nu * tau * slip + nu * slip_time
     diag[D_DURATION] = tau
