@@ -9,7 +9,7 @@ from .model.event import integrate_event
 from .model.onset import onset_delay
 from .model.schedule import build_schedule, tree_min
 from .model.workspace import (D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ENERGY_SCALE, D_REJECTED, D_RESIDUAL, D_SLIP,
-                              D_STEPS, D_VMAX, D_WORK, OK, STATUS_TEXT, Workspace)
+                              D_STEPS, D_VMAX, D_WORK, NTRACE, OK, STATUS_TEXT, Workspace)
 
 
 @dataclass
@@ -68,8 +68,11 @@ def advance_to_onset(force, psi, model):
     return (epicenter, delay, *ws.state((delay, 0.0), model.nu))
 
 
-def run_event(force, psi, epicenter, model, integrator, v_start=0.0):
-    """Integrate one event from the given onset state; returns an EventResult."""
+def run_event(force, psi, epicenter, model, integrator, v_start=0.0, trace=None):
+    """Integrate one event from the given onset state; returns an EventResult.
+
+    `trace`, an array (rows, NTRACE), receives a row per step tried (workspace.TRACE_COLUMNS).
+    """
     n = len(force)
     ws = Workspace(n)
     ws.load(force, psi)
@@ -79,7 +82,8 @@ def run_event(force, psi, epicenter, model, integrator, v_start=0.0):
     clock = np.zeros(2)
     start = time.perf_counter()
     status = integrate_event(*ws.arrays[:7], clock, n, epicenter, v_start, l2, nu, a, b, method, dt,
-                             rtol, atol, h_max, max_duration, max_steps, ws.diag, profile)
+                             rtol, atol, h_max, max_duration, max_steps, ws.diag, profile,
+                             np.zeros((0, NTRACE)) if trace is None else trace)
     seconds = time.perf_counter() - start
     force, psi = ws.state((ws.diag[D_DURATION], 0.0), nu)     # every block at the end
     d = ws.diag

@@ -8,7 +8,8 @@ from ensemble.config import Integrator
 from ensemble.events import check, run_event
 from ensemble.model.steppers import ark3_step, ark4_step, ark5_step
 from ensemble.model.tableaux import ARK324, ARK436, ARK548
-from ensemble.model.workspace import P, P0, V, V0, Y, Y0, YS, Workspace
+from ensemble.model.workspace import (NTRACE, P, P0, T_BLOCK, T_ERROR, T_H, T_OWN, T_PART, T_SLIDING, T_TAU, V,
+                                      V0, Y, Y0, YS, Workspace)
 
 from .conftest import run_cli, write_config
 
@@ -215,6 +216,36 @@ def test_fewer_steps_than_ark3_at_the_same_tolerance(events):
     print(f"block-steps at rtol 1e-6: ark3 {ark3.block_steps}, ark4 {ark4.block_steps}")
     assert ark4.block_steps < ark3.block_steps / 2
     assert abs(ark4.slip - ref.slip) < abs(ark3.slip - ref.slip)
+
+
+@pytest.mark.parametrize("method", ["rk4", "ark4", "ark5"])
+def test_step_trace_accounts_for_every_step(events, method):
+    """Tracing does not change the event, and its rows add up to the event's step counts."""
+    model, evs = events
+    integrator = Integrator(method=method, rtol=1e-6)
+    for f, p, epicenter, _ in evs:
+        plain = check(run_event(f, p, epicenter, model, integrator))
+        trace = np.full((plain.steps + 5, NTRACE), np.nan)
+        traced = check(run_event(f, p, epicenter, model, integrator, trace=trace))
+        assert traced.slip == plain.slip and traced.steps == plain.steps
+        assert np.isnan(trace[plain.steps:]).all()
+        rows = trace[:plain.steps]
+        accepted = rows[:, T_ERROR] <= 1.0
+        assert np.sum(~accepted) == plain.rejected
+        assert rows[accepted, T_SLIDING].sum() == plain.block_steps
+        # accepted steps follow each other (a cut step ends before the next starts)
+        tau, h = rows[accepted, T_TAU], rows[accepted, T_H]
+        assert np.all(np.diff(tau) > 0) and np.all(np.diff(tau) <= h[:-1] + 1e-14 * tau[1:])
+        if method == "rk4":
+            assert np.all(rows[:, T_BLOCK] == -1) and np.all(rows[:, T_ERROR] == 0)
+        else:
+            blocks = rows[:, T_BLOCK]
+            assert np.all((blocks >= 0) & (blocks < len(f))) and set(rows[:, T_PART]) <= {0, 1, 2}
+            # a block whose own error is largest takes the common step: own-step block-steps are
+            # between a tenth of the sliding blocks and all of them, and at least one per step
+            own = rows[accepted, T_OWN]
+            sliding = rows[accepted, T_SLIDING]
+            assert np.all(own <= sliding + 1e-12) and np.all(own >= np.maximum(1.0, 0.1 * sliding) - 1e-12)
 
 
 def test_run_with_ark4(tmp_path):

@@ -4,7 +4,7 @@ import json
 import numpy as np
 import pytest
 
-from benchmarks import cost_scaling, hard_cases, statistics, step_budget, work_precision
+from benchmarks import cost_scaling, hard_cases, statistics, step_budget, step_trace, work_precision
 from benchmarks.baselines import BASELINES
 from benchmarks.common import cost_at_error, ks_distance, parse_setting, wasserstein1
 from ensemble.config import Model
@@ -142,3 +142,26 @@ def test_step_budget_tiny(tmp_path):
     assert all(ns > 0 for ns in data["step_alone_ns"].values())
     text = (tmp_path / "step_budget_N40_b20.txt").read_text()
     assert "speed-up over rk4:dt=1e-3" in text and "one step alone" in text
+
+
+def test_step_trace_tiny(tmp_path):
+    data = step_trace.main(["--N", "40", "--transient", "60", "--sizes", "small:-inf:2", "large:2:inf",
+                            "--runs", "ark4:rtol=1e-5", "ark5:rtol=1e-5", "--out", str(tmp_path)])
+    assert json.loads((tmp_path / "step_trace_N40_b20.json").read_text())["rows"] == data["rows"]
+    assert {(r["event"], r["setting"]) for r in data["rows"]} == {
+        (e, s) for e in ("small", "large") for s in ("ark4:rtol=1e-5", "ark5:rtol=1e-5")}
+    for r in data["rows"]:
+        assert sum(r["part_share"].values()) == pytest.approx(1.0)
+        assert sum(r["phase_share"].values()) == pytest.approx(1.0)
+        assert sum(r["rejected_share"].values()) == pytest.approx(r["rejected"] / r["steps"])
+        assert 1.0 <= r["multirate_bound"] <= r["sliding_per_step"] + 1e-12
+    # one sliding block: nobody to take another step
+    assert all(r["multirate_bound"] == pytest.approx(1.0) for r in data["rows"] if r["sliding_per_step"] == 1.0)
+    with pytest.raises(SystemExit, match="rk4:dt=1e-3 has no error control"):
+        step_trace.main(["--runs", "rk4:dt=1e-3", "--out", str(tmp_path)])
+
+
+def test_phase_of_a_block():
+    v = np.array([300.0, 300.0, 300.0, 0.0, -1.0])
+    psi = np.array([-np.log(300.0) + 1.0, -np.log(300.0) + 0.05, -np.log(300.0) - 1.0, 3.0, 3.0])
+    assert step_trace.phase(v, psi).tolist() == [0, 1, 2, 2, 2]

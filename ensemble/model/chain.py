@@ -16,7 +16,7 @@ import numpy as np
 from .event import integrate_event
 from .onset import onset_delay
 from .schedule import advance_clock, build_schedule, materialize, tree_min
-from .workspace import D_DURATION, D_SLIP, F0, OK, P
+from .workspace import D_DURATION, D_SLIP, F0, NTRACE, OK, P
 
 
 @nb.njit(cache=True)
@@ -32,6 +32,7 @@ def simulate(W, act, flag, touched, stuck, since, tree, diag, clock, l2, nu, a, 
     """
     n = W.shape[0]
     no_profile = np.empty(0)
+    no_trace = np.empty((0, NTRACE))
     if math.isnan(tree[1]):      # a freshly loaded state (Workspace.load): schedule every block
         build_schedule(W, since, tree, nu, b)
     onset = np.empty(2)
@@ -53,7 +54,7 @@ def simulate(W, act, flag, touched, stuck, since, tree, diag, clock, l2, nu, a, 
             W[epicenter, F0] = b * W[epicenter, P]
         status = integrate_event(W, act, flag, touched, stuck, since, tree, clock, n, epicenter, 0.0,
                                  l2, nu, a, b, method, dt, rtol, atol, h_max, max_duration, max_steps,
-                                 diag, no_profile)
+                                 diag, no_profile, no_trace)
         if status != OK:
             return status, k
         t_onset = clock[0] + clock[1]

@@ -22,11 +22,12 @@ import numpy as np
 from .friction import friction, left, right, spring_force
 from .onset import onset_delay
 from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
-from .steppers import ark3_step, ark4_step, ark5_step, rk4_step
+from .steppers import ERROR_WEIGHTS, ark3_step, ark4_step, ark5_step, block_error, rk4_step
 from .tableaux import ARK324, ARK436, ARK548
 from .workspace import (D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ENERGY_SCALE, D_FIRST, D_LAST, D_NSLIP,
-                        D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK, F0, HD0, HD1, K1V,
-                        NONFINITE, OK, P, P0, TOO_LONG, TR, UNSTABLE, V, V0, Y, Y0, YS)
+                        D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK, F0, HD0,
+                        HD1, K1V, NONFINITE, OK, P, P0, T_AGE, T_BLOCK, T_ERROR, T_H, T_OWN, T_PART,
+                        T_PSI, T_SLIDING, T_TAU, T_V, TOO_LONG, TR, TS, UNSTABLE, V, V0, Y, Y0, YS)
 
 # integrators (see ensemble.integrators): fixed-step RK4, adaptive IMEX ARK3(2), ARK4(3), ARK5(4)
 RK4, ARK3, ARK4, ARK5 = 0, 1, 2, 3
@@ -152,6 +153,7 @@ def _start(W, act, na, flag, touched, nt, since, tree, t0, nu, j, tau, yrest):
         nt += 1
     W[j, P] = _rest_psi(W, j, tau)
     W[j, V] = 0.0
+    W[j, TS] = tau
     flag[j] = 1
     act[na] = j
     return na + 1, nt, yrest
@@ -170,8 +172,37 @@ def take_step(method, W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol):
 
 
 @nb.njit(cache=True)
+def _record(trace, row, method, W, act, na, tau, h, err, rtol, atol, expo):
+    """Row `row` of the step trace (workspace.TRACE_COLUMNS) for the step just tried."""
+    trace[row, T_TAU] = tau
+    trace[row, T_H] = h
+    trace[row, T_SLIDING] = na
+    trace[row, T_ERROR] = err
+    trace[row, T_BLOCK] = -1
+    if method == RK4:
+        return
+    # a block whose error is e could have taken a step (err / e)^(1/(q+1)) times longer
+    # (at most 10x: the controller's largest growth over two steps)
+    own = 0.0
+    worst = -1.0
+    for k in range(na):
+        i = act[k]
+        parts = block_error(W, i, h, rtol, atol, ERROR_WEIGHTS[method])
+        e = max(parts)
+        own += 1.0 if err <= 0.0 else min(1.0, max(0.1, (e / err) ** -expo))
+        if e > worst:
+            worst = e
+            trace[row, T_BLOCK] = i
+            trace[row, T_PART] = 0 if e == parts[0] else (1 if e == parts[1] else 2)
+            trace[row, T_AGE] = tau + h - W[i, TS]
+            trace[row, T_V] = W[i, V]
+            trace[row, T_PSI] = W[i, P]
+    trace[row, T_OWN] = own
+
+
+@nb.njit(cache=True)
 def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter, v_start, l2, nu, a,
-                    b, method, dt, rtol, atol, h_max, max_duration, max_steps, diag, profile):
+                    b, method, dt, rtol, atol, h_max, max_duration, max_steps, diag, profile, trace):
     """Integrate one event from the onset of `epicenter` at time t0 until every block is at rest.
 
     On entry every block is at rest, block i with force W[i, F0] and state psi W[i, P]
@@ -184,7 +215,8 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
     state at its end (the schedule updated), the other columns and `flag` are
     zero, and `diag` holds the event summary (see workspace.D_*). If `profile`
     has n entries it receives the slip of every block (else pass an empty
-    array). Returns a status code.
+    array). If `trace` has rows, each step tried fills one (workspace.TRACE_COLUMNS, until the
+    rows run out; a step cut at a located transition appears once, as tried). Returns a status code.
     """
     na, nt, yrest = _start(W, act, 0, flag, touched, 0, since, tree, t0, nu, epicenter, 0.0, 0.0)
     t_far, far = _far_onset(W, flag, n, since, tree, t0, 0.0, l2, nu, b)
@@ -202,6 +234,7 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
     psi_limit = -math.log(v_limit)
     h_next = dt
     expo = _CONTROL_EXPONENT[method]
+    traced = 0
     while na > 0:
         if steps >= max_steps or tau > max_duration:
             status = TOO_LONG
@@ -215,6 +248,9 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
         retried = False
         while True:
             dwork, dslip, err = take_step(method, W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
+            if traced < trace.shape[0]:
+                _record(trace, traced, method, W, act, na, tau, h, err, rtol, atol, expo)
+                traced += 1
             if method == RK4 or err <= 1.0 or h < 1e-12:
                 break
             h *= max(0.2, 0.9 * err ** expo)    # rejected: retry from (Y0, V0, P0)

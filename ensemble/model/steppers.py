@@ -245,14 +245,41 @@ def _ark_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol, c, ae, ai,
         W[i, V] = W[i, V0] + h * dv
         W[i, P] = W[i, P0] + h * dp
         W[i, YS] = W[i, Y]
-        # slip and psi scales are at least 1: a block that just started must not
-        # be held to the relative accuracy of its own vanishing slip (velocity
-        # stays relative: a nucleating block's slow start decides the event)
-        e1 = abs(h * ey) / (atol + rtol * max(abs(W[i, Y0]), abs(W[i, Y]), 1.0))
-        e2 = abs(h * ev) / (atol + rtol * max(abs(W[i, V0]), abs(W[i, V])))
-        e3 = abs(h * ep) / (atol + rtol * max(abs(W[i, P0]), abs(W[i, P]), 1.0))
+        e1, e2, e3 = _error_norms(W, i, h * ey, h * ev, h * ep, rtol, atol)
         err = max(err, e1, e2, e3)
     return pw * h, ys * h, err
+
+
+@nb.njit(cache=True, inline="always")
+def _error_norms(W, i, dy, dv, dp, rtol, atol):
+    """Block i's error estimates (dy, dv, dp) relative to the tolerances: slip, velocity, psi.
+
+    Slip and psi scales are at least 1: a block that just started must not
+    be held to the relative accuracy of its own vanishing slip (velocity
+    stays relative: a nucleating block's slow start decides the event).
+    """
+    return (abs(dy) / (atol + rtol * max(abs(W[i, Y0]), abs(W[i, Y]), 1.0)),
+            abs(dv) / (atol + rtol * max(abs(W[i, V0]), abs(W[i, V]))),
+            abs(dp) / (atol + rtol * max(abs(W[i, P0]), abs(W[i, P]), 1.0)))
+
+
+@nb.njit(cache=True)
+def block_error(W, i, h, rtol, atol, bd):
+    """(slip, velocity, psi) error norms of block i in the adaptive step of size h just taken,
+    from the stages still in W; bd, the method's error weights (ERROR_WEIGHTS[method]).
+
+    For diagnostics (the step trace): the step itself only keeps the largest.
+    """
+    ey = ev = ep = 0.0
+    for s in range(bd.shape[0]):
+        ey += bd[s] * W[i, ARK_V + s]
+        ev += bd[s] * W[i, ARK_A + s]
+        ep += bd[s] * W[i, ARK_G + s]
+    return _error_norms(W, i, h * ey, h * ev, h * ep, rtol, atol)
+
+
+# error weights b - bhat by method code (RK4, ARK3, ARK4, ARK5 as in event.py; RK4 has none)
+ERROR_WEIGHTS = (_D3[:0], _D3, _D4, _D5)
 
 
 @nb.njit(cache=True, error_model="numpy")

@@ -31,12 +31,30 @@ ARK_STAGES = 8
 ARK_V = 20
 ARK_A = ARK_V + ARK_STAGES
 ARK_G = ARK_A + ARK_STAGES
-NCOLS = ARK_G + ARK_STAGES
+# local time at which a block started to slide in this event (for the step trace)
+TS = ARK_G + ARK_STAGES
+NCOLS = TS + 1
 
 # entries of the per-event diagnostics vector
 (D_DURATION, D_SLIP, D_FIRST, D_LAST, D_NSLIP, D_WORK, D_RESIDUAL, D_STEPS, D_VMAX,
  D_BLOCK_STEPS, D_REJECTED, D_CUTS, D_ENERGY_SCALE) = range(13)
 NDIAG = 13
+
+# columns of the optional step trace of an event (one row per step tried, rejected ones included)
+(T_TAU, T_H, T_SLIDING, T_ERROR, T_BLOCK, T_PART, T_AGE, T_V, T_PSI, T_OWN) = range(10)
+NTRACE = 10
+TRACE_COLUMNS = {
+    T_TAU: "local time at the step start",
+    T_H: "step size",
+    T_SLIDING: "sliding blocks",
+    T_ERROR: "error norm of the step (> 1: rejected; 0 for RK4)",
+    T_BLOCK: "block with the largest error (-1 for RK4)",
+    T_PART: "part of that block's error: 0 slip, 1 velocity, 2 state psi",
+    T_AGE: "local time since that block started",
+    T_V: "that block's velocity at the step end",
+    T_PSI: "that block's psi at the step end",
+    T_OWN: "block-steps had every block taken its own step: sum of min(1, max(0.1, (err_i / err)^(1/(q+1))))",
+}
 
 # status codes of the kernels
 OK, NONFINITE, UNSTABLE, TOO_LONG = 0, 1, 2, 3
