@@ -8,6 +8,7 @@ The part before the colon is a kernel integrator (any name in ensemble.integrato
 so new methods work without changes here) or a baseline that only work_precision knows; the
 part after it are keyword arguments (numbers where they parse as numbers).
 """
+import argparse
 import json
 import time
 from dataclasses import dataclass
@@ -127,6 +128,21 @@ def cost_at_error(errors, seconds, target):
             w = np.log(target / e0) / np.log(e1 / e0) if e1 > e0 else 0.0
             return float(np.exp(np.log(s0) + w * (np.log(s1) - np.log(s0)))), "interpolated"
     raise AssertionError("unreachable")
+
+
+def single_event_parser(doc, runs, sizes, runs_help):
+    """The options of the benchmarks on single events from pre-event states of a developed chain:
+    --N, --b, --transient, --seed, --runs (default `runs`), --sizes (default `sizes`), --out."""
+    p = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--N", type=int, default=800, help="blocks")
+    p.add_argument("--b", type=float, default=20.0)
+    p.add_argument("--transient", type=int, default=1000, help="events before the pre-event states are taken")
+    p.add_argument("--seed", type=int, default=0, help="root seed of the developed chain")
+    p.add_argument("--runs", nargs="+", default=runs, help=runs_help)
+    p.add_argument("--sizes", nargs="+", default=sizes, metavar="LABEL:LOW:HIGH",
+                   help="event classes by magnitude, LOW <= mu < HIGH (one event of each)")
+    p.add_argument("--out", default="benchmarks/results")
+    return p
 
 
 def write_outputs(out, stem, data, lines):

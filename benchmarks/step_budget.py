@@ -19,7 +19,6 @@ Every method's speed-up over the first setting (RK4) on an event factors exactly
 which the table prints side by side: how much the step control saves, and how much more each of
 its steps costs. Writes step_budget_N{N}_b{b}.{json,txt}. Default run: about 2 min.
 """
-import argparse
 import time
 
 import numba as nb
@@ -31,7 +30,7 @@ from ensemble.integrators import kernel_args
 from ensemble.model.event import take_step
 from ensemble.model.workspace import F0, NCOLS, P, P0, V, V0, Y, Y0, YS
 
-from .common import parse_setting, write_outputs
+from .common import parse_setting, single_event_parser, write_outputs
 from .work_precision import kernel_event, pre_event_states
 
 RUNS = ["rk4:dt=1e-3", "ark4:rtol=3e-5", "ark4:rtol=1e-5", "ark4:rtol=3e-6", "ark5:rtol=3e-5", "ark5:rtol=1e-5"]
@@ -132,17 +131,9 @@ def table(rows, alone, title):
 
 
 def parse_args(argv=None):
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--N", type=int, default=800, help="blocks")
-    p.add_argument("--b", type=float, default=20.0)
-    p.add_argument("--transient", type=int, default=1000, help="events before the pre-event states are taken")
-    p.add_argument("--seed", type=int, default=0, help="root seed of the developed chain")
-    p.add_argument("--runs", nargs="+", default=RUNS,
-                   help="kernel settings (see benchmarks/common.py); the first is the baseline of the ratios")
+    p = single_event_parser(__doc__, RUNS, SIZES, "kernel settings (see benchmarks/common.py); the first is "
+                                                  "the baseline of the ratios")
     p.add_argument("--reference", default="rk4:dt=1.25e-4", help="kernel setting for the reference slip")
-    p.add_argument("--sizes", nargs="+", default=SIZES, metavar="LABEL:LOW:HIGH",
-                   help="event classes by magnitude, LOW <= mu < HIGH (one event of each)")
-    p.add_argument("--out", default="benchmarks/results")
     return p.parse_args(argv)
 
 

@@ -20,15 +20,13 @@ accepted steps it reports, weighted by block-steps (the work):
 
 Writes step_trace_N{N}_b{b}.{json,txt}. Default run: about 1 min.
 """
-import argparse
-
 import numpy as np
 
 from ensemble.config import Model
 from ensemble.events import check, run_event
 from ensemble.model.workspace import NTRACE, T_ERROR, T_OWN, T_PART, T_PSI, T_SLIDING, T_V
 
-from .common import parse_setting, write_outputs
+from .common import parse_setting, single_event_parser, write_outputs
 from .step_budget import parse_sizes
 from .work_precision import pre_event_states
 
@@ -101,16 +99,8 @@ def table(rows, title):
 
 
 def parse_args(argv=None):
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--N", type=int, default=800, help="blocks")
-    p.add_argument("--b", type=float, default=20.0)
-    p.add_argument("--transient", type=int, default=1000, help="events before the pre-event states are taken")
-    p.add_argument("--seed", type=int, default=0, help="root seed of the developed chain")
-    p.add_argument("--runs", nargs="+", default=RUNS, help="adaptive kernel settings (see benchmarks/common.py)")
-    p.add_argument("--sizes", nargs="+", default=SIZES, metavar="LABEL:LOW:HIGH",
-                   help="event classes by magnitude, LOW <= mu < HIGH (one event of each)")
-    p.add_argument("--out", default="benchmarks/results")
-    return p.parse_args(argv)
+    return single_event_parser(__doc__, RUNS, SIZES, "adaptive kernel settings (see benchmarks/common.py)"
+                               ).parse_args(argv)
 
 
 def main(argv=None):
