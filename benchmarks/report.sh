@@ -6,7 +6,7 @@
 # Runs every benchmark at its default (paper-setting) sizes, one after the other on one core, and
 # writes tables (.txt), data (.json) and figures (.png) into OUT. Expected duration on this
 # machine: about 60 min in all (work precision ~5-10 min, statistics ~25 min,
-# cost scaling ~15-20 min, step budget ~2 min, step trace ~1 min, hard cases ~10 min, throughput ~1 min). Environment: PY (python,
+# cost scaling ~15-20 min, step budget ~4 min, step trace ~1 min, hard cases ~10 min, throughput ~1 min). Environment: PY (python,
 # default .venv/bin/python), JOBS (processes for the statistics run, default 1; 2 halves its time but
 # then two runs share the machine's cores, so its events/s are per process under that load).
 set -euo pipefail
@@ -28,6 +28,7 @@ step "cost per event against N and b"
 "$PY" -m benchmarks.cost_scaling --out "$OUT"
 step "step budget: block-steps per slid block and cost per block-step"
 "$PY" -m benchmarks.step_budget --out "$OUT"
+"$PY" -m benchmarks.step_budget --b 50 --out "$OUT"
 step "step trace: what limits the adaptive step (b = 20 and 50)"
 "$PY" -m benchmarks.step_trace --out "$OUT"
 "$PY" -m benchmarks.step_trace --b 50 --out "$OUT"
