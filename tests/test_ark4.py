@@ -248,6 +248,17 @@ def test_step_trace_accounts_for_every_step(events, method):
             assert np.all(own <= sliding + 1e-12) and np.all(own >= np.maximum(1.0, 0.1 * sliding) - 1e-12)
 
 
+@pytest.mark.parametrize("method", ["ark4", "ark5"])
+def test_pi_control_keeps_rejections_rare(events, method):
+    """PI step control: at most 12% of the steps tried are rejected (measured 2-9% on these events;
+    the plain controller 0.9 err^(-1/(q+1)) rejected ~20% on large events)."""
+    model, evs = events
+    for f, p, epicenter, _ in evs:
+        ev = check(run_event(f, p, epicenter, model, Integrator(method=method, rtol=1e-5)))
+        print(f"{method}: {ev.rejected} of {ev.steps} steps rejected")
+        assert ev.rejected <= 0.12 * ev.steps
+
+
 def test_run_with_ark4(tmp_path):
     cfg = write_config(tmp_path / "c.toml", integrator={"method": "ark4", "rtol": 1e-6},
                        run={"seeds": 1, "events": 30, "transient": 10})
