@@ -36,7 +36,8 @@ _CONTROL_EXPONENT = (0.0,) + tuple(-1.0 / (pair.embedded_order + 1) for pair in 
 # PI control of the accepted steps (Gustafsson; Hairer & Wanner II, sec. IV.2): the next step is
 # h 0.9 err^(-0.7/(q+1)) err_prev^(0.4/(q+1)), err_prev the last accepted step's error. Against the
 # plain 0.9 err^(-1/(q+1)) it halves the rejected steps (ark4, rtol 1e-5, large event: 588 -> 279) and
-# is 1.02-1.15x faster at equal slip error on the step-budget events (b = 20 and 50).
+# is 1.0-1.15x faster at equal slip error on the step-budget events (b = 20 and 50; interpolated
+# between tolerances in benchmarks/results/step_budget_* before and after the change, 9498c4f..565d956).
 _PI_I, _PI_P = 0.7, 0.4
 
 # Stability limit of classical RK4 on the negative real axis: the state equation

@@ -47,7 +47,7 @@ TRACE_COLUMNS = {
     T_TAU: "local time at the step start",
     T_H: "step size",
     T_SLIDING: "sliding blocks",
-    T_ERROR: "error norm of the step (> 1: rejected; 0 for RK4)",
+    T_ERROR: "error norm of the step (> 1: rejected, unless h fell below 1e-12; 0 for RK4)",
     T_BLOCK: "block with the largest error (-1 for RK4)",
     T_PART: "part of that block's error: 0 slip, 1 velocity, 2 state psi",
     T_AGE: "local time since that block started",
