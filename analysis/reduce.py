@@ -9,7 +9,6 @@ so resampling single events would understate the errors.
 """
 from dataclasses import dataclass
 
-import h5py
 import numpy as np
 
 from ensemble import catalog
@@ -61,8 +60,8 @@ def _bin_add(hist, block, values, edges):
     np.add.at(hist, (block[ok], idx[ok]), 1)
 
 
-def reduce_task(h5, task, written, per_task, nu, n_blocks_chain, opt):
-    """Stream one task's events from an open catalog into TaskHistograms."""
+def reduce_task(chunks, written, nu, n_blocks_chain, opt):
+    """Stream one task's events (chunks of opt.chunk rows, dicts of columns) into TaskHistograms."""
     k = opt.blocks
     out = TaskHistograms(np.zeros((k, len(opt.mu_edges) - 1), np.int64),
                          np.zeros((k, len(opt.tnu_edges) - 1), np.int64),
@@ -71,14 +70,10 @@ def reduce_task(h5, task, written, per_task, nu, n_blocks_chain, opt):
     if written == 0:
         return out
     scanner = RecurrenceScanner(n_blocks_chain, opt.mu_c, opt.window)
-    ev = h5["events"]
-    base = task * per_task
-    for lo in range(0, written, opt.chunk):
-        hi = min(lo + opt.chunk, written)
-        t = ev["t"][base + lo:base + hi]
-        mu = ev["mu"][base + lo:base + hi]
-        epicenter = ev["epicenter"][base + lo:base + hi]
-        boundary = ev["boundary"][base + lo:base + hi]
+    lo = 0
+    for ev in chunks:
+        hi = lo + len(ev["t"])
+        t, mu, epicenter, boundary = ev["t"], ev["mu"], ev["epicenter"], ev["boundary"]
         block = (np.arange(lo, hi) * k) // written
         _bin_add(out.mu, block, mu, opt.mu_edges)
         np.add.at(out.numbers[:, stats.N_EVENTS], block, 1)
@@ -95,16 +90,18 @@ def reduce_task(h5, task, written, per_task, nu, n_blocks_chain, opt):
         np.add.at(out.numbers[:, stats.SUM_TNU], rblock, tnu)
         np.add.at(out.numbers[:, stats.N_REC_INT], rblock[interior], 1)
         np.add.at(out.numbers[:, stats.SUM_TNU_INT], rblock[interior], tnu[interior])
+        lo = hi
     return out
 
 
 def reduce_tasks(path, task_indices, opt):
     """TaskHistograms for the given tasks of a catalog (one rank's share)."""
-    per_task, tasks, _ = catalog.read_tasks(path)
     out = {}
-    with h5py.File(path, "r") as h5:
+    with catalog.Reader(path) as cat:
+        tasks = cat.tasks
         for k in task_indices:
-            out[k] = reduce_task(h5, k, int(tasks["events_written"][k]), per_task,
+            # the catalog verifies each task's checksum once its last chunk is read
+            out[k] = reduce_task(cat.task_events(k, opt.chunk), int(tasks["events_written"][k]),
                                  float(tasks["nu"][k]), int(tasks["N"][k]), opt)
     return out
 

@@ -35,7 +35,8 @@ def write(path, source, attrs_in, tasks, per_task, points, opt, force=False):
         h5["bins/mu"] = opt.mu_edges
         h5["bins/tnu"] = opt.tnu_edges
         for name, values in tasks.items():
-            h5[f"tasks/{name}"] = values
+            # text columns (a task's error, its integrator) are stored as UTF-8 bytes
+            h5[f"tasks/{name}"] = np.char.encode(values) if values.dtype.kind == "U" else values
         order = sorted(per_task)
         for name in ("mu", "tnu", "tnu_interior", "numbers"):
             h5[f"per_task/{name}"] = np.stack([getattr(per_task[k], name) for k in order])

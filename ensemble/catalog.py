@@ -22,25 +22,43 @@ killed at any moment leaves a file whose metadata is intact.
     /tasks/{point, seed_index, N, l, nu, a, b, c}    one row per task
     /tasks/events_written   events of the task stored so far
     /tasks/{rank, wall_time, events_per_second, seed_entropy, spawn_key}   provenance
+    /tasks/status      int64  0 open (not started, running or interrupted), 1 finished, 2 failed
+    /tasks/error       bytes  why a failed task failed (empty otherwise)
+    /tasks/integrator  bytes  the task's [integrator] as TOML (a failed task may be rerun with another)
     /checkpoint/state   float64  per task two slots of [force (N), psi (N), since (2N), clock (2)]:
                                  block i's force and psi hold at the two-float time
                                  since[i] = (since[2i], since[2i+1]); clock = (hi, lo) now
     /checkpoint/offset  int64    start of each task's slots in /checkpoint/state
-    /checkpoint/commit  int64    per task [slot in use, events done incl. transient, events written]
-    attributes of /: config (resolved TOML text), version, format
+    /checkpoint/commit  int64    per task and slot: [sequence, events done incl. transient, events
+                                 written, CRC of the state slot, CRC of the written events, CRC of the row]
+    attributes of /: config (resolved TOML text), version, format, events_per_task, transient
 
-A checkpoint is written into the slot not in use, after the events it covers;
-only then the commit row switches to it. A crash between the two leaves the
-previous (slot, counters) pair, which is still complete and consistent.
+Commit order. A batch is committed as: its event rows (past the rows any commit
+points to), then the checkpoint into the slot not in use, then that slot's commit
+row with the next sequence number (a single write of one row), then the
+/tasks/events_written mirror. The commit row with the highest valid sequence is the
+task's truth for readers and for resume; a crash before its write leaves the
+previous row, whose slot and events are untouched, so no crash moment loses or
+double-counts an event (tests/test_faults.py crashes at every write of a batch).
+The serial writer flushes between these steps so that they reach the file in order.
+
+Integrity. Checkpoint slots, each task's event columns and the commit rows carry
+CRC-32 checksums (integrity.py), verified with range checks on resume and on read:
+a corrupt catalog fails naming the task and what is wrong, never resumes or reduces
+silently wrong.
 """
+import ctypes
+import errno
 import os
+from dataclasses import dataclass
 
 import h5py
 import numpy as np
 
 from . import __version__
+from .integrity import EventCrc, commit_crc, crc, event_problems
 
-FORMAT = "bk-catalog-2"
+FORMAT = "bk-catalog-3"
 
 EVENT_FIELDS = {
     "task": np.int64, "t": np.float64, "epicenter": np.int64, "mu": np.float64,
@@ -55,12 +73,36 @@ PROVENANCE_FIELDS = {
     "rank": np.int64, "wall_time": np.float64, "events_per_second": np.float64,
     "seed_entropy": np.int64, "spawn_key": np.int64,
 }
+TEXT_BYTES = 512                      # /tasks/error and /tasks/integrator: fixed-length text
+OPEN, FINISHED, FAILED = 0, 1, 2      # /tasks/status
+STATUS_NAMES = {OPEN: "open", FINISHED: "finished", FAILED: "failed"}
 _FILL = {np.int64: -1, np.float64: np.nan, np.bool_: False}
-COMMIT_SLOT, COMMIT_DONE, COMMIT_WRITTEN = range(3)
+# fields of a commit row (/checkpoint/commit[task, slot])
+C_SEQ, C_DONE, C_WRITTEN, C_STATE_CRC, C_EVENTS_CRC, C_ROW_CRC = range(6)
+NCOMMIT = 6
+READ_CHUNK = 1 << 16                  # rows per column read at a time when verifying events
 
 
 class CatalogError(RuntimeError):
-    """A catalog that cannot be created, written or read; the message names the file."""
+    """A catalog that cannot be created, written or read; the message names the file.
+
+    broken: a write failed, and HDF5 may fail again (or crash) on anything else done with
+    the open file, closing included: the caller should end the process without touching it.
+    collective: raised on every rank alike (no abort of the others is needed).
+    """
+
+    def __init__(self, message, broken=False, collective=False):
+        super().__init__(message)
+        self.broken = broken
+        self.collective = collective
+
+
+def _reason(err):
+    """The useful part of an HDF5 error: its errno text where it names one, else the first line."""
+    text = str(err)
+    if "error message = '" in text:
+        return text.split("error message = '", 1)[1].split("'", 1)[0]
+    return text.splitlines()[0] if text else type(err).__name__
 
 
 def partial_path(path):
@@ -74,6 +116,11 @@ def has_parallel_hdf5():
 
 def _state_size(n):
     return 4 * n + 2
+
+
+def _text(value):
+    data = value.encode()[:TEXT_BYTES]
+    return np.bytes_(data)
 
 
 class Checkpoint:
@@ -92,30 +139,76 @@ class Checkpoint:
                    flat[4 * n:].copy(), int(done))
 
 
-class _Layout:
-    """Structure of a catalog file, created collectively and opened once."""
+@dataclass(frozen=True)
+class Head:
+    """The commit in use of one task: its slot and the fields of its row."""
+    slot: int
+    seq: int
+    done: int
+    written: int
+    state_crc: int
+    events_crc: int
 
-    def __init__(self, h5):
+
+@dataclass
+class TaskRecord:
+    """What a writer knows of a task when a rank takes it up."""
+    checkpoint: Checkpoint = None   # None: start from the initial state
+    written: int = 0                # events stored (the checkpoint covers them)
+    status: int = OPEN
+    integrator: str = ""            # its [integrator] as TOML text
+    error: str = ""
+
+
+class _Layout:
+    """Structure of a catalog file, created collectively and opened once.
+
+    `barrier` is called between the steps of a commit (the serial writer flushes
+    there so that the steps reach the file in order).
+    """
+
+    def __init__(self, h5, barrier=lambda: None):
         self.h5 = h5
-        self.events = {name: h5["events"][name] for name in EVENT_FIELDS}
-        self.tasks = {name: h5["tasks"][name] for name in h5["tasks"]}
-        self.state = h5["checkpoint"]["state"]
-        self.offset = h5["checkpoint"]["offset"][...]
-        self.commit = h5["checkpoint"]["commit"]
-        self.per_task = self.events["t"].shape[0] // max(len(self.offset), 1)
+        self.path = h5.filename
+        self.barrier = barrier
+        try:
+            self.events = {name: h5["events"][name] for name in EVENT_FIELDS}
+            self.tasks = {name: h5["tasks"][name] for name in h5["tasks"]}
+            self.state = h5["checkpoint"]["state"]
+            self.offset = h5["checkpoint"]["offset"][...]
+            self.commit = h5["checkpoint"]["commit"]
+            self.per_task = int(h5.attrs["events_per_task"])
+            self.transient = int(h5.attrs["transient"])
+            self.n_blocks = self.tasks["N"][...]
+        except (KeyError, OSError, ValueError) as err:
+            raise CatalogError(f"{self.path}: damaged catalog ({err})") from None
+        n_tasks = len(self.offset)
+        sizes = 2 * (4 * self.n_blocks + 2)
+        if (self.commit.shape != (n_tasks, 2, NCOMMIT) or len(self.n_blocks) != n_tasks
+                or any(ds.shape[0] != n_tasks * self.per_task for ds in self.events.values())
+                or np.any(self.n_blocks < 2) or self.per_task < 1 or self.transient < 0
+                or np.any(self.offset != np.concatenate([[0], np.cumsum(sizes)[:-1]]))
+                or self.state.shape[0] != int(sizes.sum())):
+            raise CatalogError(f"{self.path}: damaged catalog (its datasets do not fit together)")
+        self.n_tasks = n_tasks
+        self._crc = {}    # task -> EventCrc of its rows written so far (on the writing process)
+        self._head = {}   # task -> Head in use (on the writing process)
 
     @staticmethod
-    def create(h5, cfg, tasks):
+    def create(h5, cfg, tasks, integrator_text):
         """Every dataset and attribute of the catalog (call on every rank with the same values)."""
         rows = len(tasks) * cfg.run.events
         h5.attrs["config"] = cfg.to_toml()
         h5.attrs["version"] = __version__
         h5.attrs["format"] = FORMAT
+        h5.attrs["events_per_task"] = cfg.run.events
+        h5.attrs["transient"] = cfg.run.transient
         ev = h5.create_group("events")
         for name, dtype in EVENT_FIELDS.items():
             # never fill: a full run would otherwise write the whole catalog twice; rows past
-            # /tasks/events_written are undefined and never read
-            ev.create_dataset(name, shape=(rows,), dtype=dtype, fillvalue=_FILL[dtype], fill_time="never")
+            # a task's committed count are undefined and never read
+            ev.create_dataset(name, shape=(rows,), dtype=dtype, fillvalue=_FILL[dtype], fill_time="never",
+                              dcpl=_early_allocation())
         tg = h5.create_group("tasks")
         for name, dtype in TASK_FIELDS.items():
             values = [getattr(t.model, name) if name in ("N", "l", "nu", "a", "b", "c")
@@ -124,48 +217,263 @@ class _Layout:
         tg.create_dataset("events_written", data=np.zeros(len(tasks), dtype=np.int64))
         for name, dtype in PROVENANCE_FIELDS.items():
             tg.create_dataset(name, shape=(len(tasks),), dtype=dtype, fillvalue=_FILL[dtype])
+        tg.create_dataset("status", data=np.full(len(tasks), OPEN, dtype=np.int64))
+        tg.create_dataset("error", shape=(len(tasks),), dtype=f"S{TEXT_BYTES}")
+        tg.create_dataset("integrator", data=np.full(len(tasks), _text(integrator_text), dtype=f"S{TEXT_BYTES}"))
         sizes = np.array([2 * _state_size(t.model.N) for t in tasks], dtype=np.int64)
         offset = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
         cp = h5.create_group("checkpoint")
-        cp.create_dataset("state", shape=(int(sizes.sum()),), dtype=np.float64, fillvalue=np.nan)
+        cp.create_dataset("state", shape=(int(sizes.sum()),), dtype=np.float64, fillvalue=np.nan,
+                          dcpl=_early_allocation())
         cp.create_dataset("offset", data=offset)
-        cp.create_dataset("commit", data=np.tile(np.array([-1, 0, 0], dtype=np.int64), (len(tasks), 1)))
+        cp.create_dataset("commit", data=np.zeros((len(tasks), 2, NCOMMIT), dtype=np.int64))
+
+    def _fail(self, task, what):
+        return CatalogError(f"{self.path}: task {task}: {what} (corrupt catalog)")
+
+    # -- reading and verifying -------------------------------------------------------------
+
+    def head(self, task):
+        """The valid commit row with the highest sequence number, or None if the task has none."""
+        rows = self.commit[task]
+        best = None
+        for slot in (0, 1):
+            row = [int(x) for x in rows[slot]]
+            if not any(row):
+                continue        # never written
+            if row[C_ROW_CRC] != commit_crc(task, slot, row[:C_ROW_CRC]):
+                raise self._fail(task, f"commit row {slot} fails its checksum")
+            seq, done, written = row[C_SEQ], row[C_DONE], row[C_WRITTEN]
+            if not (seq >= 1 and 0 <= written <= self.per_task and written == max(0, done - self.transient)):
+                raise self._fail(task, f"commit row {slot} out of range (sequence {seq}, done {done}, "
+                                       f"written {written})")
+            if best is not None and best.seq == seq:
+                raise self._fail(task, "two commit rows with the same sequence number")
+            if best is None or seq > best.seq:
+                best = Head(slot, seq, done, written, row[C_STATE_CRC], row[C_EVENTS_CRC])
+        return best
+
+    def task_events(self, task, written, chunk=READ_CHUNK):
+        """The task's first `written` events in chunks (dicts of columns), verified as they stream.
+
+        The CRC comparison happens after the last chunk: consume the whole generator.
+        """
+        running = EventCrc(EVENT_FIELDS)
+        base = task * self.per_task
+        last_t = -np.inf
+        for lo in range(0, written, chunk):
+            hi = min(lo + chunk, written)
+            part = {name: ds[base + lo:base + hi] for name, ds in self.events.items()}
+            running.update(part)
+            problems = event_problems(part, int(self.n_blocks[task]))
+            if np.any(part["task"] != task):
+                problems.append("rows of another task")
+            if part["t"][0] < last_t:
+                problems.append("onset times decrease")
+            if problems:
+                raise self._fail(task, f"events {lo}-{hi - 1}: {'; '.join(problems)}")
+            last_t = part["t"][-1]
+            yield part
+        self._check_events(task, written, running)
+        return running
+
+    def _check_events(self, task, written, running):
+        head = self.head(task)
+        expected = head.events_crc if head is not None else EventCrc(EVENT_FIELDS).combined()
+        if head is not None and head.written != written:
+            raise CatalogError(f"{self.path}: task {task}: asked for {written} events, {head.written} committed")
+        if running.combined() != expected:
+            raise self._fail(task, f"its {written} events fail their checksum")
+
+    def verify_events(self, task, written):
+        """EventCrc of the task's first `written` rows, checked against the commit in use."""
+        gen = self.task_events(task, written)
+        while True:
+            try:
+                next(gen)
+            except StopIteration as stop:
+                return stop.value
+
+    def read_state(self, task, head):
+        size = _state_size(int(self.n_blocks[task]))
+        lo = self.offset[task] + head.slot * size
+        flat = self.state[lo:lo + size]
+        if crc(flat) != head.state_crc:
+            raise self._fail(task, f"checkpoint slot {head.slot} fails its checksum")
+        if not np.all(np.isfinite(flat)):
+            raise self._fail(task, f"checkpoint slot {head.slot} holds non-finite values")
+        return Checkpoint.unpack(flat, head.done)
+
+    def record(self, task, restart=False):
+        """The task's TaskRecord, its checkpoint and events verified; the writer's state for it set up.
+
+        restart: the task is taken up from its start (a failed task rerun): nothing is read back.
+        """
+        head = self.head(task)
+        self._head[task] = head
+        rec = TaskRecord(status=int(self.tasks["status"][task]),
+                         integrator=self.tasks["integrator"][task].decode(errors="replace"),
+                         error=self.tasks["error"][task].decode(errors="replace"))
+        if rec.status not in STATUS_NAMES:
+            raise self._fail(task, f"status {rec.status} out of range")
+        if head is None or restart:
+            self._crc[task] = EventCrc(EVENT_FIELDS)
+            return rec
+        self._crc[task] = self.verify_events(task, head.written)
+        rec.checkpoint = self.read_state(task, head)
+        rec.written = head.written
+        return rec
+
+    # -- writing ---------------------------------------------------------------------------
+
+    def _write(self, task, what, fn):
+        with writing(self.path, f"task {task}'s {what}"):
+            fn()
 
     def write_events(self, task, start, batch):
+        running = self._crc[task]
         n = len(batch["t"])
-        if start + n > self.per_task:
-            raise CatalogError(f"{self.h5.filename}: task {task} has more than {self.per_task} events")
+        if start != running.rows or start + n > self.per_task:
+            raise CatalogError(f"{self.path}: task {task}: rows {start}-{start + n - 1} do not follow "
+                               f"the {running.rows} written (of at most {self.per_task})")
         lo = task * self.per_task + start
-        for name in EVENT_FIELDS:
-            self.events[name][lo:lo + n] = batch[name]
+
+        def write():
+            for name in EVENT_FIELDS:
+                self.events[name][lo:lo + n] = batch[name]
+        self._write(task, "events", write)
+        running.update(batch)
 
     def write_checkpoint(self, task, checkpoint, written):
-        slot = 1 - int(self.commit[task, COMMIT_SLOT]) if self.commit[task, COMMIT_SLOT] >= 0 else 0
+        running = self._crc[task]
+        if written != running.rows:
+            raise CatalogError(f"{self.path}: task {task}: checkpoint for {written} events, "
+                               f"{running.rows} written")
+        head = self._head.get(task)
+        slot = 0 if head is None else 1 - head.slot
+        seq = 1 if head is None else head.seq + 1
         flat = checkpoint.pack()
         lo = self.offset[task] + slot * len(flat)
-        self.state[lo:lo + len(flat)] = flat
-        self.commit[task] = np.array([slot, checkpoint.done, written], dtype=np.int64)
-        self.tasks["events_written"][task] = written
-
-    def read_checkpoint(self, task, n):
-        slot, done, written = (int(x) for x in self.commit[task])
-        if slot < 0:
-            return None, 0
-        size = _state_size(n)
-        lo = self.offset[task] + slot * size
-        return Checkpoint.unpack(self.state[lo:lo + size], done), written
+        self._write(task, "checkpoint", lambda: self.state.__setitem__(slice(lo, lo + len(flat)), flat))
+        self.barrier()
+        fields = [seq, checkpoint.done, written, crc(flat), running.combined()]
+        row = np.array(fields + [commit_crc(task, slot, fields)], dtype=np.int64)
+        self._write(task, "commit row", lambda: self.commit.__setitem__((task, slot), row))
+        self._head[task] = Head(slot, seq, checkpoint.done, written, fields[3], fields[4])
+        self._write(task, "event count", lambda: self.tasks["events_written"].__setitem__(task, written))
+        self.barrier()
 
     def write_provenance(self, task, values):
-        for name, value in values.items():
-            self.tasks[name][task] = value
+        def write():
+            for name, value in values.items():
+                self.tasks[name][task] = value
+            self.tasks["status"][task] = FINISHED
+        self._write(task, "provenance", write)
+
+    def write_failure(self, task, message):
+        def write():
+            self.tasks["error"][task] = _text(message)
+            self.tasks["status"][task] = FAILED
+        self._write(task, "failure record", write)
+
+    def write_start(self, task, integrator_text):
+        """A task taken up from its start (again): its integrator, status open, no error."""
+        def write():
+            self.tasks["integrator"][task] = _text(integrator_text)
+            self.tasks["error"][task] = _text("")
+            self.tasks["status"][task] = OPEN
+        self._write(task, "start record", write)
+
+
+class writing:
+    """Context of a write: any HDF5 failure becomes one CatalogError (broken) naming the file and what."""
+
+    def __init__(self, path, what):
+        self.path, self.what = path, what
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, err, tb):
+        if err is None or isinstance(err, CatalogError) or not isinstance(err, Exception):
+            return False
+        raise CatalogError(f"{self.path}: writing {self.what} failed ({_reason(err)}); what was committed "
+                           f"before stays readable; continue with `python -m ensemble resume`",
+                           broken=True) from None
+
+
+def _early_allocation():
+    """Dataset creation properties: file space allocated at creation, so the file's layout
+    (and its metadata) never changes afterwards (serial HDF5 would allocate at the first write)."""
+    dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)
+    dcpl.set_alloc_time(h5py.h5d.ALLOC_TIME_EARLY)
+    return dcpl
+
+
+def _reserve_space(path):
+    """Reserve the file's disk blocks now where the file system does that at once (fallocate).
+
+    Then a full disk stops a run at its start, not hours later; where fallocate is not
+    supported (some network file systems) nothing is reserved and a write that fails
+    later ends the run with a clear error instead.
+    """
+    libc = ctypes.CDLL(None, use_errno=True)
+    fallocate = getattr(libc, "fallocate", None)
+    if fallocate is None:
+        return
+    fallocate.argtypes = (ctypes.c_int, ctypes.c_int, ctypes.c_int64, ctypes.c_int64)
+    fd = os.open(path, os.O_RDWR)
+    try:
+        size = os.fstat(fd).st_size
+        if size and fallocate(fd, 0, 0, size) != 0:
+            err = ctypes.get_errno()
+            if err in (errno.ENOSPC, errno.EDQUOT, errno.EFBIG):
+                raise OSError(err, f"{os.strerror(err)}: the catalog needs {size / 2**20:.1f} MiB")
+    finally:
+        os.close(fd)
+
+
+def _create_file(path, open_file, cfg, tasks, integrator_text, reserve=True):
+    """Create a catalog; on failure remove what was made (we hold the run's lock) and raise CatalogError.
+
+    reserve: this process reserves the disk space (one rank of a parallel create).
+    """
+    h5 = None
+    try:
+        h5 = open_file(path, "w")
+        _Layout.create(h5, cfg, tasks, integrator_text)
+        h5.flush()
+        if reserve:
+            _reserve_space(path)
+        return h5
+    except (OSError, ValueError, RuntimeError) as err:
+        if h5 is not None:
+            try:
+                h5.close()
+            except Exception:  # noqa: BLE001 - already failing; the first error is the one to report
+                pass
+        try:
+            os.remove(path)
+        except OSError:
+            pass
+        raise CatalogError(f"{path}: cannot create catalog ({err})") from None
+
+
+def _open_file(path, open_file):
+    try:
+        h5 = open_file(path, "r+")
+    except OSError as err:
+        raise CatalogError(f"{path}: cannot open catalog ({err})") from None
+    _check_format(h5, path)
+    return h5
 
 
 class _Writer:
-    """Common API of the writers: commit(task, start, batch, checkpoint), finish(task, provenance)."""
+    """Common API of the writers: record, commit, finish, fail, start, poll, close."""
 
-    def resume_point(self, task, n):
-        """(Checkpoint or None, events written) of a task in this catalog."""
-        return self.layout.read_checkpoint(task, n)
+    def record(self, task, restart=False):
+        """TaskRecord of a task in this catalog (verified; restart: taken up from its start)."""
+        return self.layout.record(task, restart)
 
 
 class ParallelWriter(_Writer):
@@ -173,17 +481,24 @@ class ParallelWriter(_Writer):
 
     name = "parallel HDF5 (mpio), independent writes"
 
-    def __init__(self, path, comm, cfg=None, tasks=None):
+    def __init__(self, path, comm, cfg=None, tasks=None, integrator_text=""):
         self.comm = comm
-        mode = "w" if cfg is not None else "r+"
+
+        def open_file(p, mode):
+            return h5py.File(p, mode, driver="mpio", comm=comm)
+        error = None
         try:
-            self.h5 = h5py.File(path, mode, driver="mpio", comm=comm)
-        except OSError as err:
-            raise CatalogError(f"{path}: cannot open catalog ({err})") from None
-        if cfg is not None:
-            _Layout.create(self.h5, cfg, tasks)
-            self.h5.flush()
-        self.layout = _Layout(self.h5)
+            if cfg is not None:
+                self.h5 = _create_file(path, open_file, cfg, tasks, integrator_text,
+                                       reserve=comm.Get_rank() == 0)
+            else:
+                self.h5 = _open_file(path, open_file)
+            self.layout = _Layout(self.h5)
+        except CatalogError as err:
+            error = str(err)
+        errors = [e for e in comm.allgather(error) if e]
+        if errors:
+            raise CatalogError(errors[0], collective=True)
 
     def commit(self, task, start, batch, checkpoint):
         if batch is not None:
@@ -193,13 +508,20 @@ class ParallelWriter(_Writer):
     def finish(self, task, provenance):
         self.layout.write_provenance(task, provenance)
 
+    def fail(self, task, message):
+        self.layout.write_failure(task, message)
+
+    def start(self, task, integrator_text):
+        self.layout.write_start(task, integrator_text)
+
     def poll(self):
         pass
 
     def close(self):
         """Collective."""
         self.layout = None
-        self.h5.close()
+        with writing(self.h5.filename, "the end of the run"):
+            self.h5.close()
 
 
 class Rank0Writer(_Writer):
@@ -207,70 +529,98 @@ class Rank0Writer(_Writer):
 
     Rank 0 writes incoming rows whenever it polls (between kernel calls) and,
     at the end, until every rank has said it is done. With one rank this is a
-    plain serial writer.
+    plain serial writer. Every message is served where it arrives, in `poll` or in
+    `close`, and each rank's "done" is counted wherever it was received.
     """
 
     name = "serial HDF5 on rank 0, rows sent by message"
     TAG = 17
 
-    def __init__(self, path, comm, cfg=None, tasks=None):
+    def __init__(self, path, comm, cfg=None, tasks=None, integrator_text=""):
         self.comm = comm
         self.rank = comm.Get_rank()
         self.layout = None
+        self.finished_ranks = 0
         error = None
         if self.rank == 0:
             try:
-                self.h5 = h5py.File(path, "w" if cfg is not None else "r+")
                 if cfg is not None:
-                    _Layout.create(self.h5, cfg, tasks)
-                    self.h5.flush()
-                self.layout = _Layout(self.h5)
-            except OSError as err:
-                error = f"{path}: cannot open catalog ({err})"
+                    self.h5 = _create_file(path, h5py.File, cfg, tasks, integrator_text)
+                else:
+                    self.h5 = _open_file(path, h5py.File)
+                self.layout = _Layout(self.h5, barrier=self._flush)
+            except CatalogError as err:
+                error = str(err)
         error = comm.bcast(error, root=0)
         if error:
-            raise CatalogError(error)
+            raise CatalogError(error, collective=True)
 
-    def resume_point(self, task, n):
-        # Only rank 0 can read the file: ask it (it answers while polling).
+    def _call(self, kind, *args):
+        """Do `kind` here (rank 0) or ask rank 0 to."""
         if self.rank == 0:
-            return self.layout.read_checkpoint(task, n)
-        self.comm.send(("read", task, n), dest=0, tag=self.TAG)
-        return self.comm.recv(source=0, tag=self.TAG + 1)
+            return self._do(kind, *args)
+        self.comm.send((kind, *args), dest=0, tag=self.TAG)
+        if kind == "record":
+            answer = self.comm.recv(source=0, tag=self.TAG + 1)
+            if isinstance(answer, Exception):
+                raise answer
+            return answer
+        return None
+
+    def record(self, task, restart=False):
+        return self._call("record", task, restart)
 
     def commit(self, task, start, batch, checkpoint):
-        if self.rank == 0:
-            self._commit(task, start, batch, checkpoint)
-        else:
-            self.comm.send(("commit", task, start, batch, checkpoint), dest=0, tag=self.TAG)
+        self._call("commit", task, start, batch, checkpoint)
 
     def finish(self, task, provenance):
-        if self.rank == 0:
-            self.layout.write_provenance(task, provenance)
-            self.h5.flush()
-        else:
-            self.comm.send(("finish", task, provenance), dest=0, tag=self.TAG)
+        self._call("finish", task, provenance)
 
-    def _commit(self, task, start, batch, checkpoint):
-        if batch is not None:
-            self.layout.write_events(task, start, batch)
-        self.h5.flush()   # events reach the file before the commit row points past them
-        self.layout.write_checkpoint(task, checkpoint, start + (0 if batch is None else len(batch["t"])))
-        self.h5.flush()
+    def fail(self, task, message):
+        self._call("fail", task, message)
+
+    def start(self, task, integrator_text):
+        self._call("start", task, integrator_text)
+
+    def _flush(self):
+        with writing(self.h5.filename, "buffered data"):
+            self.h5.flush()
+
+    def _do(self, kind, *args):
+        layout = self.layout
+        if kind == "record":
+            return layout.record(*args)
+        if kind == "commit":
+            task, start, batch, checkpoint = args
+            if batch is not None:
+                layout.write_events(task, start, batch)
+                self._flush()   # events reach the file before the commit row points past them
+            layout.write_checkpoint(task, checkpoint, start + (0 if batch is None else len(batch["t"])))
+        elif kind == "finish":
+            layout.write_provenance(*args)
+        elif kind == "fail":
+            layout.write_failure(*args)
+        elif kind == "start":
+            layout.write_start(*args)
+        if kind in ("finish", "fail", "start"):
+            self._flush()
+        return None
 
     def _serve(self, status):
-        """Carry out one request of another rank; returns its kind."""
-        msg = self.comm.recv(source=status.Get_source(), tag=self.TAG)
+        """Carry out one request of another rank."""
+        source = status.Get_source()
+        msg = self.comm.recv(source=source, tag=self.TAG)
         kind = msg[0]
-        if kind == "commit":
-            self._commit(*msg[1:])
-        elif kind == "finish":
-            self.layout.write_provenance(msg[1], msg[2])
-            self.h5.flush()
-        elif kind == "read":
-            self.comm.send(self.layout.read_checkpoint(msg[1], msg[2]), dest=status.Get_source(),
-                           tag=self.TAG + 1)
-        return kind
+        if kind == "done":
+            self.finished_ranks += 1
+        elif kind == "record":
+            try:
+                answer = self._do(*msg)
+            except CatalogError as err:   # the asking rank raises it (and aborts the job)
+                answer = err
+            self.comm.send(answer, dest=source, tag=self.TAG + 1)
+        else:
+            self._do(*msg)
 
     def poll(self):
         if self.rank != 0:
@@ -284,14 +634,13 @@ class Rank0Writer(_Writer):
         """Collective: rank 0 serves every other rank until each has sent 'done'."""
         from mpi4py import MPI
         if self.rank == 0:
-            waiting = self.comm.Get_size() - 1
             status = MPI.Status()
-            while waiting:
+            while self.finished_ranks < self.comm.Get_size() - 1:
                 self.comm.Probe(source=MPI.ANY_SOURCE, tag=self.TAG, status=status)
-                if self._serve(status) == "done":
-                    waiting -= 1
+                self._serve(status)
             self.layout = None
-            self.h5.close()
+            with writing(self.h5.filename, "the end of the run"):
+                self.h5.close()
         else:
             self.comm.send(("done",), dest=0, tag=self.TAG)
         self.comm.Barrier()
@@ -309,13 +658,9 @@ def choose_writer(name, comm):
     return WRITERS[name]
 
 
-def _open_for_reading(path):
-    if not os.path.exists(path):
-        raise CatalogError(f"{path}: no such catalog")
-    try:
-        h5 = h5py.File(path, "r")
-    except OSError as err:
-        raise CatalogError(f"{path}: cannot read catalog ({err})") from None
+# -- reading --------------------------------------------------------------------------------
+
+def _check_format(h5, path):
     found = h5.attrs.get("format")
     if found != FORMAT:
         h5.close()
@@ -323,25 +668,82 @@ def _open_for_reading(path):
             raise CatalogError(f"{path}: catalog format {found}, this version reads {FORMAT} "
                                "(the checkpoint layout changed; rerun, or read it with the older version)")
         raise CatalogError(f"{path}: not an event catalog of this package")
+
+
+def _open_for_reading(path):
+    """Open read-only without HDF5's file lock: a catalog may be read while a run writes it.
+
+    That is safe because a catalog's metadata is complete and flushed at creation and
+    never changes afterwards; what a run is writing lies beyond the commit rows read here.
+    """
+    if not os.path.exists(path):
+        raise CatalogError(f"{path}: no such catalog")
+    if os.path.isdir(path):
+        raise CatalogError(f"{path}: is a directory, not a catalog")
+    try:
+        h5 = h5py.File(path, "r", locking=False)
+    except OSError as err:
+        raise CatalogError(f"{path}: cannot read catalog ({err})") from None
+    _check_format(h5, path)
     return h5
 
 
+class Reader:
+    """A catalog open for reading: its tasks (committed counts from the commit rows) and events.
+
+        with catalog.Reader(path) as cat:
+            for chunk in cat.task_events(k):    # dicts of columns, verified as they stream
+                ...
+    """
+
+    def __init__(self, path):
+        self.path = str(path)
+        self.h5 = _open_for_reading(self.path)
+        try:
+            self.layout = _Layout(self.h5)
+            self.attrs = {k: self.h5.attrs[k] for k in self.h5.attrs}
+            self.per_task = self.layout.per_task
+            self.tasks = {name: ds[...] for name, ds in self.layout.tasks.items()}
+            heads = [self.layout.head(k) for k in range(self.layout.n_tasks)]
+        except BaseException:
+            self.h5.close()
+            raise
+        self.tasks["events_written"] = np.array([0 if h is None else h.written for h in heads], dtype=np.int64)
+        self.tasks["events_done"] = np.array([0 if h is None else h.done for h in heads], dtype=np.int64)
+        for name in ("error", "integrator"):
+            self.tasks[name] = np.array([x.decode(errors="replace") for x in self.tasks[name]])
+
+    def task_events(self, task, chunk=READ_CHUNK):
+        """The task's committed events in chunks; raises CatalogError if they are corrupt."""
+        return self.layout.task_events(task, int(self.tasks["events_written"][task]), chunk)
+
+    def events(self):
+        """Every committed event (dict of arrays, tasks in order), verified."""
+        parts = [part for k in range(self.layout.n_tasks) for part in self.task_events(k)]
+        if not parts:
+            return {name: np.zeros(0, dtype=dtype) for name, dtype in EVENT_FIELDS.items()}
+        return {name: np.concatenate([p[name] for p in parts]) for name in EVENT_FIELDS}
+
+    def close(self):
+        self.h5.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
 def read_tasks(path):
-    """Catalog -> (rows per task, tasks: dict of arrays, attrs: dict), without the events."""
-    with _open_for_reading(path) as h5:
-        layout = _Layout(h5)
-        tasks = {name: ds[...] for name, ds in layout.tasks.items()}
-        attrs = {k: h5.attrs[k] for k in h5.attrs}
-        return layout.per_task, tasks, attrs
+    """Catalog -> (rows per task, tasks: dict of arrays, attrs: dict), without the events.
+
+    tasks["events_written"] is each task's committed event count (from its commit row).
+    """
+    with Reader(path) as cat:
+        return cat.per_task, cat.tasks, cat.attrs
 
 
 def read(path):
-    """Catalog -> (events: dict of arrays with only the written rows, tasks: dict, attrs: dict)."""
-    with _open_for_reading(path) as h5:
-        layout = _Layout(h5)
-        tasks = {name: ds[...] for name, ds in layout.tasks.items()}
-        rows = np.concatenate([np.arange(k * layout.per_task, k * layout.per_task + n)
-                               for k, n in enumerate(tasks["events_written"])] or [np.zeros(0, int)])
-        events = {name: ds[...][rows] for name, ds in layout.events.items()}
-        attrs = {k: h5.attrs[k] for k in h5.attrs}
-    return events, tasks, attrs
+    """Catalog -> (events: dict of arrays with only the committed rows, verified, tasks, attrs)."""
+    with Reader(path) as cat:
+        return cat.events(), cat.tasks, cat.attrs

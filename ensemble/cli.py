@@ -1,16 +1,20 @@
-"""Command line: python -m ensemble run|validate|status|slurm ...
+"""Command line: python -m ensemble run|resume|validate|status|slurm ...
 
 Under mpirun every rank runs the same command. An exception on any rank is
 printed with the rank (and the task, where there is one) and aborts all ranks
 at once, instead of leaving the others hanging in MPI.
 """
 import argparse
+import os
+import signal
 import sys
 import time
+import tomllib
 
 from . import __version__
-from .catalog import CatalogError
-from .config import ConfigError, load, replace
+from .catalog import CatalogError, partial_path, read_tasks
+from .config import ConfigError, from_dict, load, parse_override, replace
+from .lock import LockError
 
 ABORT_GRACE_SECONDS = 1.0
 
@@ -28,6 +32,13 @@ def _parser():
     run.add_argument("-o", "--output", help="catalog path (default: output.path of the config)")
     run.add_argument("--force", action="store_true", help="overwrite an existing catalog")
     run.add_argument("--resume", action="store_true", help="continue an interrupted run from its checkpoints")
+    res = sub.add_parser("resume", help="continue an interrupted or partly failed run from its catalog's "
+                                        "stored config")
+    res.add_argument("catalog", help="catalog path (PATH or PATH.partial)")
+    res.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
+                     help="integrator.KEY=VALUE reruns the failed tasks from their start with that "
+                          "integrator; output.KEY=VALUE and run.poll_seconds=VALUE change how the run "
+                          "goes on (repeatable)")
     st = sub.add_parser("status", help="summarise a catalog (finished, or being written)")
     st.add_argument("catalog", help="catalog path (PATH.partial is found automatically)")
     from .slurm import add_arguments
@@ -58,29 +69,89 @@ def _status(args):
     return 0
 
 
+# what `resume` may change: how the run goes on, and the integrator of the failed tasks
+_RESUMABLE = {"integrator": None, "output": None, "run": ("poll_seconds",)}
+
+
+def _resume_config(args):
+    """(stored config with the allowed overrides, catalog path, [integrator] to rerun failed tasks or None)."""
+    path = str(args.catalog).removesuffix(".partial")
+    partial = partial_path(path)
+    if not os.path.exists(partial):
+        return None, path, None
+    _, tasks, attrs = read_tasks(partial)
+    raw = tomllib.loads(attrs["config"])
+    rerun = False
+    for text in args.set:
+        section, key, value = parse_override(text)
+        allowed = _RESUMABLE.get(section, ())
+        if (allowed is not None and key not in allowed) or (section, key) == ("output", "path"):
+            raise ConfigError(f"--set {section}.{key}: resume continues the stored run and cannot change it "
+                              f"(only integrator.*, output.* and run.poll_seconds); start a new run instead")
+        raw.setdefault(section, {})[key] = value
+        rerun = rerun or section == "integrator"
+    raw.setdefault("output", {})["path"] = path
+    cfg = from_dict(raw)
+    return cfg, path, cfg.integrator if rerun else None
+
+
+def _late_signal(signum, frame):
+    """After the work (and before it starts): a signal is acknowledged, not obeyed, so that a
+    run that has renamed its catalog cannot end with the signal's exit status over a good catalog."""
+    os.write(2, f"{signal.Signals(signum).name} received outside the work loop: ignored\n".encode())
+
+
 def _run(args):
     from mpi4py import MPI
 
-    from .runner import run
+    from .parallel import INTERRUPT_SIGNALS
+    from .runner import Refused, run
     comm = MPI.COMM_WORLD
     rank = comm.Get_rank()
+    for sig in INTERRUPT_SIGNALS:
+        signal.signal(sig, _late_signal)
     try:
+        command = " ".join(["python -m ensemble", *sys.argv[1:]])
+        if args.command == "resume":
+            cfg, path, rerun = _resume_config(args)
+            if cfg is None:
+                if os.path.exists(path):
+                    if rank == 0:
+                        print(f"{path} is complete; nothing to resume")
+                    return 0
+                raise Refused(f"{partial_path(path)}: no interrupted run to resume")
+            return run(cfg, path, comm, resume=True, rerun=rerun, command=command)
         cfg = _config(args)
-        return run(cfg, cfg.output.path, comm, resume=args.resume, force=args.force)
-    except (ConfigError, CatalogError) as err:
+        return run(cfg, cfg.output.path, comm, resume=args.resume, force=args.force, command=command)
+    except (ConfigError, LockError, Refused) as err:
         # raised on every rank alike (decisions are made on rank 0 and broadcast)
         if rank == 0:
             print(f"error: {err}", file=sys.stderr, flush=True)
-        return 2 if isinstance(err, ConfigError) else 1
-    except Exception as err:  # noqa: BLE001 - the guard that turns any failure into an abort
-        print(f"error: rank {rank}: {err}", file=sys.stderr, flush=True)
-        if comm.Get_size() > 1:
-            # MPI_Abort makes the process manager kill every rank, and what a rank
-            # wrote to its stderr pipe but the manager has not yet forwarded is lost
-            # (seen with MPICH's Hydra): give the message a moment to get out.
-            time.sleep(ABORT_GRACE_SECONDS)
-            comm.Abort(1)
+        return 2
+    except CatalogError as err:
+        if comm.Get_size() > 1 and not err.collective:
+            _abort(comm, rank, err)
+        if rank == 0 or not err.collective:
+            print(f"error: {err}", file=sys.stderr, flush=True)
+        if err.broken:
+            # HDF5 crashes when the broken file's objects are freed at exit: leave at once
+            sys.stdout.flush()
+            os._exit(1)
         return 1
+    except Exception as err:  # noqa: BLE001 - the guard that turns any failure into an abort
+        _abort(comm, rank, err)
+        return 1
+
+
+def _abort(comm, rank, err):
+    """Print the error of this rank; with more ranks, abort them all (serial: the caller returns 1)."""
+    print(f"error: rank {rank}: {err}", file=sys.stderr, flush=True)
+    if comm.Get_size() > 1:
+        # MPI_Abort makes the process manager kill every rank, and what a rank
+        # wrote to its stderr pipe but the manager has not yet forwarded is lost
+        # (seen with MPICH's Hydra): give the message a moment to get out.
+        time.sleep(ABORT_GRACE_SECONDS)
+        comm.Abort(1)
 
 
 def _slurm(args):
@@ -91,7 +162,8 @@ def _slurm(args):
 def main(argv=None):
     args = _parser().parse_args(argv)
     try:
-        return {"run": _run, "validate": _validate, "status": _status, "slurm": _slurm}[args.command](args)
+        return {"run": _run, "resume": _run, "validate": _validate, "status": _status,
+                "slurm": _slurm}[args.command](args)
     except (ConfigError, CatalogError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2 if isinstance(err, ConfigError) else 1

@@ -9,6 +9,7 @@ once per task (take a task, count it done), so that wait is paid once per task,
 not per kernel call; the run-wide event counts for the progress line travel as
 non-blocking messages instead.
 """
+import os
 import signal
 import time
 
@@ -38,6 +39,7 @@ class Coordinator:
         self.signal_name = None
         self._local_signal = None
         self._old_handlers = {}
+        self.busy_with = None    # what this rank does that cannot be interrupted (said when signalled)
         self._sent = {tag: np.zeros(self.size, dtype=np.int64) for tag in (STOP_TAG, COUNT_TAG)}
         self._received = {tag: np.zeros(self.size, dtype=np.int64) for tag in (STOP_TAG, COUNT_TAG)}
         self._requests = []
@@ -124,6 +126,10 @@ class Coordinator:
 
     def _on_signal(self, signum, frame):
         self._local_signal = signal.Signals(signum).name
+        if self.busy_with:
+            # acknowledged at once (os.write: no buffered I/O inside a signal handler)
+            os.write(2, f"rank {self.rank}: {self._local_signal} received while {self.busy_with}; "
+                        f"the run stops as soon as that is done\n".encode())
 
     def poll(self):
         """Make MPI progress; True once a stop was requested here or on any other rank."""

@@ -4,15 +4,20 @@ The same code runs serially (one rank, no mpirun) and under MPI. Each task is
 one trajectory on one rank; its seed comes from its index, so results do not
 depend on the number of ranks or on which rank ran a task.
 """
+import glob
 import os
+import sys
 import time
+import tomllib
+from dataclasses import fields
 
 import numpy as np
 
 from . import catalog
-from .catalog import Checkpoint, CatalogError
-from .config import ConfigError, loads
+from .catalog import FAILED, FINISHED, Checkpoint, CatalogError
+from .config import ConfigError, _toml_value, from_dict, loads
 from .integrators import kernel_args
+from .lock import RunLock
 from .model.chain import simulate
 from .model.workspace import (D_DURATION, D_FIRST, D_LAST, D_NSLIP, D_SLIP, NDIAG, OK,
                               STATUS_TEXT, Workspace)
@@ -20,6 +25,11 @@ from .parallel import Coordinator
 from .tasks import initial_state, task_list
 
 EXIT_INTERRUPTED = 75   # checkpointed after a signal; continue with --resume (EX_TEMPFAIL)
+EXIT_FAILED = 1         # some tasks failed (recorded in the catalog); the others finished
+
+
+class Refused(RuntimeError):
+    """The run was refused before any work (output exists, is in use, or cannot be written)."""
 
 
 class SimulationError(RuntimeError):
@@ -29,9 +39,10 @@ class SimulationError(RuntimeError):
 class Trajectory:
     """One task's chain between events: its workspace, clock and event counter."""
 
-    def __init__(self, cfg, task, checkpoint=None):
+    def __init__(self, cfg, task, checkpoint=None, integrator=None):
         self.cfg = cfg
         self.task = task
+        self.integrator = cfg.integrator if integrator is None else integrator
         self.ws = Workspace(task.model.N)
         if checkpoint is None:
             self.ws.load(*initial_state(cfg, task))
@@ -41,7 +52,7 @@ class Trajectory:
             self.ws.load(checkpoint.force, checkpoint.psi, checkpoint.since)
             self.clock = checkpoint.clock.copy()
             self.done = checkpoint.done
-        self.args = kernel_args(task.model, cfg.integrator)
+        self.args = kernel_args(task.model, self.integrator)
 
     def checkpoint(self):
         ws = self.ws
@@ -62,7 +73,8 @@ class Trajectory:
             where = self.done + k
             phase = "transient " if where < self.cfg.run.transient else ""
             raise SimulationError(f"task {self.task.index} {phase}event {where}: {STATUS_TEXT[status]} "
-                                  f"(method={self.cfg.integrator.method}, dt={self.cfg.integrator.dt})")
+                                  f"(method={self.integrator.method}, dt={self.integrator.dt}, "
+                                  f"rtol={self.integrator.rtol})")
         self.done += n
         return t, epicenter, diag
 
@@ -79,54 +91,116 @@ def event_rows(task, t, epicenter, diag):
     }
 
 
-class Progress:
-    """Rank 0's progress line at a steady interval (fit for a log file)."""
+def integrator_text(integrator):
+    """A task's [integrator] as TOML text (stored per task in the catalog)."""
+    return "\n".join(f"{f.name} = {_toml_value(getattr(integrator, f.name))}" for f in fields(integrator))
 
-    def __init__(self, coord, n_tasks, total_events, every, log):
+
+def parse_integrator(text, where):
+    """The inverse of integrator_text, validated like a config."""
+    try:
+        return from_dict({"integrator": tomllib.loads(text)}).integrator
+    except (tomllib.TOMLDecodeError, ConfigError) as err:
+        raise CatalogError(f"{where}: stored integrator cannot be read ({err})") from None
+
+
+class Progress:
+    """Rank 0's progress: a line at a steady interval (fit for a log file), fresher in the lock file."""
+
+    LOCK_SECONDS = 2.0
+
+    def __init__(self, coord, n_tasks, total_events, every, log, lock=None):
         self.coord, self.n_tasks, self.total, self.every, self.log = coord, n_tasks, total_events, every, log
+        self.lock = lock
         self.start = time.perf_counter()
         self.last = self.start
+        self.last_lock = -np.inf
 
-    def maybe_print(self, tasks=None):
-        """Print if the interval has passed (or always, given the final task count)."""
+    def restart_clock(self):
+        """Rates and time left count from here (after the kernels are compiled)."""
+        self.start = self.last = time.perf_counter()
+
+    def line(self, tasks=None):
         now = time.perf_counter()
-        if self.coord.rank != 0 or (tasks is None and now - self.last < self.every):
-            return
-        self.last = now
         tasks = self.coord.tasks_done() if tasks is None else tasks
         events = self.coord.events_total
         rate = (events - self.coord.events_resumed) / max(now - self.start, 1e-9)
         left = (self.total - events) / rate if rate > 0 else float("inf")
         eta = f"{left / 60:.1f} min" if np.isfinite(left) else "?"
-        self.log(f"progress: tasks {tasks}/{self.n_tasks}, events {events}/{self.total} "
-                 f"(incl. transient), {rate:.1f} events/s, {eta} left")
+        return (f"tasks {tasks}/{self.n_tasks}, events {events}/{self.total} "
+                f"(incl. transient), {rate:.1f} events/s, {eta} left")
+
+    def maybe_print(self, tasks=None):
+        """Print if the interval has passed (or always, given the final task count)."""
+        if self.coord.rank != 0:
+            return
+        now = time.perf_counter()
+        if self.lock is not None and (tasks is not None or now - self.last_lock >= self.LOCK_SECONDS):
+            self.last_lock = now
+            self.lock.progress(self.line(tasks))
+        if tasks is None and now - self.last < self.every:
+            return
+        self.last = now
+        self.log("progress: " + self.line(tasks))
 
 
 class TaskRunner:
-    """Integrates one task on this rank: kernel calls, buffer, flushes with checkpoints."""
+    """Integrates one task on this rank: kernel calls, buffer, flushes with checkpoints.
 
-    def __init__(self, cfg, writer, coord, progress):
+    A task that fails numerically (SimulationError) is recorded as failed in the
+    catalog and the rank goes on with the next task; `failed` lists them.
+    `rerun`: an [integrator] for tasks that failed before (rerun from their start), or None.
+    """
+
+    def __init__(self, cfg, writer, coord, progress, rerun=None):
         self.cfg, self.writer, self.coord, self.progress = cfg, writer, coord, progress
+        self.rerun = rerun
+        self.failed = []      # (task index, message) of the tasks that failed on this rank
         self.io_time = 0.0    # seconds spent handing events and checkpoints to the writer
 
     def run(self, task):
-        """Returns True if the task finished, False if a stop request interrupted it."""
+        """Returns True if the task finished or failed, False if a stop request interrupted it."""
         try:
             return self._run(task)
-        except SimulationError:
+        except SimulationError as err:
+            self.writer.fail(task.index, str(err))
+            self.failed.append((task.index, str(err)))
+            print(f"error: rank {self.coord.rank}: {err}; the task is recorded as failed, the "
+                  f"others go on", file=sys.stderr, flush=True)
+            self.coord.task_done()
+            return True
+        except CatalogError:
             raise
         except Exception as err:
             raise RuntimeError(f"task {task.index}: {type(err).__name__}: {err}") from err
 
+    def _take_up(self, task):
+        """(Trajectory, events written) to continue, or None if there is nothing to do."""
+        cfg = self.cfg
+        where = f"task {task.index}"
+        rec = self.writer.record(task.index)
+        if rec.status == FAILED:
+            if self.rerun is None:
+                self.failed.append((task.index, rec.error))
+                return None
+            rec = self.writer.record(task.index, restart=True)
+            self.writer.start(task.index, integrator_text(self.rerun))
+            return Trajectory(cfg, task, None, self.rerun), 0
+        if rec.checkpoint is not None:
+            self.coord.count_events(rec.checkpoint.done, resumed=True)
+        if rec.written >= cfg.run.events:
+            if rec.status != FINISHED:   # stopped between its last commit and the finish record
+                self.writer.finish(task.index, {})
+            return None
+        return Trajectory(cfg, task, rec.checkpoint, parse_integrator(rec.integrator, where)), rec.written
+
     def _run(self, task):
         cfg = self.cfg
-        cp, written = self.writer.resume_point(task.index, task.model.N)
-        if cp is not None:
-            self.coord.count_events(cp.done, resumed=True)
-        if written >= cfg.run.events:
+        taken = self._take_up(task)
+        if taken is None:
             self.coord.task_done()
             return True
-        traj = Trajectory(cfg, task, cp)
+        traj, written = taken
         total = cfg.run.transient + cfg.run.events
         buffer = []
         buffered = 0
@@ -179,11 +253,11 @@ class TaskRunner:
         return True
 
 
-def _same_config(stored_text, cfg):
-    """Keys (outside [output]) whose values differ between the stored and the given config."""
+def config_differences(stored_text, cfg, sections=("model", "run", "integrator")):
+    """Keys (outside [output] and run.poll_seconds) whose values differ between the stored and the given config."""
     stored = loads(stored_text)
     diffs = []
-    for section in ("model", "run", "integrator"):
+    for section in sections:
         a, b = getattr(stored, section), getattr(cfg, section)
         for key in a.__dataclass_fields__:
             if getattr(a, key) != getattr(b, key) and key != "poll_seconds":
@@ -193,49 +267,113 @@ def _same_config(stored_text, cfg):
     return diffs
 
 
-def _prepare(cfg, path, resume, force):
-    """Rank 0's decision about the files; returns (mode, message) or raises."""
+def _check_output(path):
+    """Refuse, before any work, an output that cannot become a catalog."""
+    final, partial = str(path), catalog.partial_path(path)
+    for p in (final, partial):
+        if os.path.isdir(p):
+            raise Refused(f"{p}: is a directory; give the catalog a file name")
+    parent = os.path.dirname(os.path.abspath(final))
+    if not os.path.isdir(parent):
+        raise Refused(f"{final}: directory {parent} does not exist")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise Refused(f"{final}: cannot write in {parent}")
+
+
+def _prepare(cfg, path, resume, force, rerun=None):
+    """Rank 0's decision about the files (under the run's lock); returns (mode, message) or raises.
+
+    rerun: the failed tasks are to be rerun with this [integrator] (which may differ from the stored one).
+    """
+    _check_output(path)
     final, partial = str(path), catalog.partial_path(path)
     if resume:
         if not os.path.exists(partial):
             if os.path.exists(final):
+                _, _, attrs = catalog.read_tasks(final)
+                diffs = config_differences(attrs["config"], cfg)
+                if diffs:
+                    raise ConfigError(f"{final}: --resume with a different config ({'; '.join(diffs)}); "
+                                      f"the catalog is complete")
                 return "complete", f"{final} is complete; nothing to resume"
-            raise CatalogError(f"{partial}: no interrupted run to resume")
-        _, _, attrs = catalog.read(partial)
-        diffs = _same_config(attrs["config"], cfg)
+            raise Refused(f"{partial}: no interrupted run to resume")
+        _, tasks, attrs = catalog.read_tasks(partial)
+        diffs = config_differences(attrs["config"], cfg, ("model", "run") if rerun else
+                                   ("model", "run", "integrator"))
         if diffs:
             raise ConfigError(f"{partial}: --resume with a different config ({'; '.join(diffs)})")
+        if rerun is not None and not np.any(tasks["status"] == FAILED):
+            raise ConfigError(f"{partial}: no failed task to rerun (a changed [integrator] applies to "
+                              f"failed tasks only)")
         return "resume", None
     if os.path.exists(final) and not force:
-        raise CatalogError(f"{final}: catalog exists (use --force to overwrite it)")
+        raise Refused(f"{final}: catalog exists (use --force to overwrite it)")
     if os.path.exists(partial) and not force:
-        raise CatalogError(f"{partial}: an interrupted run exists (use --resume to continue it, "
-                           f"--force to start over)")
+        raise Refused(f"{partial}: an interrupted run exists (use --resume to continue it, "
+                      f"--force to start over)")
     return "new", None
 
 
-def run(cfg, path, comm, resume=False, force=False, log=print):
+def _kernels_cached():
+    """True if the event kernels' compiled code is in numba's cache (see ensemble.model)."""
+    import numba
+    return bool(glob.glob(os.path.join(numba.config.CACHE_DIR, "**", "chain.simulate-*.nbi"), recursive=True))
+
+
+def _compile_kernels(cfg, task, coord, say):
+    """Compile (or load from the cache) the kernels before any timing starts.
+
+    A signal in the meantime is acknowledged at once (Coordinator) and served when this returns.
+    """
+    cached = _kernels_cached()
+    if not cached:
+        say("compiling kernels (first run only, about a minute; cached for the next runs)")
+    start = time.perf_counter()
+    coord.busy_with = "compiling kernels"
+    tiny = type(task)(task.index, task.point, task.seed_index, type(task.model)(**{**vars(task.model), "N": 2}))
+    Trajectory(cfg, tiny).advance(0)
+    coord.busy_with = None
+    if not cached:
+        say(f"kernels ready in {time.perf_counter() - start:.0f} s")
+
+
+def run(cfg, path, comm, resume=False, force=False, log=print, rerun=None, command=""):
     """Run every task of cfg on the ranks of comm into the catalog at `path`.
 
-    Writes to path + '.partial' and renames it to `path` when every task is
-    done, so a good catalog is never replaced by a half-written one. Returns 0,
-    or EXIT_INTERRUPTED after a stop request (every rank checkpointed).
+    Rank 0 holds the run's lock (lock.py) from before anything is decided until
+    the end. Writes to path + '.partial' and renames it to `path` when every task
+    has finished, so a good catalog is never replaced by a half-written one.
+    `rerun`: an [integrator] for the tasks that failed before (resume only).
+    Returns 0, EXIT_INTERRUPTED after a stop request (every rank checkpointed),
+    or EXIT_FAILED if some tasks failed (the others finished; the catalog stays partial).
     """
     rank = comm.Get_rank()
     say = log if rank == 0 else (lambda *a, **k: None)
+    lock = None
     decision = None
-    if rank == 0:
-        try:
-            decision = _prepare(cfg, path, resume, force)
-        except (CatalogError, ConfigError) as err:
-            decision = err
-    decision = comm.bcast(decision, root=0)
-    if isinstance(decision, Exception):
-        raise decision
-    mode, message = decision
-    if mode == "complete":
-        say(message)
-        return 0
+    try:
+        if rank == 0:
+            try:
+                lock = RunLock(path, command).acquire()
+                if lock.note:
+                    say(f"note: {lock.note}")
+                decision = _prepare(cfg, path, resume, force, rerun)
+            except Exception as err:  # noqa: BLE001 - every rank raises it after the broadcast
+                decision = err
+        decision = comm.bcast(decision, root=0)
+        if isinstance(decision, Exception):
+            raise decision
+        mode, message = decision
+        if mode == "complete":
+            say(message)
+            return 0
+        return _run_locked(cfg, path, comm, mode, log, say, rerun, lock)
+    finally:
+        if lock is not None:
+            lock.release()
+
+
+def _run_locked(cfg, path, comm, mode, log, say, rerun, lock):
     tasks = task_list(cfg)
     Writer = catalog.choose_writer(cfg.output.writer, comm)
     partial = catalog.partial_path(path)
@@ -243,7 +381,7 @@ def run(cfg, path, comm, resume=False, force=False, log=print):
         f"{Writer.name if comm.Get_size() > 1 else 'serial HDF5'}")
     t_start = time.perf_counter()
     if mode == "new":
-        writer = Writer(partial, comm, cfg, tasks)
+        writer = Writer(partial, comm, cfg, tasks, integrator_text(cfg.integrator))
     else:
         writer = Writer(partial, comm)
     # event counts reach rank 0 as messages: about 100 per second in all, however many ranks
@@ -251,17 +389,28 @@ def run(cfg, path, comm, resume=False, force=False, log=print):
                                                   cfg.output.progress_seconds / 2))
     coord.install_signal_handlers()
     progress = Progress(coord, len(tasks), len(tasks) * (cfg.run.transient + cfg.run.events),
-                        cfg.output.progress_seconds, log)
-    worker = TaskRunner(cfg, writer, coord, progress)
+                        cfg.output.progress_seconds, log, lock)
+    worker = TaskRunner(cfg, writer, coord, progress, rerun)
     try:
+        return _serve(cfg, path, comm, tasks, writer, coord, progress, worker, log, t_start)
+    finally:
+        # until here a signal only sets a flag that nobody reads once the work is over
+        coord.restore_signal_handlers()
+
+
+def _serve(cfg, path, comm, tasks, writer, coord, progress, worker, log, t_start):
+    rank = comm.Get_rank()
+    partial = catalog.partial_path(path)
+    try:
+        _compile_kernels(cfg, tasks[0], coord, log if rank == 0 else (lambda *a, **k: None))
+        progress.restart_clock()
         busy, idle = _work(tasks, worker, writer, coord, progress)
-    except BaseException:
-        if comm.Get_size() == 1:   # with more ranks the caller aborts them all
+    except BaseException as err:
+        # with more ranks the caller aborts them all; a broken file is not touched again
+        if comm.Get_size() == 1 and not getattr(err, "broken", False):
             writer.close()
             coord.close()
         raise
-    finally:
-        coord.restore_signal_handlers()
     writer.close()   # first: rank 0 may still have to receive rows from the others
     # every rank counted its finished tasks before it could pass the collective close
     done = coord.tasks_done()
@@ -269,6 +418,7 @@ def run(cfg, path, comm, resume=False, force=False, log=print):
     coord.close()
     progress.maybe_print(tasks=done)
     per_rank = comm.gather((busy, idle, coord.rma_wait, worker.io_time), root=0)
+    failed = sorted(f for part in comm.allgather(worker.failed) for f in part)
     elapsed = time.perf_counter() - t_start
     if rank == 0:
         for r, (b, i, w, io) in enumerate(per_rank):
@@ -277,16 +427,22 @@ def run(cfg, path, comm, resume=False, force=False, log=print):
         if stopped:
             log(f"interrupted ({coord.signal_name}): every rank checkpointed into {partial}; "
                 f"continue with --resume")
+        elif failed:
+            log(f"failed: {len(failed)} of {len(tasks)} tasks (the others finished) in {partial}:")
+            for k, message in failed:
+                log(f"  task {k}: {message}")
+            log(f"rerun them from their start with another integrator, e.g. `python -m ensemble resume "
+                f"{path} --set integrator.dt=...` (or method, rtol)")
         else:
             os.replace(partial, str(path))
             log(f"wrote {path}: {len(tasks)} tasks, {len(tasks) * cfg.run.events} events in {elapsed:.1f} s")
-    return EXIT_INTERRUPTED if stopped else 0
+    return EXIT_INTERRUPTED if stopped else (EXIT_FAILED if failed else 0)
 
 
 def _work(tasks, worker, writer, coord, progress):
     """Take tasks until none is left (or a stop request); returns (busy, idle) seconds."""
     busy = 0.0
-    stopped = False
+    stopped = coord.poll()
     while not stopped:
         k = coord.next_task()
         if k >= len(tasks):
@@ -301,4 +457,3 @@ def _work(tasks, worker, writer, coord, progress):
         progress.maybe_print()
         time.sleep(0.05)
     return busy, time.perf_counter() - waited
-

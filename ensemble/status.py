@@ -1,35 +1,67 @@
-"""`python -m ensemble status`: what a catalog holds, while it is written or after."""
+"""`python -m ensemble status`: what a catalog holds and what its run is doing.
+
+The state of a run comes from its files: the lock (lock.py) says whether a run
+is alive and carries its latest progress line (a few seconds old at most); the
+catalog's commit rows say what each task has stored; the final name exists only
+once every task has finished. The catalog is read without taking HDF5's file
+lock, so this works while any writer is writing it.
+"""
 import os
 
 import numpy as np
 
-from . import catalog
+from . import catalog, lock
 from .config import loads
+
+RESUME = "python -m ensemble resume"
+
+
+def _state(path):
+    """(file to read or None, one-line state) of the run whose final catalog is `path`."""
+    final, partial = str(path), catalog.partial_path(path)
+    info = lock.read_info(final)
+    if lock.is_held(final):
+        line = f"running ({lock.describe(info)})"
+        if info.get("progress"):
+            line += f"\n  progress: {info['progress']}"
+        return (partial if os.path.exists(partial) else None), line
+    if os.path.exists(partial):
+        died = f" (its run died: lock file {lock.lock_path(final)} left behind)" if info else ""
+        return partial, f"interrupted{died}; continue with `{RESUME} {final}`"
+    if os.path.exists(final):
+        return final, "complete"
+    raise catalog.CatalogError(f"{final}: no such catalog (nor {partial})")
 
 
 def summary(path):
-    """A text summary: config, per-task progress and provenance, totals."""
-    final, partial = str(path), catalog.partial_path(path)
-    if not os.path.exists(final) and os.path.exists(partial):
-        path, state = partial, "in progress or interrupted"
-    elif os.path.exists(final):
-        state = "complete"
-    else:
-        raise catalog.CatalogError(f"{path}: no such catalog (nor {partial})")
-    _, tasks, attrs = catalog.read(path)
+    """A text summary: state, per-task progress and provenance, totals, config."""
+    path = str(path).removesuffix(".partial")
+    source, state = _state(path)
+    if source is None:
+        return f"{path}: {state}\n(the catalog is being created)"
+    per_task, tasks, attrs = catalog.read_tasks(source)
     cfg = loads(attrs["config"])
-    per_task = cfg.run.events
-    lines = [f"{path}: {state}, version {attrs['version']}", ""]
-    lines.append("task point seed     N      b      a       c   events  finished  rank  events/s")
+    failed = np.flatnonzero(tasks["status"] == catalog.FAILED)
+    if len(failed) and not state.startswith("running"):
+        state = (f"failed: tasks {', '.join(map(str, failed))} (the others go on with `{RESUME} {path}`; "
+                 f"rerun the failed ones with `{RESUME} {path} --set integrator.KEY=VALUE`)")
+    lines = [f"{source}: {state}", f"version {attrs['version']}, format {attrs['format']}", ""]
+    lines.append("task point seed     N      b      a       c   events  recorded    status  rank  events/s")
+    total = cfg.run.transient + cfg.run.events
     for k in range(len(tasks["point"])):
         written = int(tasks["events_written"][k])
         rate = tasks["events_per_second"][k]
+        st = catalog.STATUS_NAMES[int(tasks["status"][k])]
         lines.append(f"{k:4d} {tasks['point'][k]:5d} {tasks['seed_index'][k]:4d} {tasks['N'][k]:5d} "
-                     f"{tasks['b'][k]:6g} {tasks['a'][k]:6g} {tasks['c'][k]:7g} {written:8d}  "
-                     f"{'yes' if written == per_task else 'no':>8s}  {tasks['rank'][k]:4d}  "
+                     f"{tasks['b'][k]:6g} {tasks['a'][k]:6g} {tasks['c'][k]:7g} "
+                     f"{int(tasks['events_done'][k]):8d} {written:9d} {st:>9s}  {tasks['rank'][k]:4d}  "
                      f"{'' if np.isnan(rate) else f'{rate:8.1f}'}")
-    done = int(np.sum(tasks["events_written"] == per_task))
-    lines += ["", f"tasks finished {done}/{len(tasks['point'])}, events recorded "
+    for k in failed:
+        lines.append(f"  task {k} failed: {tasks['error'][k]}")
+    done = int(np.sum(tasks["status"] == catalog.FINISHED))
+    lines += ["", f"(events: done incl. the transient of {cfg.run.transient}, as of each task's last "
+                  f"checkpoint; of {total} per task)",
+              f"tasks finished {done}/{len(tasks['point'])}, events recorded "
               f"{int(tasks['events_written'].sum())}/{len(tasks['point']) * per_task}", "",
               "config:", attrs["config"]]
     return "\n".join(lines)
