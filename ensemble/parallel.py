@@ -9,8 +9,10 @@ once per task (take a task, count it done), so that wait is paid once per task,
 not per kernel call; the run-wide event counts for the progress line travel as
 non-blocking messages instead.
 """
+import contextlib
 import os
 import signal
+import threading
 import time
 
 import numpy as np
@@ -39,7 +41,7 @@ class Coordinator:
         self.signal_name = None
         self._local_signal = None
         self._old_handlers = {}
-        self.busy_with = None    # what this rank does that cannot be interrupted (said when signalled)
+
         self._sent = {tag: np.zeros(self.size, dtype=np.int64) for tag in (STOP_TAG, COUNT_TAG)}
         self._received = {tag: np.zeros(self.size, dtype=np.int64) for tag in (STOP_TAG, COUNT_TAG)}
         self._requests = []
@@ -126,10 +128,40 @@ class Coordinator:
 
     def _on_signal(self, signum, frame):
         self._local_signal = signal.Signals(signum).name
-        if self.busy_with:
-            # acknowledged at once (os.write: no buffered I/O inside a signal handler)
-            os.write(2, f"rank {self.rank}: {self._local_signal} received while {self.busy_with}; "
-                        f"the run stops as soon as that is done\n".encode())
+
+    @contextlib.contextmanager
+    def acknowledging(self, what):
+        """Say at once that a signal arrived during `what` (which cannot be interrupted).
+
+        Python runs signal handlers only between bytecodes of the main thread, which a
+        long call into compiled code (LLVM compiling the kernels) delays. The C-level
+        handler also writes the signal number to a wakeup fd at once; a thread waiting on
+        it says so (it gets the interpreter while the main thread is in such a call).
+        """
+        read_fd, write_fd = os.pipe()
+        os.set_blocking(write_fd, False)
+        old = signal.set_wakeup_fd(write_fd)
+        done = threading.Event()
+
+        def watch():
+            while True:
+                data = os.read(read_fd, 1)
+                if done.is_set() or not data:
+                    return
+                if data[0] in INTERRUPT_SIGNALS:
+                    os.write(2, f"rank {self.rank}: {signal.Signals(data[0]).name} received while {what}; "
+                                f"the run stops as soon as that is done\n".encode())
+        thread = threading.Thread(target=watch, name="signal-ack", daemon=True)
+        thread.start()
+        try:
+            yield
+        finally:
+            signal.set_wakeup_fd(old)
+            done.set()
+            os.write(write_fd, b"\0")
+            thread.join()
+            os.close(read_fd)
+            os.close(write_fd)
 
     def poll(self):
         """Make MPI progress; True once a stop was requested here or on any other rank."""

@@ -326,13 +326,12 @@ def _compile_kernels(cfg, task, coord, say):
     A signal in the meantime is acknowledged at once (Coordinator) and served when this returns.
     """
     cached = _kernels_cached()
-    if not cached:
-        say("compiling kernels (first run only, about a minute; cached for the next runs)")
     start = time.perf_counter()
-    coord.busy_with = "compiling kernels"
     tiny = type(task)(task.index, task.point, task.seed_index, type(task.model)(**{**vars(task.model), "N": 2}))
-    Trajectory(cfg, tiny).advance(0)
-    coord.busy_with = None
+    with coord.acknowledging("compiling kernels"):
+        if not cached:
+            say("compiling kernels (first run only, about a minute; cached for the next runs)")
+        Trajectory(cfg, tiny).advance(0)
     if not cached:
         say(f"kernels ready in {time.perf_counter() - start:.0f} s")
 

@@ -29,6 +29,7 @@ def mpi_cmd(n, *args):
 
 
 def mpirun(n, *args, timeout=300):
+    # a hung job fails the test with TimeoutExpired instead of hanging the suite
     return subprocess.run(mpi_cmd(n, *args), capture_output=True, text=True, env=env(), timeout=timeout)
 
 
@@ -103,16 +104,31 @@ def rank_pids(root):
     return sorted(found)
 
 
-def start_and_interrupt(cfg, out, how):
-    """Start a 2-rank run, wait for progress, interrupt it; returns (exit code, stdout)."""
-    proc = subprocess.Popen(mpi_cmd(2, "run", cfg, "-o", out), stdout=subprocess.PIPE,
-                            stderr=subprocess.STDOUT, text=True, env=env(), start_new_session=True)
-    lines = []
-    for line in proc.stdout:
-        lines.append(line)
-        if line.startswith("progress:") and "events 0/" not in line:
-            break
-    time.sleep(1.5)
+def wait_for_commit(proc, out, timeout=120):
+    """Wait (polling, no sleep of a guessed length) until the run has committed a batch of events."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        assert proc.poll() is None, "the run ended before it was interrupted"
+        try:
+            _, tasks, _ = catalog.read_tasks(catalog.partial_path(out))
+            if tasks["events_written"].sum() > 0:
+                return
+        except catalog.CatalogError:
+            pass     # not created yet
+        time.sleep(0.1)
+    raise AssertionError(f"no batch committed within {timeout} s")
+
+
+def start_and_interrupt(cfg, out, how, writer="auto"):
+    """Start a 2-rank run, wait for a committed batch, interrupt it; returns (exit code, output)."""
+    proc = subprocess.Popen(mpi_cmd(2, "run", cfg, "-o", out, "--set", f'output.writer="{writer}"'),
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env(),
+                            start_new_session=True)
+    try:
+        wait_for_commit(proc, out)
+    except BaseException:
+        os.killpg(proc.pid, signal.SIGKILL)
+        raise
     ranks = rank_pids(proc.pid)
     assert len(ranks) == 2, ranks
     if how == "kill":
@@ -120,27 +136,36 @@ def start_and_interrupt(cfg, out, how):
             os.kill(pid, signal.SIGKILL)
     else:
         # Signal the ranks themselves, as Slurm does (hydra's mpiexec, when signalled, forwards
-        # the signal but then exits 0 whatever the ranks return). `one`: only the first rank.
+        # the signal but then exits 0 whatever the ranks return). `one`/`other`: only the
+        # first/second rank by pid (rank order unknown), `all`: both.
         sig, which = how
-        for pid in ranks[:1] if which == "one" else ranks:
+        for pid in {"one": ranks[:1], "other": ranks[1:], "all": ranks}[which]:
             os.kill(pid, sig)
-    rest, _ = proc.communicate(timeout=60)
-    return proc.returncode, "".join(lines) + rest
+    try:
+        output, _ = proc.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        output, _ = proc.communicate()
+        raise AssertionError(f"the run hung after {how}:\n{output}") from None
+    return proc.returncode, output
 
 
-@pytest.mark.parametrize("sig,which", [(signal.SIGTERM, "all"), (signal.SIGUSR1, "one"),
-                                       (signal.SIGINT, "all")])
-def test_resume_after_signal_equals_uninterrupted(four_tasks, sig, which):
+@pytest.mark.parametrize("sig,which,writer", [
+    (signal.SIGTERM, "all", "auto"), (signal.SIGUSR1, "one", "auto"), (signal.SIGINT, "all", "auto"),
+    # the rank-0 writer: rank 0 must serve the other rank's last rows and its "done", wherever they arrive
+    (signal.SIGTERM, "one", "rank0"), (signal.SIGTERM, "other", "rank0"), (signal.SIGTERM, "all", "rank0"),
+    (signal.SIGUSR1, "other", "rank0")])
+def test_resume_after_signal_equals_uninterrupted(four_tasks, sig, which, writer):
     """Every rank checkpoints and exits 75 (also when only one rank got the signal); resume completes."""
     d, cfg = four_tasks
-    out = d / f"sig{int(sig)}.h5"
-    code, log = start_and_interrupt(cfg, out, (sig, which))
+    out = d / f"sig{int(sig)}_{which}_{writer}.h5"
+    code, log = start_and_interrupt(cfg, out, (sig, which), writer)
     assert code == 75, log
     assert "interrupted" in log and not out.exists()
     _, tasks, _ = catalog.read(catalog.partial_path(out))
     assert 0 < tasks["events_written"].sum() < 4 * 400      # really cut in the middle
     status = run_cli("status", out)
-    assert status.returncode == 0 and "in progress or interrupted" in status.stdout
+    assert status.returncode == 0 and "interrupted" in status.stdout and "resume" in status.stdout
     resume_equals_uninterrupted(d, cfg, out)
 
 

@@ -1,0 +1,83 @@
+"""Fault injection for tests: crash or fail a real run at a chosen point (used in a subprocess).
+
+    python -c "from tests import inject; inject.crash_at_write(5); inject.main(['run', ...])"
+
+Nothing here is imported by the package: the faults are injected by patching, from outside.
+"""
+import os
+import sys
+
+import h5py
+
+CRASH_CODE = 99
+
+
+def _count_writes(on_write):
+    """Call on_write(k, what) before the k-th dataset write or file flush of this process (1-based)."""
+    counter = [0]
+    set_item, flush = h5py.Dataset.__setitem__, h5py.File.flush
+
+    def tick(what):
+        counter[0] += 1
+        on_write(counter[0], what)
+
+    def patched_set(self, key, value):
+        tick(f"write {self.name}")
+        return set_item(self, key, value)
+
+    def patched_flush(self):
+        tick("flush")
+        return flush(self)
+    h5py.Dataset.__setitem__ = patched_set
+    h5py.File.flush = patched_flush
+
+
+def crash_at_write(k):
+    """Die like kill -9 (no cleanup, nothing flushed) just before the k-th write or flush."""
+    def on_write(i, what):
+        if i == k:
+            os._exit(CRASH_CODE)
+    _count_writes(on_write)
+
+
+def log_writes(path):
+    """Append one line per write or flush ('k what') to `path`."""
+    def on_write(i, what):
+        with open(path, "a") as fh:
+            fh.write(f"{i} {what}\n")
+    _count_writes(on_write)
+
+
+def fail_on_rank(rank, after_calls=1):
+    """Raise a RuntimeError (a bug, not a numerical failure) on one MPI rank once it has run a while."""
+    from mpi4py import MPI
+
+    from ensemble import runner
+    calls = [0]
+    original = runner.event_rows
+
+    def patched(*args):
+        calls[0] += 1
+        if MPI.COMM_WORLD.Get_rank() == rank and calls[0] > after_calls:
+            raise RuntimeError("injected failure")
+        return original(*args)
+    runner.event_rows = patched
+
+
+def signal_after_rename(signum):
+    """Send this process `signum` right after the run renames its finished catalog."""
+    import signal
+
+    from ensemble import runner
+    replace = os.replace
+
+    def patched(src, dst):
+        replace(src, dst)
+        os.kill(os.getpid(), signum)
+        signal.getsignal(signum)   # the handler runs between bytecodes: before the run returns
+    runner.os.replace = patched
+
+
+def main(argv):
+    from ensemble.cli import main as cli_main
+    sys.exit(cli_main(argv))

@@ -1,0 +1,375 @@
+"""Faults, serially: crashes at every write of a batch, corrupt files, concurrent runs, stale locks,
+a full disk, bad output paths, late signals, and what `status` says in each case.
+
+Every subprocess runs under a timeout, and waits are on conditions (a committed batch, a held
+lock), not on sleeps of a guessed length.
+"""
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+
+import h5py
+import numpy as np
+import pytest
+
+from ensemble import catalog, lock
+from ensemble.integrity import commit_crc
+
+from .conftest import ROOT, run_cli, write_config
+from .inject import CRASH_CODE
+
+TIMEOUT = 120
+
+
+def env(**extra):
+    return dict(os.environ, NUMBA_CACHE_DIR=os.environ.get("NUMBA_CACHE_DIR", str(ROOT / ".numba_cache")),
+                OMP_NUM_THREADS="1", NUMBA_NUM_THREADS="1", **extra)
+
+
+def injected(setup, *argv, timeout=TIMEOUT):
+    """Run `python -m ensemble argv` in a subprocess after `setup` (code using tests.inject)."""
+    code = f"import sys; sys.path.insert(0, {str(ROOT)!r}); from tests import inject; {setup}; inject.main({list(map(str, argv))!r})"
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env(), timeout=timeout)
+
+
+def cli(*args, timeout=TIMEOUT):
+    return subprocess.run([sys.executable, "-m", "ensemble", *map(str, args)], capture_output=True, text=True,
+                          env=env(), timeout=timeout)
+
+
+def same_events(path_a, path_b):
+    a, ta, _ = catalog.read(path_a)
+    b, tb, _ = catalog.read(path_b)
+    assert len(a["t"]) == len(b["t"]) > 0
+    for name in catalog.EVENT_FIELDS:
+        np.testing.assert_array_equal(a[name], b[name], err_msg=name)
+    np.testing.assert_array_equal(ta["events_written"], tb["events_written"])
+
+
+@pytest.fixture(scope="module")
+def small(tmp_path_factory):
+    """Two tasks of three batches each, and the uninterrupted catalog."""
+    d = tmp_path_factory.mktemp("faults")
+    cfg = write_config(d / "cfg.toml", run={"seeds": 2, "events": 60, "transient": 10},
+                       output={"batch": 20, "flush_seconds": 1000.0})
+    res = cli("run", cfg, "-o", d / "full.h5")
+    assert res.returncode == 0, res.stderr
+    return d, cfg
+
+
+def test_crash_at_every_write_of_a_batch_resumes_to_the_uninterrupted_catalog(small):
+    """kill -9 before each write and each flush of task 0's second batch (and just after it)."""
+    d, cfg = small
+    log = d / "writes.log"
+    res = injected(f"inject.log_writes({str(log)!r})", "run", cfg, "-o", d / "logged.h5")
+    assert res.returncode == 0, res.stderr
+    writes = [line.split(" ", 1) for line in log.read_text().splitlines()]
+    starts = [int(k) for k, what in writes if what == "write /events/task"]
+    # task 0's second batch: from its first event column to the first write of the next batch
+    window = range(starts[1], starts[2] + 1)
+    kinds = {what for k, what in writes if int(k) in window}
+    assert {"write /checkpoint/state", "write /checkpoint/commit", "write /tasks/events_written",
+            "flush"} <= kinds, kinds
+    for k in window:
+        out = d / f"crash{k}.h5"
+        res = injected(f"inject.crash_at_write({k})", "run", cfg, "-o", out)
+        assert res.returncode == CRASH_CODE, res.stderr
+        events, tasks, _ = catalog.read(catalog.partial_path(out))       # consistent after the crash
+        assert len(events["t"]) == tasks["events_written"].sum() < 120
+        res = cli("run", cfg, "-o", out, "--resume")
+        assert res.returncode == 0, (k, res.stderr)
+        same_events(d / "full.h5", out)
+
+
+def _flip_byte(path, dataset, index):
+    """Flip one byte of element `index` of a contiguous dataset, in the file's bytes."""
+    with h5py.File(path, "r") as h5:
+        ds = h5[dataset]
+        offset = ds.id.get_offset() + index * ds.dtype.itemsize
+    with open(path, "r+b") as fh:
+        fh.seek(offset + 3)
+        byte = fh.read(1)
+        fh.seek(offset + 3)
+        fh.write(bytes([byte[0] ^ 0x10]))
+
+
+@pytest.fixture
+def interrupted(small, tmp_path):
+    """A copy of a catalog crashed after two of task 0's batches (a .partial to resume)."""
+    d, cfg = small
+    out = tmp_path / "x.h5"
+    res = injected("inject.crash_at_write(60)", "run", cfg, "-o", out)
+    assert res.returncode == CRASH_CODE, res.stderr
+    _, tasks, _ = catalog.read(catalog.partial_path(out))
+    assert tasks["events_written"][0] > 0
+    return cfg, out
+
+
+@pytest.mark.parametrize("where,message", [
+    ("state", "checkpoint slot"), ("event", "fail their checksum"), ("commit", "commit row")])
+def test_a_one_byte_flip_fails_resume_and_read_naming_the_task(interrupted, where, message):
+    cfg, out = interrupted
+    partial = catalog.partial_path(out)
+    with h5py.File(partial, "r") as h5:
+        row = h5["checkpoint/commit"][0]
+        slot = int(np.argmax(row[:, 0]))          # the slot in use: highest sequence number
+        n = int(h5["tasks/N"][0])
+    if where == "state":
+        _flip_byte(partial, "checkpoint/state", slot * (4 * n + 2) + 5)
+    elif where == "event":
+        _flip_byte(partial, "events/mu", 7)
+    else:
+        _flip_byte(partial, "checkpoint/commit", slot * catalog.NCOMMIT + catalog.C_DONE)
+    res = cli("run", cfg, "-o", out, "--resume")
+    assert res.returncode != 0 and "task 0" in res.stderr and message in res.stderr, res.stderr
+    assert len(res.stderr.strip().splitlines()) == 1
+    if where != "state":        # readers do not read checkpoints
+        with pytest.raises(catalog.CatalogError, match=f"task 0.*{message}"):
+            catalog.read(partial)
+
+
+def test_an_out_of_range_commit_row_with_a_valid_checksum_is_refused(interrupted):
+    """A negative event count (once an endless loop) with a matching CRC: the range check catches it."""
+    cfg, out = interrupted
+    partial = catalog.partial_path(out)
+    with h5py.File(partial, "r+") as h5:
+        rows = h5["checkpoint/commit"][0]
+        slot = int(np.argmax(rows[:, 0]))
+        fields = [int(x) for x in rows[slot][:catalog.C_ROW_CRC]]
+        fields[catalog.C_DONE] = -5
+        h5["checkpoint/commit"][0, slot] = fields + [commit_crc(0, slot, fields)]
+    res = cli("run", cfg, "-o", out, "--resume")
+    assert res.returncode == 1 and "task 0" in res.stderr and "out of range" in res.stderr
+
+
+def start(cfg, out, *extra):
+    return subprocess.Popen([sys.executable, "-m", "ensemble", "run", cfg, "-o", out, *extra],
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env())
+
+
+def wait_until(condition, proc, timeout=TIMEOUT):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if condition():
+            return
+        assert proc.poll() is None, proc.communicate()[0]
+        time.sleep(0.05)
+    raise AssertionError("condition not met in time")
+
+
+def committed(out):
+    try:
+        _, tasks, _ = catalog.read_tasks(catalog.partial_path(out))
+    except catalog.CatalogError:
+        return False
+    return tasks["events_written"].sum() > 0
+
+
+@pytest.fixture(scope="module")
+def long_cfg(tmp_path_factory):
+    d = tmp_path_factory.mktemp("long")
+    return write_config(d / "long.toml", run={"seeds": 2, "events": 200000, "transient": 10},
+                        output={"batch": 20, "flush_seconds": 0.2, "progress_seconds": 1000.0})
+
+
+def stop(proc):
+    proc.send_signal(signal.SIGTERM)
+    out, _ = proc.communicate(timeout=60)
+    return proc.returncode, out
+
+
+def test_a_second_run_on_a_live_output_is_refused_and_the_first_one_is_intact(long_cfg, tmp_path):
+    out = tmp_path / "live.h5"
+    first = start(long_cfg, out)
+    try:
+        wait_until(lambda: committed(out), first)
+        for extra in (["--force"], ["--resume"], []):
+            res = cli("run", long_cfg, "-o", out, *extra)
+            assert res.returncode == 2 and "in use by another run" in res.stderr, res.stderr
+            assert f"pid {first.pid}" in res.stderr
+        status = cli("status", out)
+        assert status.returncode == 0 and "running" in status.stdout and "progress:" in status.stdout
+    finally:
+        code, log = stop(first)
+    assert code == 75, log
+    assert not os.path.exists(lock.lock_path(out))          # released on the way out
+    events, tasks, _ = catalog.read(catalog.partial_path(out))
+    assert len(events["t"]) == tasks["events_written"].sum() > 0
+
+
+def test_status_shows_progress_within_seconds_of_the_start(long_cfg, tmp_path):
+    """Before any flush (flush_seconds = 1000 here) the lock carries the live progress line."""
+    out = tmp_path / "early.h5"
+    proc = start(long_cfg, out, "--set", "output.flush_seconds=1000")
+    try:
+        wait_until(lambda: "events 0/" not in lock.read_info(out).get("progress", "events 0/"), proc)
+        status = cli("status", out)
+        assert "running" in status.stdout and "events/s" in status.stdout, status.stdout
+        assert "open" in status.stdout         # per task, from the catalog being written
+    finally:
+        code, _ = stop(proc)
+    assert code == 75
+
+
+def test_a_stale_lock_of_a_dead_run_is_taken_over(small, tmp_path):
+    d, cfg = small
+    out = tmp_path / "stale.h5"
+    dead = subprocess.Popen(["sleep", "0"])
+    dead.wait()
+    with open(lock.lock_path(out), "w") as fh:
+        fh.write(f"host: {socket.gethostname()}\npid: {dead.pid}\nstarted: x\nheartbeat: {time.time():.1f}\n")
+    res = cli("run", cfg, "-o", out)
+    assert res.returncode == 0, res.stderr
+    assert "took over the lock left by a run that died" in res.stdout
+    assert not os.path.exists(lock.lock_path(out))
+
+
+def test_a_lock_from_another_host_with_a_fresh_heartbeat_is_refused_with_how_to_remove_it(small, tmp_path):
+    d, cfg = small
+    out = tmp_path / "foreign.h5"
+    path = lock.lock_path(out)
+    with open(path, "w") as fh:
+        fh.write(f"host: node-elsewhere\npid: 4242\nstarted: x\nheartbeat: {time.time():.1f}\n")
+    res = cli("run", cfg, "-o", out)
+    assert res.returncode == 2 and "node-elsewhere" in res.stderr and f"rm {path}" in res.stderr
+    assert not os.path.exists(catalog.partial_path(out))
+    os.remove(path)
+    assert cli("run", cfg, "-o", out).returncode == 0
+
+
+def test_resume_of_a_finished_catalog_refuses_a_changed_config(small):
+    d, cfg = small
+    res = cli("run", cfg, "-o", d / "full.h5", "--resume", "--set", "model.b=30")
+    assert res.returncode == 2 and "model.b" in res.stderr
+    res = cli("run", cfg, "-o", d / "full.h5", "--resume")
+    assert res.returncode == 0 and "complete" in res.stdout
+
+
+def test_output_paths_are_checked_before_any_work(small, tmp_path):
+    d, cfg = small
+    (tmp_path / "adir").mkdir()
+    for target in (tmp_path / "adir", tmp_path / "missing" / "x.h5"):
+        res = cli("run", cfg, "-o", target, "--force")
+        assert res.returncode == 2 and str(target.parent if "missing" in str(target) else target) in res.stderr
+        assert "progress" not in res.stdout and not os.path.exists(catalog.partial_path(target))
+    assert list((tmp_path / "adir").iterdir()) == []
+
+
+def test_a_signal_just_after_the_rename_leaves_exit_0(small, tmp_path):
+    d, cfg = small
+    res = injected("inject.signal_after_rename(15)", "run", cfg, "-o", tmp_path / "late.h5")
+    assert res.returncode == 0, res.stderr      # not 143: the catalog is complete
+    same_events(d / "full.h5", tmp_path / "late.h5")
+
+
+def test_resume_continues_from_the_stored_config_without_retyping_overrides(long_cfg, tmp_path):
+    """A run started with --set options, interrupted, is continued by `resume CATALOG` alone."""
+    sets = ["--set", "run.events=90", "--set", "model.b=30", "--set", "output.flush_seconds=0.2"]
+    ref = tmp_path / "ref.h5"
+    assert cli("run", long_cfg, "-o", ref, *sets).returncode == 0
+    out = tmp_path / "cut.h5"
+    proc = start(long_cfg, out, *sets)
+    wait_until(lambda: committed(out), proc)
+    code, _ = stop(proc)
+    if code == 0:
+        pytest.skip("the run finished before it could be interrupted (an idle machine is too fast)")
+    res = cli("resume", out)
+    assert res.returncode == 0, res.stderr
+    same_events(ref, out)
+    res = cli("resume", out)
+    assert res.returncode == 0 and "complete" in res.stdout
+
+
+def test_resume_refuses_changes_to_the_physics_and_integrator_changes_without_failed_tasks(interrupted):
+    cfg, out = interrupted
+    res = cli("resume", out, "--set", "model.b=30")
+    assert res.returncode == 2 and "model.b" in res.stderr and "new run" in res.stderr
+    res = cli("resume", out, "--set", "integrator.dt=1e-4")
+    assert res.returncode == 2 and "no failed task" in res.stderr
+
+
+def test_a_failing_task_is_recorded_and_rerun_with_another_integrator(small, tmp_path):
+    """b = 80 is unstable at dt = 1e-3: the task fails, the other finishes; resume reruns it."""
+    d, _ = small
+    cfg = write_config(tmp_path / "mix.toml", sweep={"b": [20.0, 80.0]}, run={"seeds": 1, "events": 60,
+                       "transient": 10}, integrator={"dt": 1e-3}, output={"batch": 20})
+    out = tmp_path / "mix.h5"
+    res = cli("run", cfg, "-o", out)
+    assert res.returncode == 1 and "task 1" in res.stderr and "stability" in res.stderr
+    assert "resume" in res.stdout and not out.exists()
+    _, tasks, _ = catalog.read(catalog.partial_path(out))
+    assert list(tasks["status"]) == [catalog.FINISHED, catalog.FAILED] and "stability" in tasks["error"][1]
+    status = cli("status", out)
+    assert status.returncode == 0 and "failed: tasks 1" in status.stdout
+    assert cli("resume", out).returncode == 1           # nothing changed: still failed, said again
+    res = cli("resume", out, "--set", "integrator.dt=2e-4")
+    assert res.returncode == 0, res.stderr
+    events, tasks, _ = catalog.read(out)
+    assert list(tasks["status"]) == [catalog.FINISHED] * 2 and list(tasks["events_written"]) == [60, 60]
+    assert "dt = 0.001" in tasks["integrator"][0] and "dt = 0.0002" in tasks["integrator"][1]
+    ref = tmp_path / "ref.h5"
+    assert cli("run", cfg, "-o", ref, "--set", "integrator.dt=2e-4").returncode == 0
+    ref_events, _, _ = catalog.read(ref)
+    for name in catalog.EVENT_FIELDS:       # the rerun task equals a run at dt = 2e-4 from the start
+        np.testing.assert_array_equal(events[name][events["task"] == 1], ref_events[name][ref_events["task"] == 1])
+
+
+@pytest.fixture
+def small_disk(tmp_path):
+    """A tmpfs of 300 KiB (needs root, as in CI; elsewhere the test cannot make a full disk)."""
+    mount = tmp_path / "disk"
+    mount.mkdir()
+    res = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=300k", "tmpfs", str(mount)], capture_output=True)
+    if res.returncode != 0:
+        pytest.skip(f"cannot mount a small tmpfs here ({res.stderr.decode().strip()})")
+    yield mount
+    subprocess.run(["umount", "-l", str(mount)], capture_output=True)
+
+
+def test_a_full_disk_stops_the_run_with_one_line_and_nothing_lost(small, small_disk):
+    d, cfg = small
+    big = ["--set", "run.events=3000", "--set", "output.batch=500"]     # ~440 KiB of events
+    # at creation: the space is reserved up front, so the run stops before any work
+    res = cli("run", cfg, "-o", small_disk / "a.h5", *big)
+    assert res.returncode == 1 and "No space left on device" in res.stderr
+    assert len(res.stderr.strip().splitlines()) == 1 and not any(small_disk.iterdir())
+    # in the middle (a file system without fallocate: nothing reserved): one line, a readable catalog
+    res = injected("from ensemble import catalog; catalog._reserve_space = lambda path: None",
+                   "run", cfg, "-o", small_disk / "b.h5", *big)
+    assert res.returncode == 1 and "No space left on device" in res.stderr, res.stderr
+    assert len(res.stderr.strip().splitlines()) == 1
+    status = cli("status", small_disk / "b.h5")
+    assert status.returncode == 0 and "interrupted" in status.stdout
+    # space freed: the same catalog, resumed, completes (the small config fits)
+    subprocess.run(["mount", "-o", "remount,size=8m", str(small_disk)], check=True)
+    res = cli("resume", small_disk / "b.h5")
+    assert res.returncode == 0, res.stderr
+
+
+def test_signal_during_kernel_compilation_is_acknowledged_at_once(small, tmp_path):
+    """An empty numba cache: rank 0 says it compiles; SIGINT is acknowledged within seconds, exit 75."""
+    d, cfg = small
+    proc = subprocess.Popen([sys.executable, "-m", "ensemble", "run", cfg, "-o", tmp_path / "c.h5"],
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                            env=dict(env(), NUMBA_CACHE_DIR=str(tmp_path / "cache")))
+    watchdog = threading.Timer(300, proc.kill)     # the reads below cannot block for longer
+    watchdog.start()
+    try:
+        lines = [proc.stdout.readline(), proc.stdout.readline()]      # "writing ...", "compiling ..."
+        assert lines[1].startswith("compiling kernels"), lines
+        proc.send_signal(signal.SIGINT)
+        out, _ = proc.communicate()
+    finally:
+        watchdog.cancel()
+        proc.kill()
+    assert proc.returncode == 75, out
+    # acknowledged while compiling: before the kernels were ready, not after
+    assert "SIGINT received while compiling kernels" in out.split("kernels ready")[0], out
+    assert "interrupted (SIGINT)" in out
+    assert "progress" not in out.split("kernels ready")[0]    # the rate does not count the compilation
+    shutil.rmtree(tmp_path / "cache", ignore_errors=True)
