@@ -14,8 +14,8 @@ from .catalog import Checkpoint, CatalogError
 from .config import ConfigError, loads
 from .integrators import kernel_args
 from .model.chain import simulate
-from .model.workspace import (D_DURATION, D_FIRST, D_LAST, D_NSLIP, D_SLIP, NDIAG, OK,
-                              STATUS_TEXT, Workspace)
+from .model.workspace import (D_DURATION, D_FIRST, D_LAST, D_NSLIP, D_SLIP, NDIAG, OK, PAUSED,
+                              STATUS_TEXT, UNLIMITED, Workspace)
 from .parallel import Coordinator
 from .tasks import initial_state, task_list
 
@@ -44,27 +44,32 @@ class Trajectory:
         self.args = kernel_args(task.model, cfg.integrator)
 
     def checkpoint(self):
-        ws = self.ws
-        return Checkpoint(ws.force.copy(), ws.psi.copy(), ws.since.copy(), self.clock.copy(), self.done)
+        """The state after the last completed event (also while an event is paused)."""
+        force, psi, since, clock = self.ws.between_events(self.clock)
+        return Checkpoint(force, psi, since, clock, self.done)
 
     def state(self):
         """(force, psi) of every block now (between events), c-free frame."""
         return self.ws.state(self.clock, self.task.model.nu)
 
-    def advance(self, n):
-        """Run n events; returns (onset times, epicenters, diagnostics rows)."""
+    def advance(self, n, budget=UNLIMITED):
+        """Run n events; returns (onset times, epicenters, diagnostics rows).
+
+        With a work `budget` (chain.simulate) fewer events may be returned: the call stops
+        when the budget is spent, possibly in the middle of an event, which the next call continues.
+        """
         t = np.empty(n)
         epicenter = np.empty(n, dtype=np.int64)
         diag = np.empty((n, NDIAG))
         ws = self.ws
-        status, k = simulate(*ws.arrays, self.clock, *self.args, n, t, epicenter, diag)
-        if status != OK:
+        status, k = simulate(*ws.arrays, self.clock, *self.args, n, budget, t, epicenter, diag)
+        if status not in (OK, PAUSED):
             where = self.done + k
             phase = "transient " if where < self.cfg.run.transient else ""
             raise SimulationError(f"task {self.task.index} {phase}event {where}: {STATUS_TEXT[status]} "
                                   f"(method={self.cfg.integrator.method}, dt={self.cfg.integrator.dt})")
-        self.done += n
-        return t, epicenter, diag
+        self.done += k
+        return t[:k], epicenter[:k], diag[:k]
 
 
 def event_rows(task, t, epicenter, diag):
