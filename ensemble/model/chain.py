@@ -21,10 +21,10 @@ import numpy as np
 
 from .event import begin_event, continue_event
 from .onset import onset_delay
-from .schedule import advance_clock, build_schedule, materialize, tree_min
+from .schedule import advance_clock, build_schedule, finite_state, materialize, tree_min
 from .undo import log_block
 from .workspace import (BETWEEN, D_DURATION, D_SLIP, EV_CLOCK_HI, EV_CLOCK_LO, EV_EPICENTER, EV_PHASE,
-                        F0, NTRACE, OK, P, PAUSED)
+                        F0, NONFINITE, NTRACE, OK, P, PAUSED)
 
 # Work units charged for each event besides its block-steps: the onset search (tree descent,
 # onset delay), setting it up and finishing it cost about as much as a few tens of block-steps
@@ -51,12 +51,17 @@ def simulate(W, act, flag, touched, stuck, since, tree, diag, event, undo, clock
     holds their onset keys, or NaN at the root after a new state was loaded.
     out_t[k] is the onset time of event k, out_epicenter[k] its epicenter,
     out_diag[k] the event's diagnostics vector (workspace.D_*). On a status
-    other than OK and PAUSED the state is that after the failed event, which is not counted.
+    other than OK and PAUSED the state is that after the failed event, which is not counted;
+    NONFINITE also stands for a NaN or inf among the parameters or the loaded state.
     """
     n = W.shape[0]
     no_profile = np.empty(0)
     no_trace = np.empty((0, NTRACE))
+    if not _finite_parameters(l2, nu, a, b, dt, rtol, atol, h_max, max_duration):
+        return NONFINITE, 0
     if math.isnan(tree[1]):      # a freshly loaded state (Workspace.load): schedule every block
+        if not finite_state(W, since):
+            return NONFINITE, 0
         build_schedule(W, since, tree, nu, b)
     onset = np.empty(2)
     k = 0
@@ -69,6 +74,8 @@ def simulate(W, act, flag, touched, stuck, since, tree, diag, event, undo, clock
             # The onset, exactly: the epicenter's own delay from its state (the tree
             # only orders the blocks), never before the end of the previous event.
             delay = onset_delay(W[epicenter, F0], W[epicenter, P], nu, b)
+            if not math.isfinite(delay):     # a NaN state, or inf: no block ever starts (b / nu > 1e308)
+                return NONFINITE, k
             onset[0] = since[epicenter, 0]
             onset[1] = since[epicenter, 1]
             advance_clock(onset, delay)
@@ -105,3 +112,10 @@ def simulate(W, act, flag, touched, stuck, since, tree, diag, event, undo, clock
         k += 1
     return (OK if event[EV_PHASE] == BETWEEN else PAUSED), k
 
+
+@nb.njit(cache=True)
+def _finite_parameters(l2, nu, a, b, dt, rtol, atol, h_max, max_duration):
+    """No NaN or inf among the model and integrator parameters."""
+    return (math.isfinite(l2) and math.isfinite(nu) and math.isfinite(a) and math.isfinite(b)
+            and math.isfinite(dt) and math.isfinite(rtol) and math.isfinite(atol)
+            and math.isfinite(h_max) and math.isfinite(max_duration))

@@ -102,7 +102,7 @@ UNLIMITED = 2**62
 # status codes of the kernels (all but OK and PAUSED are errors)
 OK, NONFINITE, UNSTABLE, TOO_LONG, PAUSED = 0, 1, 2, 3, 4
 STATUS_TEXT = {
-    NONFINITE: "non-finite state (numerical blow-up)",
+    NONFINITE: "non-finite state or parameter (numerical blow-up, or NaN/inf in the input)",
     UNSTABLE: "step beyond the stability limit of RK4 (dt / theta > 2.785); reduce integrator.dt",
     TOO_LONG: "event exceeded integrator.max_duration (stable sliding? b below the block stiffness?)",
     PAUSED: "not an error: the work budget of the kernel call ran out in the middle of an event, "
