@@ -19,13 +19,19 @@ from .config import ConfigError, _toml_value, from_dict, loads
 from .integrators import kernel_args
 from .lock import RunLock
 from .model.chain import simulate
-from .model.workspace import (D_DURATION, D_FIRST, D_LAST, D_NSLIP, D_SLIP, NDIAG, OK,
-                              STATUS_TEXT, Workspace)
+from .model.workspace import (D_DURATION, D_FIRST, D_LAST, D_NSLIP, D_SLIP, NDIAG, OK, PAUSED,
+                              STATUS_TEXT, UNLIMITED, Workspace)
 from .parallel import Coordinator
 from .tasks import initial_state, task_list
 
 EXIT_INTERRUPTED = 75   # checkpointed after a signal; continue with --resume (EX_TEMPFAIL)
 EXIT_FAILED = 1         # some tasks failed (recorded in the catalog); the others finished
+
+
+# work budget of a kernel call, in block-steps (chain.simulate): ~0.05 s at the ~200 ns per
+# block-step of the adaptive methods (benchmarks/results/step_budget_*); then sized by time
+FIRST_BUDGET = 250_000
+MIN_BUDGET = 1_000
 
 
 class Refused(RuntimeError):
@@ -55,28 +61,33 @@ class Trajectory:
         self.args = kernel_args(task.model, self.integrator)
 
     def checkpoint(self):
-        ws = self.ws
-        return Checkpoint(ws.force.copy(), ws.psi.copy(), ws.since.copy(), self.clock.copy(), self.done)
+        """The state after the last completed event (also while an event is paused)."""
+        force, psi, since, clock = self.ws.between_events(self.clock)
+        return Checkpoint(force, psi, since, clock, self.done)
 
     def state(self):
         """(force, psi) of every block now (between events), c-free frame."""
         return self.ws.state(self.clock, self.task.model.nu)
 
-    def advance(self, n):
-        """Run n events; returns (onset times, epicenters, diagnostics rows)."""
+    def advance(self, n, budget=UNLIMITED):
+        """Run n events; returns (onset times, epicenters, diagnostics rows).
+
+        With a work `budget` (chain.simulate) fewer events may be returned: the call stops
+        when the budget is spent, possibly in the middle of an event, which the next call continues.
+        """
         t = np.empty(n)
         epicenter = np.empty(n, dtype=np.int64)
         diag = np.empty((n, NDIAG))
         ws = self.ws
-        status, k = simulate(*ws.arrays, self.clock, *self.args, n, t, epicenter, diag)
-        if status != OK:
+        status, k = simulate(*ws.arrays, self.clock, *self.args, n, budget, t, epicenter, diag)
+        if status not in (OK, PAUSED):
             where = self.done + k
             phase = "transient " if where < self.cfg.run.transient else ""
             raise SimulationError(f"task {self.task.index} {phase}event {where}: {STATUS_TEXT[status]} "
                                   f"(method={self.integrator.method}, dt={self.integrator.dt}, "
                                   f"rtol={self.integrator.rtol})")
-        self.done += n
-        return t, epicenter, diag
+        self.done += k
+        return t[:k], epicenter[:k], diag[:k]
 
 
 def event_rows(task, t, epicenter, diag):
@@ -205,6 +216,7 @@ class TaskRunner:
         buffer = []
         buffered = 0
         chunk = 4
+        budget = FIRST_BUDGET
         wall = time.perf_counter()
         last_flush = wall
         record_time = 0.0
@@ -230,16 +242,22 @@ class TaskRunner:
             phase_left = (total if recording else cfg.run.transient) - traj.done
             n = min(chunk, phase_left, cfg.output.batch - buffered)
             t0 = time.perf_counter()
-            out = traj.advance(n)
+            out = traj.advance(n, budget)
             elapsed = time.perf_counter() - t0
-            # size the next kernel call to last about poll_seconds
-            chunk = int(np.clip(n * cfg.run.poll_seconds / max(elapsed, 1e-6), 1, cfg.output.batch))
-            self.coord.count_events(n)
-            if recording:
+            k = len(out[0])
+            # Size the next kernel call to last about poll_seconds: by events while they are
+            # cheap, by work (budget, in block-steps) when one event is long, so that signals,
+            # progress and checkpoints are served in time whatever an event costs.
+            scale = cfg.run.poll_seconds / max(elapsed, 1e-6)
+            if k < n:
+                budget = int(np.clip(budget * min(scale, 4.0), MIN_BUDGET, UNLIMITED))
+            chunk = int(np.clip(max(k, 1) * scale, 1, cfg.output.batch))
+            self.coord.count_events(k)
+            if recording and k:
                 record_time += elapsed
-                recorded_here += n
+                recorded_here += k
                 buffer.append(event_rows(task, *out))
-                buffered += n
+                buffered += k
             now = time.perf_counter()
             if buffered >= cfg.output.batch or now - last_flush >= cfg.output.flush_seconds:
                 flush()

@@ -4,7 +4,7 @@ import numpy as np
 from ensemble.config import Integrator, Model
 from ensemble.integrators import kernel_args
 from ensemble.model.chain import simulate
-from ensemble.model.workspace import NDIAG, Workspace
+from ensemble.model.workspace import NDIAG, UNLIMITED, Workspace
 
 from .conftest import developed_state, next_event
 
@@ -41,7 +41,7 @@ def test_clock_offset_does_not_change_events():
         t = np.empty(20)
         epi = np.empty(20, dtype=np.int64)
         diag = np.empty((20, NDIAG))
-        status, _ = simulate(*ws.arrays, clock, *kernel_args(model, Integrator(method="rk4")), 20, t, epi, diag)
+        status, _ = simulate(*ws.arrays, clock, *kernel_args(model, Integrator(method="rk4")), 20, UNLIMITED, t, epi, diag)
         assert status == 0
         out.append((t - start, epi, diag))
     np.testing.assert_array_equal(out[0][2], out[1][2])

@@ -373,3 +373,43 @@ def test_signal_during_kernel_compilation_is_acknowledged_at_once(small, tmp_pat
     assert "interrupted (SIGINT)" in out
     assert "progress" not in out.split("kernels ready")[0]    # the rate does not count the compilation
     shutil.rmtree(tmp_path / "cache", ignore_errors=True)
+
+
+def test_kernel_calls_paused_in_the_middle_of_events_give_the_same_catalog(small, tmp_path):
+    """poll_seconds so short that most kernel calls end inside an event (rk4 at a small dt)."""
+    d, cfg = small
+    slow = ["--set", "integrator.dt=2e-5", "--set", "run.events=30"]
+    ref = tmp_path / "ref.h5"
+    assert cli("run", cfg, "-o", ref, *slow, "--set", "run.poll_seconds=100").returncode == 0
+    out = tmp_path / "paused.h5"
+    res = cli("run", cfg, "-o", out, *slow, "--set", "run.poll_seconds=0.001")
+    assert res.returncode == 0, res.stderr
+    same_events(ref, out)
+    # and a checkpoint taken while an event is paused resumes to the same catalog
+    cut = tmp_path / "cut.h5"
+    proc = start(cfg, cut, *slow, "--set", "run.poll_seconds=0.001", "--set", "output.flush_seconds=0.05")
+    wait_until(lambda: committed(cut), proc)
+    code, _ = stop(proc)
+    if code == 0:
+        pytest.skip("the run finished before it could be interrupted")
+    assert code == 75
+    assert cli("resume", cut).returncode == 0
+    same_events(ref, cut)
+
+
+def test_a_signal_during_one_very_long_event_is_served_within_a_kernel_call(tmp_path):
+    """One event takes minutes here (RK4 at dt = 1e-8); SIGTERM still ends the run at once with 75."""
+    cfg = write_config(tmp_path / "slow.toml", model={"N": 200, "b": 20.0},
+                       run={"seeds": 1, "events": 10, "transient": 0}, integrator={"method": "rk4", "dt": 1e-8})
+    out = tmp_path / "slow.h5"
+    proc = start(cfg, out)
+    try:
+        # the work loop has started (it refreshes the lock's progress line between kernel calls)
+        wait_until(lambda: lock.read_info(out).get("progress", "starting") != "starting", proc)
+        code, log = stop(proc)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert code == 75, log
+    _, tasks, _ = catalog.read(catalog.partial_path(out))
+    assert tasks["events_written"][0] == 0 and tasks["events_done"][0] == 0   # the event was in progress

@@ -7,62 +7,115 @@ reaches t ~ 1e15, where a single float64 resolves only ~0.1; everything the
 physics uses is a time difference (time since the onset, since a block came to
 rest), so accuracy does not decay as the run goes on. Between events only the
 blocks an event touched are updated (schedule.py).
+
+A call is bounded by a work budget rather than by events alone, because one event can
+cost minutes (a tiny RK4 step, a huge N) while the caller must serve signals, progress and
+checkpoints every few tenths of a second. Work is counted in block-steps (event.py) plus
+EVENT_WORK per event; a call may stop in the middle of an event and the next call continues
+it, bit-identically (its state stays in the workspace: workspace.EV_*, undo.py).
 """
 import math
 
 import numba as nb
 import numpy as np
 
-from .event import integrate_event
+from .event import begin_event, continue_event
 from .onset import onset_delay
-from .schedule import advance_clock, build_schedule, materialize, tree_min
-from .workspace import D_DURATION, D_SLIP, F0, NTRACE, OK, P
+from .schedule import advance_clock, build_schedule, finite_state, materialize, tree_min
+from .undo import log_block
+from .workspace import (BETWEEN, D_DURATION, D_SLIP, EV_CLOCK_HI, EV_CLOCK_LO, EV_EPICENTER, EV_PHASE,
+                        F0, NONFINITE, NTRACE, OK, P, PAUSED)
+
+# Work units charged for each event besides its block-steps: the onset search (tree descent,
+# onset delay), setting it up and finishing it cost about as much as a few tens of block-steps
+# (O(log N) and O(blocks touched) operations), which matters for the many one-block events.
+EVENT_WORK = 32
 
 
 @nb.njit(cache=True)
-def simulate(W, act, flag, touched, stuck, since, tree, diag, clock, l2, nu, a, b, method, dt, rtol,
-             atol, h_max, max_duration, max_steps, n_events, out_t, out_epicenter, out_diag):
-    """Run n_events events from the time `clock`; returns (status, number of events completed).
+def simulate(W, act, flag, touched, stuck, since, tree, diag, event, undo, clock, l2, nu, a, b, method,
+             dt, rtol, atol, h_max, max_duration, max_steps, n_events, budget, out_t, out_epicenter,
+             out_diag):
+    """Run up to n_events events from the time `clock`, within `budget` work units.
+
+    Returns (status, k), k the number of events completed in this call:
+    OK and k = n_events, or OK and k < n_events when the budget ran out between two events;
+    PAUSED when it ran out in the middle of an event, which stays in the workspace (`event`,
+    `undo`, and `clock` at its onset) and the next call continues (its row is then that
+    call's first). Work: the block-steps of the events (event.py) plus EVENT_WORK per event
+    begun. The budget is checked before each step and before each event, so a call overruns
+    it by at most one step; with budget >= 1 every call makes progress. Any budget gives
+    the same events, bit for bit, as one call with workspace.UNLIMITED.
 
     Every block is at rest with its state at time since[i] (see schedule.py); `tree`
     holds their onset keys, or NaN at the root after a new state was loaded.
     out_t[k] is the onset time of event k, out_epicenter[k] its epicenter,
     out_diag[k] the event's diagnostics vector (workspace.D_*). On a status
-    other than OK the state is that after the failed event, which is not counted.
+    other than OK and PAUSED the state is that after the failed event, which is not counted;
+    NONFINITE also stands for a NaN or inf among the parameters or the loaded state.
     """
     n = W.shape[0]
     no_profile = np.empty(0)
     no_trace = np.empty((0, NTRACE))
+    if not _finite_parameters(l2, nu, a, b, dt, rtol, atol, h_max, max_duration):
+        return NONFINITE, 0
     if math.isnan(tree[1]):      # a freshly loaded state (Workspace.load): schedule every block
+        if not finite_state(W, since):
+            return NONFINITE, 0
         build_schedule(W, since, tree, nu, b)
     onset = np.empty(2)
     k = 0
+    spent = 0
     while k < n_events:
-        _, epicenter = tree_min(tree)
-        # The onset, exactly: the epicenter's own delay from its state (the tree
-        # only orders the blocks), never before the end of the previous event.
-        onset[0] = since[epicenter, 0]
-        onset[1] = since[epicenter, 1]
-        advance_clock(onset, onset_delay(W[epicenter, F0], W[epicenter, P], nu, b))
-        if (onset[0] - clock[0]) + (onset[1] - clock[1]) > 0.0:
-            clock[0] = onset[0]
-            clock[1] = onset[1]
-        materialize(W, since, epicenter, clock, nu)
-        # Put the epicenter on its threshold, not a round-off below it, so the
-        # event starts without a false stick (a force above it stays as it is).
-        if W[epicenter, F0] < b * W[epicenter, P]:
-            W[epicenter, F0] = b * W[epicenter, P]
-        status = integrate_event(W, act, flag, touched, stuck, since, tree, clock, n, epicenter, 0.0,
-                                 l2, nu, a, b, method, dt, rtol, atol, h_max, max_duration, max_steps,
-                                 diag, no_profile, no_trace)
-        if status != OK:
-            return status, k
+        if event[EV_PHASE] == BETWEEN:
+            if spent >= budget:
+                return OK, k
+            _, epicenter = tree_min(tree)
+            # The onset, exactly: the epicenter's own delay from its state (the tree
+            # only orders the blocks), never before the end of the previous event.
+            delay = onset_delay(W[epicenter, F0], W[epicenter, P], nu, b)
+            if not math.isfinite(delay):     # a NaN state, or inf: no block ever starts (b / nu > 1e308)
+                return NONFINITE, k
+            onset[0] = since[epicenter, 0]
+            onset[1] = since[epicenter, 1]
+            advance_clock(onset, delay)
+            # from here on the event changes the between-events state: keep what it was
+            event[EV_CLOCK_HI] = clock[0]
+            event[EV_CLOCK_LO] = clock[1]
+            log_block(W, since, event, undo, epicenter)
+            if (onset[0] - clock[0]) + (onset[1] - clock[1]) > 0.0:
+                clock[0] = onset[0]
+                clock[1] = onset[1]
+            materialize(W, since, epicenter, clock, nu)
+            # Put the epicenter on its threshold, not a round-off below it, so the
+            # event starts without a false stick (a force above it stays as it is).
+            if W[epicenter, F0] < b * W[epicenter, P]:
+                W[epicenter, F0] = b * W[epicenter, P]
+            begin_event(W, act, flag, touched, since, tree, clock, n, epicenter, 0.0, l2, nu, b, dt, event,
+                        undo)
+            spent += EVENT_WORK
+        status, used = continue_event(W, act, flag, touched, stuck, since, tree, clock, n, l2, nu, a, b,
+                                      method, dt, rtol, atol, h_max, max_duration, max_steps, diag,
+                                      no_profile, no_trace, event, undo, budget - spent)
+        spent += used
+        if status == PAUSED:
+            return PAUSED, k
         t_onset = clock[0] + clock[1]
         advance_clock(clock, diag[D_DURATION])
+        if status != OK:
+            return status, k
         if diag[D_SLIP] == 0.0:
             continue    # nothing moved (an onset within round-off of the threshold): no event
         out_t[k] = t_onset
-        out_epicenter[k] = epicenter
+        out_epicenter[k] = int(event[EV_EPICENTER])
         out_diag[k, :] = diag
         k += 1
-    return OK, n_events
+    return (OK if event[EV_PHASE] == BETWEEN else PAUSED), k
+
+
+@nb.njit(cache=True)
+def _finite_parameters(l2, nu, a, b, dt, rtol, atol, h_max, max_duration):
+    """No NaN or inf among the model and integrator parameters."""
+    return (math.isfinite(l2) and math.isfinite(nu) and math.isfinite(a) and math.isfinite(b)
+            and math.isfinite(dt) and math.isfinite(rtol) and math.isfinite(atol)
+            and math.isfinite(h_max) and math.isfinite(max_duration))

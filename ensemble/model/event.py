@@ -13,6 +13,13 @@ the end of a step instead would make the slip only second-order accurate.
 Work arrays (see `workspace.py`): columns of the float array `W` hold per-block
 quantities, `act` the active list, `flag` 0 (never slid in this event), 1
 (sliding), 2 (slid and now at rest), `touched` the blocks that slid.
+
+An event is begun (`begin_event`) and then integrated by `continue_event`, which returns
+after a given amount of work if the event has not finished by then, its loop variables kept
+in the event-state vector (workspace.EV_*), and carries on from there at the next call:
+every floating-point operation is the same as in one call, so the result is bit-identical.
+Work is counted in block-steps: the sliding blocks of every step tried (rejected steps and
+steps redone after a cut included), the quantity the cost of an event is proportional to.
 """
 import math
 
@@ -24,10 +31,14 @@ from .onset import onset_delay
 from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
 from .steppers import ERROR_WEIGHTS, ark3_step, ark4_step, ark5_step, block_error, rk4_step
 from .tableaux import ARK324, ARK436, ARK548
-from .workspace import (D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ENERGY_SCALE, D_FIRST, D_LAST, D_NSLIP,
-                        D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK, F0, HD0,
-                        HD1, K1V, NONFINITE, OK, P, P0, T_AGE, T_BLOCK, T_ERROR, T_H, T_OWN, T_PART,
-                        T_PSI, T_SLIDING, T_TAU, T_V, TOO_LONG, TR, TS, UNSTABLE, V, V0, Y, Y0, YS)
+from .undo import clear_log, log_block
+from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ENERGY_SCALE, D_FIRST, D_LAST,
+                        D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK, EV_BLOCK_STEPS,
+                        EV_CUTS, EV_EPICENTER, EV_ERR_PREV, EV_FAR, EV_H_NEXT, EV_NA, EV_NT, EV_PHASE,
+                        EV_REJECTED, EV_SLIP_TIME, EV_STEPS, EV_T_FAR, EV_TAU, EV_TRACED, EV_VMAX,
+                        EV_WORK, EV_YREST, F0, HD0, HD1, IN_EVENT, K1V, NEVENT, NONFINITE, NUNDO, OK,
+                        P, P0, PAUSED, T_AGE, T_BLOCK, T_ERROR, T_H, T_OWN, T_PART, T_PSI, T_SLIDING,
+                        T_TAU, T_V, TOO_LONG, TR, TS, UNLIMITED, UNSTABLE, V, V0, Y, Y0, YS)
 
 # integrators (see ensemble.integrators): fixed-step RK4, adaptive IMEX ARK3(2), ARK4(3), ARK5(4)
 RK4, ARK3, ARK4, ARK5 = 0, 1, 2, 3
@@ -141,17 +152,18 @@ def _far_onset(W, flag, n, since, tree, t0, tau, l2, nu, b):
 
 
 @nb.njit(cache=True)
-def _watch(W, since, tree, t0, nu, j):
+def _watch(W, since, tree, t0, nu, j, event, undo):
     """Block j starts or neighbours a sliding block: bring it to t0, take it off the schedule."""
+    log_block(W, since, event, undo, j)
     materialize(W, since, j, t0, nu)
     tree_set(tree, j, np.inf)
 
 
 @nb.njit(cache=True)
-def _start(W, act, na, flag, touched, nt, since, tree, t0, nu, j, tau, yrest):
+def _start(W, act, na, flag, touched, nt, since, tree, t0, nu, j, tau, yrest, event, undo):
     """Block j starts to slide at local time tau; returns (na, nt, yrest)."""
     for k in (left(j), j, right(j, W.shape[0])):
-        _watch(W, since, tree, t0, nu, k)
+        _watch(W, since, tree, t0, nu, k, event, undo)
     if flag[j] == 2:
         yrest -= W[j, Y]
     else:
@@ -223,26 +235,94 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
     has n entries it receives the slip of every block (else pass an empty
     array). If `trace` has rows, each step tried fills one (workspace.TRACE_COLUMNS, until the
     rows run out; a step cut at a located transition appears once, as tried). Returns a status code.
+
+    This is begin_event and continue_event without a budget, in one call.
     """
-    na, nt, yrest = _start(W, act, 0, flag, touched, 0, since, tree, t0, nu, epicenter, 0.0, 0.0)
+    event = np.zeros(NEVENT)
+    undo = np.empty((n, NUNDO))
+    begin_event(W, act, flag, touched, since, tree, t0, n, epicenter, v_start, l2, nu, b, dt, event, undo)
+    status, _ = continue_event(W, act, flag, touched, stuck, since, tree, t0, n, l2, nu, a, b, method, dt,
+                               rtol, atol, h_max, max_duration, max_steps, diag, profile, trace, event,
+                               undo, UNLIMITED)
+    return status
+
+
+@nb.njit(cache=True)
+def begin_event(W, act, flag, touched, since, tree, t0, n, epicenter, v_start, l2, nu, b, dt, event, undo):
+    """Start an event at the onset of `epicenter` at time t0 (as integrate_event's entry).
+
+    The epicenter and its neighbours are watched (their between-events values logged in `undo`),
+    and the event's loop variables go into `event` (EV_*, EV_PHASE = IN_EVENT) for
+    continue_event. EV_NUNDO and the clock entries are the caller's (chain.simulate).
+    """
+    na, nt, yrest = _start(W, act, 0, flag, touched, 0, since, tree, t0, nu, epicenter, 0.0, 0.0, event,
+                           undo)
     t_far, far = _far_onset(W, flag, n, since, tree, t0, 0.0, l2, nu, b)
     W[epicenter, V] = v_start
-    tau = 0.0
-    work = 0.0
-    slip_time = 0.0
-    steps = 0
-    block_steps = 0
-    rejected = 0
-    cuts = 0
-    vmax = v_start
+    event[EV_PHASE] = IN_EVENT
+    event[EV_EPICENTER] = epicenter
+    _keep(event, na, nt, yrest, t_far, far, 0.0, 0.0, 0.0, 0, 0, 0, 0, v_start, dt, 1.0, 0)
+
+
+@nb.njit(cache=True, inline="always")
+def _keep(event, na, nt, yrest, t_far, far, tau, work, slip_time, steps, block_steps, rejected, cuts,
+          vmax, h_next, err_prev, traced):
+    """The loop variables of the event in progress into the event-state vector (workspace.EV_*)."""
+    event[EV_NA] = na
+    event[EV_NT] = nt
+    event[EV_YREST] = yrest
+    event[EV_T_FAR] = t_far
+    event[EV_FAR] = far
+    event[EV_TAU] = tau
+    event[EV_WORK] = work
+    event[EV_SLIP_TIME] = slip_time
+    event[EV_STEPS] = steps
+    event[EV_BLOCK_STEPS] = block_steps
+    event[EV_REJECTED] = rejected
+    event[EV_CUTS] = cuts
+    event[EV_VMAX] = vmax
+    event[EV_H_NEXT] = h_next
+    event[EV_ERR_PREV] = err_prev
+    event[EV_TRACED] = traced
+
+
+@nb.njit(cache=True)
+def continue_event(W, act, flag, touched, stuck, since, tree, t0, n, l2, nu, a, b, method, dt, rtol, atol,
+                   h_max, max_duration, max_steps, diag, profile, trace, event, undo, budget):
+    """Integrate the event in progress (begin_event) until every block is at rest, or pause.
+
+    Before each step the work spent in this call (block-steps, see above) is compared with
+    `budget`: once it is reached the call returns PAUSED, the loop variables back in `event`, and
+    the next call continues. A call with budget >= 1 takes at least one step. Otherwise as
+    integrate_event (which see); when the event has finished, `event` is BETWEEN and its undo
+    log empty. Returns (status, work units spent in this call).
+    """
+    na = int(event[EV_NA])
+    nt = int(event[EV_NT])
+    yrest = event[EV_YREST]
+    t_far = event[EV_T_FAR]
+    far = int(event[EV_FAR])
+    tau = event[EV_TAU]
+    work = event[EV_WORK]
+    slip_time = event[EV_SLIP_TIME]
+    steps = int(event[EV_STEPS])
+    block_steps = int(event[EV_BLOCK_STEPS])
+    rejected = int(event[EV_REJECTED])
+    cuts = int(event[EV_CUTS])
+    vmax = event[EV_VMAX]
+    h_next = event[EV_H_NEXT]
+    err_prev = event[EV_ERR_PREV]
+    traced = int(event[EV_TRACED])
     status = OK
     v_limit = RK4_STABILITY / dt
     psi_limit = -math.log(v_limit)
-    h_next = dt
     expo = _CONTROL_EXPONENT[method]
-    traced = 0
-    err_prev = 1.0
+    used = 0
     while na > 0:
+        if used >= budget:
+            _keep(event, na, nt, yrest, t_far, far, tau, work, slip_time, steps, block_steps, rejected,
+                  cuts, vmax, h_next, err_prev, traced)
+            return PAUSED, used
         if steps >= max_steps or tau > max_duration:
             status = TOO_LONG
             break
@@ -255,6 +335,7 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
         retried = False
         while True:
             dwork, dslip, err = take_step(method, W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
+            used += na
             if traced < trace.shape[0]:
                 _record(trace, traced, method, W, act, na, tau, h, err, rtol, atol, expo)
                 traced += 1
@@ -333,6 +414,7 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
             h = x_cut * h
             cuts += 1
             dwork, dslip, _ = take_step(method, W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
+            used += na
         tau += h
         steps += 1
         block_steps += na
@@ -353,7 +435,8 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
             break
         # Transitions at tau: the located one, then anything that crossed with it.
         if kind == 2 or kind == 3:
-            na, nt, yrest = _start(W, act, na, flag, touched, nt, since, tree, t0, nu, who, tau, yrest)
+            na, nt, yrest = _start(W, act, na, flag, touched, nt, since, tree, t0, nu, who, tau, yrest,
+                                   event, undo)
             W[who, V] = 0.0
         if kind == 1:
             W[who, V] = 0.0
@@ -385,7 +468,7 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
             for j in (left(i), right(i, n)):
                 if j != i and _above_threshold(W, flag, n, j, tau, l2, nu, b):
                     na, nt, yrest = _start(W, act, na, flag, touched, nt, since, tree, t0, nu, j,
-                                           tau, yrest)
+                                           tau, yrest, event, undo)
         # Blocks no longer watched by a sliding neighbour may only start by
         # loading: back on the schedule with their analytic onset.
         for k in range(nstuck):
@@ -404,7 +487,12 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
     diag[D_BLOCK_STEPS] = block_steps
     diag[D_REJECTED] = rejected
     diag[D_CUTS] = cuts
-    return status
+    # the final values too, so that the vector does not depend on where the event was paused
+    _keep(event, na, nt, yrest, t_far, far, tau, work, slip_time, steps, block_steps, rejected, cuts,
+          vmax, h_next, err_prev, traced)
+    clear_log(W, event, undo)
+    event[EV_PHASE] = BETWEEN
+    return status, used
 
 
 @nb.njit(cache=True)

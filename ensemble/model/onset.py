@@ -60,8 +60,14 @@ def onset_delay(F, psi, nu, b):
     if F >= b * psi:
         return 0.0
     # L = ln(b/nu) - F/b + nu*theta/b, written with psi so nothing overflows:
-    # nu*theta/b = exp(psi + ln(nu/b)).
-    log_b_over_nu = math.log(b / nu)
+    # nu*theta/b = exp(psi + ln(nu/b)). ln(b/nu) from the two logarithms only where the ratio
+    # itself overflows or underflows (b = 1e300, nu = 1e-20), which would make L NaN; the one
+    # rounding of the ratio elsewhere keeps every onset as it was.
+    ratio = b / nu
+    if 0.0 < ratio < math.inf:
+        log_b_over_nu = math.log(ratio)
+    else:
+        log_b_over_nu = math.log(b) - math.log(nu)
     y_theta = math.exp(psi - log_b_over_nu)  # nu * theta / b
     L = log_b_over_nu - F / b + y_theta
     y = solve_y_minus_log_y(L)

@@ -16,6 +16,8 @@ has been at rest must be known to far better than its state theta (which can be
 float64 rounding of the difference itself. The tree keys are single float64
 (only used to order the blocks; the epicenter's onset is recomputed exactly).
 """
+import math
+
 import numba as nb
 import numpy as np
 
@@ -76,11 +78,17 @@ def tree_set(tree, i, key):
 
 @nb.njit(cache=True)
 def tree_min(tree):
-    """(smallest key, its block): O(log N) descent along the minima."""
+    """(smallest key, its block): O(log N) descent along the minima.
+
+    The block is always one of the chain's, whatever the keys: the descent goes right only
+    to a strictly smaller key, so a NaN (which compares false) sends it left, and the left
+    child of a node that holds a block holds one too (blocks are the leftmost leaves); a
+    subtree of padding holds inf, never smaller. Ties go left.
+    """
     k = 1
     m = tree.shape[0] // 2
     while k < m:
-        k = 2 * k if tree[2 * k] <= tree[2 * k + 1] else 2 * k + 1
+        k = 2 * k + 1 if tree[2 * k + 1] < tree[2 * k] else 2 * k
     return tree[1], k - m
 
 
@@ -94,3 +102,14 @@ def build_schedule(W, since, tree, nu, b):
         tree[m + i] = onset_key(W, since, i, nu, b)
     for k in range(m - 1, 0, -1):
         tree[k] = min(tree[2 * k], tree[2 * k + 1])
+
+
+@nb.njit(cache=True)
+def finite_state(W, since):
+    """Every block's force, state and time are finite (checked once per loaded state: a NaN
+    would otherwise hide in the schedule, whose keys only order the blocks)."""
+    for i in range(W.shape[0]):
+        if not (math.isfinite(W[i, F0]) and math.isfinite(W[i, P]) and math.isfinite(since[i, 0])
+                and math.isfinite(since[i, 1])):
+            return False
+    return True

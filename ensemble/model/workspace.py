@@ -11,6 +11,11 @@ both at the block's own time since[i] (lazy loading, see schedule.py).
 
 All other columns are scratch that the event integrator leaves zeroed.
 
+An event may run over several kernel calls (chain.simulate's work budget): the loop variables
+of the event in progress stay in the vector `event` (EV_* below), and the undo log `undo` keeps
+the between-events values (F0, P, since) of every block the event has changed so far, so that
+`Workspace.between_events` can give the state before the event while it is paused.
+
 Energy balance of an event (c-free frame, x = u + c - nu t, slips y since onset,
 duration tau, W_f = int sum(Phi v) dt the friction work, W_load the work of the driver):
 
@@ -33,7 +38,9 @@ ARK_A = ARK_V + ARK_STAGES
 ARK_G = ARK_A + ARK_STAGES
 # local time at which a block started to slide in this event (for the step trace)
 TS = ARK_G + ARK_STAGES
-NCOLS = TS + 1
+# 1 while the block's between-events values are in the undo log of the event in progress (undo.py)
+LOGGED = TS + 1
+NCOLS = LOGGED + 1
 
 # entries of the per-event diagnostics vector
 (D_DURATION, D_SLIP, D_FIRST, D_LAST, D_NSLIP, D_WORK, D_RESIDUAL, D_STEPS, D_VMAX,
@@ -56,12 +63,50 @@ TRACE_COLUMNS = {
     T_OWN: "block-steps had every block taken its own step: sum of min(1, max(0.1, (err_i / err)^(1/(q+1))))",
 }
 
-# status codes of the kernels
-OK, NONFINITE, UNSTABLE, TOO_LONG = 0, 1, 2, 3
+# Entries of the event-state vector `event` (float64; counts and block indices are exact in it).
+# Between events only EV_PHASE (= BETWEEN) and EV_NUNDO (= 0) matter; during an event the
+# others hold the event's loop variables while a kernel call is paused (event.continue_event).
+EV_PHASE = 0        # BETWEEN, or IN_EVENT from the jump to the onset until the event has finished
+EV_CLOCK_HI = 1     # the clock before the jump to this event's onset (two-float time, high part)
+EV_CLOCK_LO = 2     # ... and its low part
+EV_EPICENTER = 3    # the event's epicenter
+EV_NA = 4           # number of sliding blocks (act[:na])
+EV_NT = 5           # number of blocks that slid in this event (touched[:nt])
+EV_YREST = 6        # sum of the slips of the blocks that slid and are at rest again
+EV_T_FAR = 7        # local time of the earliest onset by loading alone of a block nobody watches
+EV_FAR = 8          # that block (-1: none)
+EV_TAU = 9          # local time since the onset
+EV_WORK = 10        # friction work so far
+EV_SLIP_TIME = 11   # time integral of the total slip so far
+EV_STEPS = 12       # steps taken, rejected ones included (D_STEPS)
+EV_BLOCK_STEPS = 13 # accepted block-steps (D_BLOCK_STEPS)
+EV_REJECTED = 14    # rejected steps (D_REJECTED)
+EV_CUTS = 15        # steps cut at a located transition (D_CUTS)
+EV_VMAX = 16        # largest velocity so far (D_VMAX)
+EV_H_NEXT = 17      # the next step size (adaptive methods; dt for RK4)
+EV_ERR_PREV = 18    # error norm of the last accepted step (PI control)
+EV_TRACED = 19      # rows of the step trace filled
+EV_NUNDO = 20       # entries of the undo log
+NEVENT = 21
+# values of EV_PHASE
+BETWEEN, IN_EVENT = 0, 1
+
+# columns of the undo log: one row per block the event in progress has changed, in the order it
+# first did, with the block's between-events values from before the event
+U_BLOCK, U_F0, U_P, U_SINCE_HI, U_SINCE_LO = range(5)
+NUNDO = 5
+
+# a work budget (chain.simulate, event.continue_event) that no run exhausts: integrate to the end
+UNLIMITED = 2**62
+
+# status codes of the kernels (all but OK and PAUSED are errors)
+OK, NONFINITE, UNSTABLE, TOO_LONG, PAUSED = 0, 1, 2, 3, 4
 STATUS_TEXT = {
-    NONFINITE: "non-finite state (numerical blow-up)",
+    NONFINITE: "non-finite state or parameter (numerical blow-up, or NaN/inf in the input)",
     UNSTABLE: "step beyond the stability limit of RK4 (dt / theta > 2.785); reduce integrator.dt",
     TOO_LONG: "event exceeded integrator.max_duration (stable sliding? b below the block stiffness?)",
+    PAUSED: "not an error: the work budget of the kernel call ran out in the middle of an event, "
+            "which the next call continues",
 }
 
 
@@ -89,26 +134,63 @@ class Workspace:
         self.since = np.zeros((n, 2))
         self.tree = np.full(tree_size(n), np.nan)
         self.diag = np.zeros(NDIAG)
+        self.event = np.zeros(NEVENT)
+        self.undo = np.zeros((n, NUNDO))
 
     @property
     def arrays(self):
-        """The kernels' leading array arguments: W, act, flag, touched, stuck, since, tree, diag."""
-        return self.W, self.act, self.flag, self.touched, self.stuck, self.since, self.tree, self.diag
+        """The kernels' leading array arguments: W, act, flag, touched, stuck, since, tree, diag,
+        event, undo."""
+        return (self.W, self.act, self.flag, self.touched, self.stuck, self.since, self.tree, self.diag,
+                self.event, self.undo)
 
     def load(self, force, psi, since=None):
-        """Set the between-events state: force and psi of every block (at time since, default 0)."""
+        """Set the between-events state: force and psi of every block (at time since, default 0).
+
+        An event in progress is dropped.
+        """
         self.W[:] = 0.0
         self.flag[:] = 0
         self.W[:, F0] = force
         self.W[:, P] = psi
         self.since[:] = 0.0 if since is None else since
         self.tree[:] = np.nan    # the kernels rebuild the schedule
+        self.event[:] = 0.0      # BETWEEN, undo log empty
+
+    @property
+    def paused(self):
+        """True while an event is in progress (a kernel call stopped in its middle)."""
+        return self.event[EV_PHASE] == IN_EVENT
+
+    def between_events(self, clock):
+        """(force, psi, since, clock): copies of the between-events state, exactly.
+
+        Between events that is the current state and `clock`; during a paused event it is the
+        state after the last completed event, as it was before the kernel jumped the clock to
+        this event's onset and changed any block (from the undo log). The workspace is not
+        changed. `Workspace.load(force, psi, since)` with that clock continues exactly as the
+        uninterrupted run (the paused event is integrated again from its onset).
+        """
+        force, psi, since = self.W[:, F0].copy(), self.W[:, P].copy(), self.since.copy()
+        clock = np.array(clock, dtype=float)
+        if self.paused:
+            log = self.undo[:int(self.event[EV_NUNDO])]
+            who = log[:, U_BLOCK].astype(np.int64)      # each block once
+            force[who] = log[:, U_F0]
+            psi[who] = log[:, U_P]
+            since[who, 0] = log[:, U_SINCE_HI]
+            since[who, 1] = log[:, U_SINCE_LO]
+            clock = self.event[[EV_CLOCK_HI, EV_CLOCK_LO]].copy()
+        return force, psi, since, clock
 
     def state(self, clock, nu):
-        """(force, psi) of every block at the two-float time `clock` (new arrays)."""
-        dt = np.maximum((clock[0] - self.since[:, 0]) + (clock[1] - self.since[:, 1]), 0.0)
-        psi = self.W[:, P]
-        return self.W[:, F0] + nu * dt, psi + np.log1p(dt * np.exp(-psi))
+        """(force, psi) of every block at the two-float time `clock` (new arrays).
+
+        During a paused event: of the between-events state before it (`between_events`).
+        """
+        force, psi, since, _ = self.between_events(clock)
+        dt = np.maximum((clock[0] - since[:, 0]) + (clock[1] - since[:, 1]), 0.0)
+        return force + nu * dt, psi + np.log1p(dt * np.exp(-psi))
 
     @property
     def force(self):

@@ -1,0 +1,136 @@
+"""Kernel calls bounded by work (chain.simulate's budget): a paused event continues exactly.
+
+Any budget must give the events of one unlimited call bit for bit, and while an event is
+paused the workspace must give back the exact state after the last completed event
+(Workspace.between_events), from which a fresh workspace continues bit for bit: that is what a
+checkpoint taken during a long event holds.
+"""
+import numpy as np
+import pytest
+
+from ensemble.catalog import Checkpoint
+from ensemble.config import Config, Integrator, Model, Run
+from ensemble.integrators import kernel_args
+from ensemble.model.chain import simulate
+from ensemble.model.workspace import F0, NDIAG, OK, P, PAUSED, UNLIMITED, Workspace
+from ensemble.runner import Trajectory
+from ensemble.tasks import task_list
+
+MODELS = {"b = 20": Model(N=60, b=20.0), "a = 2": Model(N=60, b=20.0, a=2.0)}
+METHODS = ["rk4", "ark4"]
+
+
+def fresh(model, seed=3):
+    """A workspace with a random initial state (the first events are large), and its clock."""
+    rng = np.random.default_rng(seed)
+    ws = Workspace(model.N)
+    ws.load(-rng.random(model.N), np.zeros(model.N))
+    return ws, np.zeros(2)
+
+
+def outputs(n):
+    return np.empty(n), np.empty(n, dtype=np.int64), np.empty((n, NDIAG))
+
+
+def run_with_budget(ws, clock, args, n, budget):
+    """n events in calls of `budget` work units; (onsets, epicenters, diagnostics, calls that paused)."""
+    out = outputs(n)
+    done = paused = 0
+    while done < n:
+        status, k = simulate(*ws.arrays, clock, *args, n - done, budget, *(a[done:] for a in out))
+        assert status in (OK, PAUSED)
+        paused += status == PAUSED
+        done += k
+    return (*out, paused)
+
+
+@pytest.mark.parametrize("method", METHODS)
+@pytest.mark.parametrize("name", MODELS)
+def test_any_budget_gives_the_same_events_and_state(name, method):
+    model, n = MODELS[name], 20
+    args = kernel_args(model, Integrator(method=method))
+    ws_ref, clock_ref = fresh(model)
+    *ref, _ = run_with_budget(ws_ref, clock_ref, args, n, UNLIMITED)
+    for budget in (1, 7, 100, 10**9):
+        ws, clock = fresh(model)
+        *got, paused = run_with_budget(ws, clock, args, n, budget)
+        for a, b in zip(got, ref):
+            np.testing.assert_array_equal(a, b)
+        np.testing.assert_array_equal(clock, clock_ref)
+        for a, b in zip(ws.arrays, ws_ref.arrays):     # every work array, scratch included
+            np.testing.assert_array_equal(a, b)
+        assert (paused == 0) if budget == 10**9 else (paused > n)
+
+
+@pytest.mark.parametrize("method", METHODS)
+@pytest.mark.parametrize("name", MODELS)
+def test_between_events_state_of_a_paused_event(name, method):
+    """Paused anywhere, the state handed out is exactly the one after the last completed event,
+    the workspace is left alone, and a fresh workspace loaded with it continues bit for bit."""
+    model, n = MODELS[name], 16
+    args = kernel_args(model, Integrator(method=method))
+    ws, clock = fresh(model)
+    after = []      # exact between-events state after k events, k = 0..n
+    ref = outputs(n)
+    for k in range(n):
+        after.append((ws.force.copy(), ws.psi.copy(), ws.since.copy(), clock.copy()))
+        assert simulate(*ws.arrays, clock, *args, 1, UNLIMITED, *(a[k:k + 1] for a in ref)) == (OK, 1)
+    after.append((ws.force.copy(), ws.psi.copy(), ws.since.copy(), clock.copy()))
+
+    ws, clock = fresh(model)
+    rng = np.random.default_rng(0)
+    got = outputs(n)
+    done = pauses = resumed = 0
+    paused_in = set()     # events paused in the middle of
+    while done < n:
+        status, k = simulate(*ws.arrays, clock, *args, n - done, int(10 ** rng.uniform(0, 4)),
+                             *(a[done:] for a in got))
+        done += k
+        if status != PAUSED:
+            continue
+        pauses += 1
+        live = [a.copy() for a in ws.arrays] + [clock.copy()]
+        state = ws.between_events(clock)
+        for a, b in zip(state, after[done]):
+            np.testing.assert_array_equal(a, b)
+        for a, b in zip(live, list(ws.arrays) + [clock]):
+            np.testing.assert_array_equal(a, b)
+        if done % 3 == 0 and done not in paused_in:   # resume in a fresh workspace (tree rebuilt)
+            force, psi, since, c = state
+            other = Workspace(model.N)
+            other.load(force, psi, since)
+            rest = outputs(n - done)
+            assert simulate(*other.arrays, c, *args, n - done, UNLIMITED, *rest) == (OK, n - done)
+            for a, b in zip(rest, ref):
+                np.testing.assert_array_equal(a, b[done:])
+            for a, b in zip(other.between_events(c), after[n]):
+                np.testing.assert_array_equal(a, b)
+            resumed += 1
+        paused_in.add(done)
+    for a, b in zip(got, ref):
+        np.testing.assert_array_equal(a, b)
+    print(f"{pauses} pauses in {len(paused_in)} of {n} events, {resumed} resumed in a fresh workspace")
+    assert len(paused_in) >= n // 2 and resumed >= 3
+
+
+def test_trajectory_checkpoint_during_a_paused_event():
+    """The runner's Trajectory: a checkpoint taken while an event is paused resumes exactly."""
+    cfg = Config(model=Model(N=60, b=20.0, a=2.0), run=Run(), integrator=Integrator(method="ark4"))
+    task = task_list(cfg)[0]
+    whole = Trajectory(cfg, task)
+    t_ref, epi_ref, diag_ref = whole.advance(24)
+    traj = Trajectory(cfg, task)
+    parts = [traj.advance(5)]
+    while not traj.ws.paused:
+        parts.append(traj.advance(24 - traj.done, budget=300))
+    cp = traj.checkpoint()
+    assert cp.done == traj.done and cp.done < 24
+    resumed = Trajectory(cfg, task, Checkpoint(cp.force, cp.psi, cp.since, cp.clock, cp.done))
+    parts.append(resumed.advance(24 - resumed.done))
+    for col, ref in enumerate((t_ref, epi_ref, diag_ref)):
+        np.testing.assert_array_equal(np.concatenate([p[col] for p in parts]), ref)
+    # the paused trajectory itself finishes the same way
+    while traj.done < 24:
+        traj.advance(24 - traj.done, budget=300)
+    np.testing.assert_array_equal(traj.clock, whole.clock)
+    np.testing.assert_array_equal(traj.ws.W[:, [F0, P]], whole.ws.W[:, [F0, P]])

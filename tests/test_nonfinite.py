@@ -1,0 +1,132 @@
+"""NaN and inf end in the status NONFINITE, never in an index out of bounds (heap corruption).
+
+numba does not check indices unless compiled with NUMBA_BOUNDSCHECK=1, so a block index
+computed from a NaN (the onset tree used to descend into its padding) would write past the
+work arrays silently. The last test runs the hard cases and the bad inputs in one subprocess
+compiled with bounds checks, in its own numba cache (the checked build must not replace the
+normal one).
+"""
+import json
+import math
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+from ensemble.config import Integrator, Model
+from ensemble.integrators import kernel_args
+from ensemble.model.chain import simulate
+from ensemble.model.onset import onset_delay
+from ensemble.model.schedule import tree_min, tree_set
+from ensemble.model.workspace import NDIAG, NONFINITE, UNLIMITED, Workspace, tree_size
+
+from .conftest import ROOT
+
+
+def test_tree_min_returns_a_block_whatever_the_keys():
+    """NaN keys (unordered) must not lead the descent into the padding leaves past N."""
+    rng = np.random.default_rng(1)
+    for n in (1, 3, 60, 100):
+        for pattern in range(20):
+            tree = np.full(tree_size(n), np.inf)
+            for i in range(n):
+                tree_set(tree, i, math.nan if rng.random() < 0.3 or pattern == 0 else rng.normal())
+            _, block = tree_min(tree)
+            assert 0 <= block < n
+
+
+def test_onset_delay_with_b_over_nu_beyond_float64():
+    """ln(b / nu) taken from b / nu = inf made the delay NaN; it is inf (never), as it should be."""
+    assert onset_delay(-1.0, 0.0, 1e-20, 1e300) == math.inf
+
+
+def run_simulate(model, force, psi, events=5, method="rk4"):
+    ws = Workspace(model.N)
+    ws.load(force, psi)
+    t, epi, diag = np.empty(events), np.empty(events, dtype=np.int64), np.empty((events, NDIAG))
+    args = kernel_args(model, Integrator(method=method))
+    return simulate(*ws.arrays, np.zeros(2), *args, events, UNLIMITED, t, epi, diag)
+
+
+def test_nonfinite_parameters_are_named():
+    """Checked before anything runs: atol = inf, for one, would otherwise run on without error control."""
+    model = Model(N=30)
+    force, psi = -np.linspace(0.0, 1.0, model.N), np.zeros(model.N)
+    ws = Workspace(model.N)
+    for which, value in ((0, math.nan), (1, math.inf), (3, math.nan), (7, math.inf)):   # l2, nu, b, atol
+        args = list(kernel_args(model, Integrator()))
+        args[which] = value
+        ws.load(force, psi)
+        out = np.empty(3), np.empty(3, dtype=np.int64), np.empty((3, NDIAG))
+        assert simulate(*ws.arrays, np.zeros(2), *args, 3, UNLIMITED, *out) == (NONFINITE, 0)
+
+
+# Runs in a subprocess compiled with NUMBA_BOUNDSCHECK=1; prints one JSON line
+# {"hard": {case: "ok" or the error}, "bad": {input: status code or the error}}.
+BOUNDSCHECK_SCRIPT = r"""
+import dataclasses, json, math
+import numpy as np
+from ensemble.config import Config, Integrator, Model, Run
+from ensemble.runner import SimulationError, Trajectory
+from ensemble.tasks import task_list
+from tests.test_hard_cases import CASES
+from tests.test_nonfinite import run_simulate
+
+hard, bad = {}, {}
+for name, (model, rk4_dt, _) in CASES.items():
+    model = dataclasses.replace(model, N=min(model.N, 30))
+    for method in ("rk4", "ark4"):
+        for budget in (None, 50):     # whole events, and events paused every ~50 block-steps
+            integ = Integrator(method="rk4", dt=rk4_dt) if method == "rk4" else Integrator(method=method)
+            cfg = Config(model=model, run=Run(), integrator=integ)
+            traj = Trajectory(cfg, task_list(cfg)[0])
+            key = f"{name} [{method}{'' if budget is None else ', budget 50'}]"
+            try:
+                if budget is None:
+                    traj.advance(10)
+                else:
+                    while traj.done < 10:
+                        traj.advance(10 - traj.done, budget)
+                hard[key] = "ok"
+            except (IndexError, SimulationError) as err:
+                hard[key] = type(err).__name__ + ": " + str(err)
+
+def initial(model):
+    return -np.random.default_rng(0).random(model.N), np.zeros(model.N)
+
+model = Model(N=30)
+for name, block, column, value in (("NaN force", 7, 0, math.nan), ("-inf force", 20, 0, -math.inf),
+                                   ("inf psi", 5, 1, math.inf), ("NaN psi", 29, 1, math.nan)):
+    state = initial(model)
+    state[column][block] = value
+    for method in ("rk4", "ark4"):
+        try:
+            bad[f"{name} [{method}]"] = int(run_simulate(model, *state, method=method)[0])
+        except IndexError as err:
+            bad[f"{name} [{method}]"] = "IndexError: " + str(err)
+huge = Model(N=30, b=1e300, nu=1e-20)
+try:
+    bad["b = 1e300, nu = 1e-20"] = int(run_simulate(huge, *initial(huge))[0])
+except IndexError as err:
+    bad["b = 1e300, nu = 1e-20"] = "IndexError: " + str(err)
+print(json.dumps({"hard": hard, "bad": bad}))
+"""
+
+
+def test_bounds_checked_hard_cases_and_bad_inputs(tmp_path):
+    """Hard cases (small N, rk4 and ark4, with and without pauses) run; NaN/inf inputs give NONFINITE.
+
+    Under a minute (30-50 s here), most of it the bounds-checked compilation.
+    """
+    env = dict(os.environ, NUMBA_BOUNDSCHECK="1", NUMBA_CACHE_DIR=str(tmp_path / "numba"),
+               PYTHONPATH=str(ROOT), OMP_NUM_THREADS="1", NUMBA_NUM_THREADS="1")
+    res = subprocess.run([sys.executable, "-c", BOUNDSCHECK_SCRIPT], cwd=ROOT, env=env, capture_output=True,
+                         text=True, timeout=600)
+    assert res.returncode == 0, res.stderr
+    outcome = json.loads(res.stdout.strip().splitlines()[-1])
+    for kind in ("hard", "bad"):
+        print("\n".join(f"{kind}: {k}: {v}" for k, v in outcome[kind].items()))
+    assert len(outcome["hard"]) == 28 and len(outcome["bad"]) == 9
+    assert outcome["hard"] == {key: "ok" for key in outcome["hard"]}
+    assert outcome["bad"] == {key: NONFINITE for key in outcome["bad"]}
