@@ -36,10 +36,11 @@ def next_event(force, psi, model, dt, v_start=0.0):
     return epicenter, check(run_event(f, p, epicenter, model, Integrator(method="rk4", dt=dt), v_start))
 
 
-def run_cli(*args, cwd=None):
+def run_cli(*args, cwd=None, timeout=600):
+    """`python -m ensemble ARGS` in a subprocess; a hang fails the test (TimeoutExpired) instead of the suite."""
     env = dict(os.environ, NUMBA_CACHE_DIR=os.environ.get("NUMBA_CACHE_DIR", str(ROOT / ".numba_cache")))
     return subprocess.run([sys.executable, "-m", "ensemble", *map(str, args)], cwd=cwd,
-                          capture_output=True, text=True, env=env)
+                          capture_output=True, text=True, env=env, timeout=timeout)
 
 
 def write_config(path, **sections):

@@ -413,3 +413,14 @@ def test_a_signal_during_one_very_long_event_is_served_within_a_kernel_call(tmp_
     assert code == 75, log
     _, tasks, _ = catalog.read(catalog.partial_path(out))
     assert tasks["events_written"][0] == 0 and tasks["events_done"][0] == 0   # the event was in progress
+
+
+def test_status_of_the_partial_name_and_of_a_damaged_catalog(interrupted, tmp_path):
+    cfg, out = interrupted
+    res = cli("status", catalog.partial_path(out))          # the .partial's own name: not "complete"
+    assert res.returncode == 0 and "interrupted" in res.stdout.splitlines()[0]
+    damaged = tmp_path / "damaged.h5"
+    damaged.write_bytes(open(catalog.partial_path(out), "rb").read()[:4096])
+    res = cli("status", damaged)
+    assert res.returncode == 1 and "damaged.h5" in res.stderr
+    assert len(res.stderr.strip().splitlines()) == 1
