@@ -53,7 +53,8 @@ def simulate(W, act, flag, touched, stuck, since, tree, diag, event, undo, clock
     out_t[k] is the onset time of event k, out_epicenter[k] its epicenter,
     out_diag[k] the event's diagnostics vector (workspace.D_*). On a status
     other than OK and PAUSED the state is that after the failed event, which is not counted;
-    NONFINITE also stands for a NaN or inf among the parameters or the loaded state.
+    NONFINITE also stands for a NaN or inf among the parameters (h_max and max_duration may
+    be inf: no bound) or the loaded state.
     """
     n = W.shape[0]
     no_profile = np.empty(0)
@@ -116,7 +117,9 @@ def simulate(W, act, flag, touched, stuck, since, tree, diag, event, undo, clock
 
 @nb.njit(cache=True)
 def _finite_parameters(l2, nu, a, b, dt, rtol, atol, h_max, max_duration):
-    """No NaN or inf among the model and integrator parameters."""
+    """No NaN or inf among the model and integrator parameters, but for the two bounds: the
+    largest step and the longest event may be inf (no bound), though not NaN (which would
+    silently disable them as well)."""
     return (math.isfinite(l2) and math.isfinite(nu) and math.isfinite(a) and math.isfinite(b)
             and math.isfinite(dt) and math.isfinite(rtol) and math.isfinite(atol)
-            and math.isfinite(h_max) and math.isfinite(max_duration))
+            and not math.isnan(h_max) and not math.isnan(max_duration))
