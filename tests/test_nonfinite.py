@@ -19,7 +19,7 @@ from ensemble.integrators import kernel_args
 from ensemble.model.chain import simulate
 from ensemble.model.onset import onset_delay
 from ensemble.model.schedule import tree_min, tree_set
-from ensemble.model.workspace import NDIAG, NONFINITE, UNLIMITED, Workspace, tree_size
+from ensemble.model.workspace import NDIAG, NONFINITE, OK, UNLIMITED, Workspace, tree_size
 
 from .conftest import ROOT
 
@@ -54,12 +54,20 @@ def test_nonfinite_parameters_are_named():
     model = Model(N=30)
     force, psi = -np.linspace(0.0, 1.0, model.N), np.zeros(model.N)
     ws = Workspace(model.N)
-    for which, value in ((0, math.nan), (1, math.inf), (3, math.nan), (7, math.inf)):   # l2, nu, b, atol
+    # l2, nu, b, atol, max_step, max_duration in the order of kernel_args
+    for which, value in ((0, math.nan), (1, math.inf), (3, math.nan), (7, math.inf), (8, math.nan),
+                         (9, math.nan)):
         args = list(kernel_args(model, Integrator()))
         args[which] = value
         ws.load(force, psi)
         out = np.empty(3), np.empty(3, dtype=np.int64), np.empty((3, NDIAG))
         assert simulate(*ws.arrays, np.zeros(2), *args, 3, UNLIMITED, *out) == (NONFINITE, 0)
+    # the two bounds may be inf: none
+    args = list(kernel_args(model, Integrator()))
+    args[8] = args[9] = math.inf
+    ws.load(force, psi)
+    out = np.empty(3), np.empty(3, dtype=np.int64), np.empty((3, NDIAG))
+    assert simulate(*ws.arrays, np.zeros(2), *args, 3, UNLIMITED, *out) == (OK, 3)
 
 
 # Runs in a subprocess compiled with NUMBA_BOUNDSCHECK=1; prints one JSON line

@@ -26,9 +26,9 @@ from .undo import log_block
 from .workspace import (BETWEEN, D_DURATION, D_SLIP, EV_CLOCK_HI, EV_CLOCK_LO, EV_EPICENTER, EV_PHASE,
                         F0, NONFINITE, NTRACE, OK, P, PAUSED)
 
-# Work units charged for each event besides its block-steps: the onset search (tree descent,
-# onset delay), setting it up and finishing it cost about as much as a few tens of block-steps
-# (O(log N) and O(blocks touched) operations), which matters for the many one-block events.
+# Work units charged for each event besides its block-steps: a fixed stand-in for the onset
+# search (tree descent, onset delay), setting the event up and finishing it (O(log N) and
+# O(blocks touched) operations), so that a budget also bounds a call of many one-block events.
 EVENT_WORK = 32
 
 
@@ -44,7 +44,8 @@ def simulate(W, act, flag, touched, stuck, since, tree, diag, event, undo, clock
     `undo`, and `clock` at its onset) and the next call continues (its row is then that
     call's first). Work: the block-steps of the events (event.py) plus EVENT_WORK per event
     begun. The budget is checked before each step and before each event, so a call overruns
-    it by at most one step; with budget >= 1 every call makes progress. Any budget gives
+    it by at most one step (its rejected tries and a redo after a cut included), or by
+    EVENT_WORK; with budget >= 1 every call makes progress. Any budget gives
     the same events, bit for bit, as one call with workspace.UNLIMITED.
 
     Every block is at rest with its state at time since[i] (see schedule.py); `tree`
@@ -52,7 +53,8 @@ def simulate(W, act, flag, touched, stuck, since, tree, diag, event, undo, clock
     out_t[k] is the onset time of event k, out_epicenter[k] its epicenter,
     out_diag[k] the event's diagnostics vector (workspace.D_*). On a status
     other than OK and PAUSED the state is that after the failed event, which is not counted;
-    NONFINITE also stands for a NaN or inf among the parameters or the loaded state.
+    NONFINITE also stands for a NaN or inf among the parameters (h_max and max_duration may
+    be inf: no bound) or the loaded state.
     """
     n = W.shape[0]
     no_profile = np.empty(0)
@@ -115,7 +117,9 @@ def simulate(W, act, flag, touched, stuck, since, tree, diag, event, undo, clock
 
 @nb.njit(cache=True)
 def _finite_parameters(l2, nu, a, b, dt, rtol, atol, h_max, max_duration):
-    """No NaN or inf among the model and integrator parameters."""
+    """No NaN or inf among the model and integrator parameters, but for the two bounds: the
+    largest step and the longest event may be inf (no bound), though not NaN (which would
+    silently disable them as well)."""
     return (math.isfinite(l2) and math.isfinite(nu) and math.isfinite(a) and math.isfinite(b)
             and math.isfinite(dt) and math.isfinite(rtol) and math.isfinite(atol)
-            and math.isfinite(h_max) and math.isfinite(max_duration))
+            and not math.isnan(h_max) and not math.isnan(max_duration))
