@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import h5py
 import numpy as np
 
-from ensemble import catalog
+from ensemble import catalog, filekind
 
 from . import stats
 from .recurrence import RecurrenceScanner
@@ -73,12 +73,15 @@ def reduce_task(h5, task, written, per_task, nu, n_blocks_chain, opt):
     scanner = RecurrenceScanner(n_blocks_chain, opt.mu_c, opt.window)
     ev = h5["events"]
     base = task * per_task
+    t_before = -np.inf
     for lo in range(0, written, opt.chunk):
         hi = min(lo + opt.chunk, written)
         t = ev["t"][base + lo:base + hi]
         mu = ev["mu"][base + lo:base + hi]
         epicenter = ev["epicenter"][base + lo:base + hi]
         boundary = ev["boundary"][base + lo:base + hi]
+        _check_rows(h5.filename, task, lo, t, mu, epicenter, n_blocks_chain, t_before)
+        t_before = t[-1]
         block = (np.arange(lo, hi) * k) // written
         _bin_add(out.mu, block, mu, opt.mu_edges)
         np.add.at(out.numbers[:, stats.N_EVENTS], block, 1)
@@ -98,14 +101,41 @@ def reduce_task(h5, task, written, per_task, nu, n_blocks_chain, opt):
     return out
 
 
+def _check_rows(path, task, lo, t, mu, epicenter, n_blocks, t_before):
+    """Refuse event rows no run writes: they come from a damaged catalog.
+
+    Such rows would otherwise be reduced silently into wrong statistics, and an epicenter
+    outside the chain breaks the bound on pending events that RecurrenceScanner's buffers are
+    sized by (numba does not check bounds). Times of a task are finite and non-decreasing,
+    magnitudes finite (log10 of a positive slip).
+    """
+    previous = np.concatenate([[t_before], t[:-1]])
+    checks = (((epicenter < 0) | (epicenter >= n_blocks),
+               lambda i: f"epicenter {int(epicenter[i])} outside the chain of {n_blocks} blocks"),
+              (~np.isfinite(t), lambda i: f"time {float(t[i])}"),
+              (~np.isfinite(mu), lambda i: f"magnitude {float(mu[i])}"),
+              (t < previous, lambda i: f"time {float(t[i])!r} before the event ahead of it "
+                                       f"({float(previous[i])!r})"))
+    bad = [(int(np.argmax(flags)), what) for flags, what in checks if flags.any()]
+    if bad:
+        i, what = min(bad, key=lambda b: b[0])
+        raise catalog.CatalogError(f"{path}: task {task}, event {lo + i}: {what(i)}; "
+                                   "no run writes that (damaged catalog?)")
+
+
 def reduce_tasks(path, task_indices, opt):
     """TaskHistograms for the given tasks of a catalog (one rank's share)."""
-    per_task, tasks, _ = catalog.read_tasks(path)
-    out = {}
-    with h5py.File(path, "r") as h5:
-        for k in task_indices:
-            out[k] = reduce_task(h5, k, int(tasks["events_written"][k]), per_task,
-                                 float(tasks["nu"][k]), int(tasks["N"][k]), opt)
+    with filekind.reading(path, "the event catalog", catalog.CatalogError):
+        per_task, tasks, _ = catalog.read_tasks(path)
+        out = {}
+        with h5py.File(path, "r") as h5:
+            for k in task_indices:
+                written = int(tasks["events_written"][k])
+                if not 0 <= written <= per_task:
+                    raise catalog.CatalogError(f"{path}: task {k} claims {written} events written, "
+                                               f"it has {per_task} rows (damaged catalog?)")
+                out[k] = reduce_task(h5, k, written, per_task, float(tasks["nu"][k]),
+                                     int(tasks["N"][k]), opt)
     return out
 
 
