@@ -3,16 +3,25 @@
 reduce streams a catalog into per-task histograms (ranks split the tasks under
 mpirun and rank 0 merges them), then computes per parameter point the merged
 densities and summary numbers with bootstrap intervals and writes a summary.
+
+Exit codes: 0 done, 1 file error (missing, damaged or of the wrong kind: a summary or a
+config given for a catalog, ...), 2 bad options. Under mpirun an error on one rank aborts all.
 """
 import argparse
+import os
 import sys
 
 import numpy as np
 
+from ensemble import filekind
 from ensemble.catalog import CatalogError
 
 from . import summary
 from .reduce import Options, parse_bins
+
+# errors that reduce's rank 0 finds before the work starts and every rank then raises alike
+# (ensemble.abort.on_root), with their exit codes; any other error on any rank aborts them all
+COLLECTIVE = {ValueError: 2, CatalogError: 1, summary.SummaryError: 1, OSError: 1}
 
 
 def _parser():
@@ -46,19 +55,41 @@ def _parser():
 def _reduce(args):
     from mpi4py import MPI
 
-    from ensemble import catalog
-
-    from .reduce import PARAMS, point_statistics, reduce_tasks
+    from ensemble.abort import run_guarded
     comm = MPI.COMM_WORLD
-    rank, size = comm.Get_rank(), comm.Get_size()
+    return run_guarded(comm, lambda: _reduce_on(comm, args), COLLECTIVE)
+
+
+def _prepare(args):
+    """Options, output path, and the catalog's task table; every check before the work."""
+    from ensemble import catalog
     opt = Options(parse_bins(args.mu_bins), parse_bins(args.tnu_bins), args.mu_c, args.window,
                   args.b_cut, args.bootstrap, args.level, args.blocks, args.seed)
     if not (0 < opt.level < 1) or opt.bootstrap < 1 or opt.blocks < 1 or opt.window < 0:
         raise ValueError("--level must be in (0, 1); --bootstrap, --blocks >= 1; --window >= 0")
     out = args.output or str(args.catalog).removesuffix(".h5") + ".summary.h5"
-    _, tasks, attrs = catalog.read_tasks(args.catalog)
+    filekind.require(args.catalog, "catalog", CatalogError)
+    if os.path.exists(out):
+        # checked now, not after the work; and --force replaces a summary, never anything else
+        if not args.force:
+            raise summary.SummaryError(f"{out}: summary exists (use --force to overwrite it)")
+        if os.path.samefile(out, args.catalog) or filekind.identify(out)[0] != "summary":
+            raise summary.SummaryError(f"{out} {filekind.describe(out)}; --force replaces only "
+                                       "a reduction summary")
+    with filekind.reading(args.catalog, "the event catalog", CatalogError):
+        _, tasks, attrs = catalog.read_tasks(args.catalog)
+    return opt, out, tasks, attrs
+
+
+def _reduce_on(comm, args):
+    from ensemble.abort import abort_on_error, on_root
+
+    from .reduce import PARAMS, point_statistics, reduce_tasks
+    rank, size = comm.Get_rank(), comm.Get_size()
+    opt, out, tasks, attrs = on_root(comm, lambda: _prepare(args), tuple(COLLECTIVE))
     mine = [k for k in range(len(tasks["point"])) if k % size == rank]
-    parts = comm.gather(reduce_tasks(args.catalog, mine, opt), root=0)
+    with abort_on_error(comm):   # rank 0 waits in gather for every other rank's part
+        parts = comm.gather(reduce_tasks(args.catalog, mine, opt), root=0)
     if rank != 0:
         return 0
     per_task = {k: h for part in parts for k, h in part.items()}
@@ -95,6 +126,8 @@ def main(argv=None):
     args = _parser().parse_args(argv)
     try:
         return {"reduce": _reduce, "plot": _plot, "report": _report}[args.command](args)
+    except BrokenPipeError:
+        raise   # the reader of stdout went away: not a file error; __main__ ends quietly
     except (CatalogError, summary.SummaryError, ValueError, OSError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2 if isinstance(err, ValueError) else 1

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ensemble import catalog
+from ensemble import catalog, filekind
 
 from . import stats
 from .recurrence import RecurrenceScanner
@@ -97,10 +97,11 @@ def reduce_task(chunks, written, nu, n_blocks_chain, opt):
 def reduce_tasks(path, task_indices, opt):
     """TaskHistograms for the given tasks of a catalog (one rank's share)."""
     out = {}
-    with catalog.Reader(path) as cat:
+    # the catalog checks the ranges of the rows as they stream (an epicenter outside the chain
+    # would also overflow RecurrenceScanner's buffers) and each task's checksum after its last chunk
+    with filekind.reading(path, "the event catalog", catalog.CatalogError), catalog.Reader(path) as cat:
         tasks = cat.tasks
         for k in task_indices:
-            # the catalog verifies each task's checksum once its last chunk is read
             out[k] = reduce_task(cat.task_events(k, opt.chunk), int(tasks["events_written"][k]),
                                  float(tasks["nu"][k]), int(tasks["N"][k]), opt)
     return out

@@ -9,18 +9,26 @@
     /points/{mu, tnu, tnu_interior}_density     (points, bins): estimate; *_lo, *_hi: interval
     /points/numbers/<name>                      (points, 3): estimate, lo, hi (see reduce.NUMBERS)
     /points/peaks                               (points, max peaks, 3): T*nu position, lo, hi (NaN pad)
-    attributes: config (the catalog's), catalog, mu_c, window, b_cut, bootstrap, level, blocks, seed
+    attributes: format, config (the catalog's), catalog, mu_c, window, b_cut, bootstrap, level,
+                blocks, seed
+
+`format` tells a summary from a catalog (ensemble/filekind.py); summaries written before it
+existed are known by their attributes and groups.
 """
 import os
 
 import h5py
 import numpy as np
 
+from ensemble import filekind
+
 from .reduce import NUMBERS, PARAMS
+
+FORMAT = filekind.SUMMARY_FORMAT_PREFIX + "1"
 
 
 class SummaryError(RuntimeError):
-    pass
+    """A summary that cannot be written or read; the message names the file."""
 
 
 def write(path, source, attrs_in, tasks, per_task, points, opt, force=False):
@@ -29,9 +37,10 @@ def write(path, source, attrs_in, tasks, per_task, points, opt, force=False):
     n_mu, n_tnu = len(opt.mu_edges) - 1, len(opt.tnu_edges) - 1
     tmp = str(path) + ".partial"
     with h5py.File(tmp, "w") as h5:
-        h5.attrs.update({"config": attrs_in["config"], "catalog": str(source), "mu_c": opt.mu_c,
-                         "window": opt.window, "b_cut": opt.b_cut, "bootstrap": opt.bootstrap,
-                         "level": opt.level, "blocks": opt.blocks, "seed": opt.seed})
+        h5.attrs.update({"format": FORMAT, "config": attrs_in["config"], "catalog": str(source),
+                         "mu_c": opt.mu_c, "window": opt.window, "b_cut": opt.b_cut,
+                         "bootstrap": opt.bootstrap, "level": opt.level, "blocks": opt.blocks,
+                         "seed": opt.seed})
         h5["bins/mu"] = opt.mu_edges
         h5["bins/tnu"] = opt.tnu_edges
         for name, values in tasks.items():
@@ -62,14 +71,14 @@ def write(path, source, attrs_in, tasks, per_task, points, opt, force=False):
 
 def read(path):
     """Summary -> nested dict of arrays and attributes."""
-    if not os.path.exists(path):
-        raise SummaryError(f"{path}: no such summary")
+    filekind.require(path, "summary", SummaryError)
     out = {}
-    with h5py.File(path, "r") as h5:
-        def visit(name, obj):
-            if isinstance(obj, h5py.Dataset):
-                out[name] = obj[...]
-        h5.visititems(visit)
-        out["attrs"] = {k: h5.attrs[k] for k in h5.attrs}
-    out["points/method"] = np.array([m.decode() for m in out["points/method"]])
+    with filekind.reading(path, "the reduction summary", SummaryError):
+        with h5py.File(path, "r") as h5:
+            def visit(name, obj):
+                if isinstance(obj, h5py.Dataset):
+                    out[name] = obj[...]
+            h5.visititems(visit)
+            out["attrs"] = {k: h5.attrs[k] for k in h5.attrs}
+        out["points/method"] = np.array([m.decode() for m in out["points/method"]])
     return out

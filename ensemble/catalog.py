@@ -265,13 +265,11 @@ class _Layout:
             hi = min(lo + chunk, written)
             part = {name: ds[base + lo:base + hi] for name, ds in self.events.items()}
             running.update(part)
-            problems = event_problems(part, int(self.n_blocks[task]))
+            problems = event_problems(part, int(self.n_blocks[task]), lo, last_t)
             if np.any(part["task"] != task):
-                problems.append("rows of another task")
-            if part["t"][0] < last_t:
-                problems.append("onset times decrease")
+                problems.append(f"event {lo + int(np.argmax(part['task'] != task))}: a row of another task")
             if problems:
-                raise self._fail(task, f"events {lo}-{hi - 1}: {'; '.join(problems)}")
+                raise self._fail(task, "; ".join(problems))
             last_t = part["t"][-1]
             yield part
         self._check_events(task, written, running)
@@ -676,10 +674,8 @@ def _open_for_reading(path):
     That is safe because a catalog's metadata is complete and flushed at creation and
     never changes afterwards; what a run is writing lies beyond the commit rows read here.
     """
-    if not os.path.exists(path):
-        raise CatalogError(f"{path}: no such catalog")
-    if os.path.isdir(path):
-        raise CatalogError(f"{path}: is a directory, not a catalog")
+    from . import filekind     # (it reads summaries' marks; imported here to keep this module's imports light)
+    filekind.require(path, "catalog", CatalogError)
     try:
         h5 = h5py.File(path, "r", locking=False)
     except OSError as err:
@@ -700,14 +696,19 @@ class Reader:
         self.path = str(path)
         self.h5 = _open_for_reading(self.path)
         try:
+            self._read_tasks()
+        except BaseException:
+            self.h5.close()
+            raise
+
+    def _read_tasks(self):
+        from . import filekind
+        with filekind.reading(self.path, "the event catalog", CatalogError):
             self.layout = _Layout(self.h5)
             self.attrs = {k: self.h5.attrs[k] for k in self.h5.attrs}
             self.per_task = self.layout.per_task
             self.tasks = {name: ds[...] for name, ds in self.layout.tasks.items()}
             heads = [self.layout.head(k) for k in range(self.layout.n_tasks)]
-        except BaseException:
-            self.h5.close()
-            raise
         self.tasks["events_written"] = np.array([0 if h is None else h.written for h in heads], dtype=np.int64)
         self.tasks["events_done"] = np.array([0 if h is None else h.done for h in heads], dtype=np.int64)
         for name in ("error", "integrator"):

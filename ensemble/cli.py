@@ -8,15 +8,12 @@ import argparse
 import os
 import signal
 import sys
-import time
-import tomllib
 
 from . import __version__
 from .catalog import CatalogError, partial_path, read_tasks
-from .config import ConfigError, from_dict, load, parse_override, replace
+from .config import ConfigError, load, loads, parse_override, replace
 from .lock import LockError
 
-ABORT_GRACE_SECONDS = 1.0
 
 
 def _parser():
@@ -80,18 +77,15 @@ def _resume_config(args):
     if not os.path.exists(partial):
         return None, path, None
     _, tasks, attrs = read_tasks(partial)
-    raw = tomllib.loads(attrs["config"])
     rerun = False
     for text in args.set:
-        section, key, value = parse_override(text)
+        section, key, _ = parse_override(text)
         allowed = _RESUMABLE.get(section, ())
         if (allowed is not None and key not in allowed) or (section, key) == ("output", "path"):
             raise ConfigError(f"--set {section}.{key}: resume continues the stored run and cannot change it "
                               f"(only integrator.*, output.* and run.poll_seconds); start a new run instead")
-        raw.setdefault(section, {})[key] = value
         rerun = rerun or section == "integrator"
-    raw.setdefault("output", {})["path"] = path
-    cfg = from_dict(raw)
+    cfg = replace(loads(attrs["config"], args.set, source=f"the config stored in {partial}"), "output", path=path)
     return cfg, path, cfg.integrator if rerun else None
 
 
@@ -145,13 +139,8 @@ def _run(args):
 
 def _abort(comm, rank, err):
     """Print the error of this rank; with more ranks, abort them all (serial: the caller returns 1)."""
-    print(f"error: rank {rank}: {err}", file=sys.stderr, flush=True)
-    if comm.Get_size() > 1:
-        # MPI_Abort makes the process manager kill every rank, and what a rank
-        # wrote to its stderr pipe but the manager has not yet forwarded is lost
-        # (seen with MPICH's Hydra): give the message a moment to get out.
-        time.sleep(ABORT_GRACE_SECONDS)
-        comm.Abort(1)
+    from .abort import abort
+    abort(comm, err)
 
 
 def _slurm(args):

@@ -1,12 +1,18 @@
 """TOML config -> validated frozen dataclasses (the one source of parameter truth).
 
 Every key has a default, a one-line meaning and a valid range below. Unknown
-keys and out-of-range values raise ConfigError naming the key.
+keys and out-of-range values raise ConfigError naming the key; every float must
+be finite (TOML has inf and nan, and 1e400 reads as inf), and parameter points
+whose numbers the kernels' arithmetic cannot hold are refused (_OVERFLOW_RULES).
 """
 import dataclasses
+import itertools
 import math
 import tomllib
+from contextlib import contextmanager
 from dataclasses import dataclass, field, fields
+
+from . import filekind
 
 
 class ConfigError(ValueError):
@@ -126,16 +132,27 @@ def _toml_value(v):
     return str(v)
 
 
-def _coerce(section, key, value, typ):
-    """Check the type of one value (ints are accepted where floats are expected)."""
-    where = f"{section}.{key}"
+def _coerce(section, key, value, typ, where=None):
+    """Check the type and range of one value (ints are accepted where floats are expected).
+
+    where: the name the message gives the value (default section.key; sweep.KEY for a swept one).
+    """
+    where = where or f"{section}.{key}"
     if typ is float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise ConfigError(f"{where} must be a number, got {value!r}")
-        value = float(value)
+        try:
+            value = float(value)
+        except OverflowError:   # a TOML integer beyond float range
+            value = math.inf
+        if not math.isfinite(value):
+            # "> 0" and ">= 0" alone let inf through (and TOML reads 1e400 as inf)
+            raise ConfigError(f"{where} must be a finite number, got {value!r}")
     elif typ is int:
         if isinstance(value, bool) or not isinstance(value, int):
             raise ConfigError(f"{where} must be an integer, got {value!r}")
+        if not -2**63 <= value < 2**63:   # tomllib reads integers of any size; catalogs store int64
+            raise ConfigError(f"{where} must fit in 64 bits, got {value!r}")
     elif typ is str:
         if not isinstance(value, str):
             raise ConfigError(f"{where} must be a string, got {value!r}")
@@ -145,43 +162,109 @@ def _coerce(section, key, value, typ):
     return value
 
 
-def _section(name, raw):
+@contextmanager
+def _from_set(overridden, section, key):
+    """An error about a value that came from --set says so."""
+    try:
+        yield
+    except ConfigError as err:
+        if (section, key) not in overridden:
+            raise
+        raise ConfigError(f"{err} (from --set {overridden[section, key]})") from None
+
+
+def _section(name, raw, overridden):
     cls = SECTIONS[name]
     if not isinstance(raw, dict):
         raise ConfigError(f"[{name}] must be a table")
     known = {f.name: f for f in fields(cls)}
-    for key in raw:
-        if key not in known:
-            raise ConfigError(f"unknown key {name}.{key} (known: {', '.join(known)})")
-    values = {k: _coerce(name, k, v, known[k].type) for k, v in raw.items()}
+    values = {}
+    for key, value in raw.items():
+        with _from_set(overridden, name, key):
+            if key not in known:
+                raise ConfigError(f"unknown key {name}.{key} (known: {', '.join(known)})")
+            values[key] = _coerce(name, key, value, known[key].type)
     return cls(**values)
 
 
-def _sweep(raw):
+def _sweep(raw, overridden):
     if not isinstance(raw, dict):
         raise ConfigError("[sweep] must be a table")
     types = {f.name: f.type for f in fields(Model)}
     out = []
     for key, values in raw.items():
-        if key not in types:
-            raise ConfigError(f"unknown key sweep.{key} (only [model] keys can be swept: {', '.join(types)})")
-        if not isinstance(values, list) or not values:
-            raise ConfigError(f"sweep.{key} must be a non-empty list of values")
-        out.append((key, tuple(_coerce("model", key, v, types[key]) for v in values)))
+        with _from_set(overridden, "sweep", key):
+            if key not in types:
+                raise ConfigError(f"unknown key sweep.{key} (only [model] keys can be swept: "
+                                  f"{', '.join(types)})")
+            if not isinstance(values, list) or not values:
+                raise ConfigError(f"sweep.{key} must be a non-empty list of values")
+            out.append((key, tuple(_coerce("model", key, v, types[key], where=f"sweep.{key}")
+                                   for v in values)))
     return tuple(out)
 
 
-def from_dict(raw):
-    """Validate a parsed TOML document into a Config."""
+def _values(cfg, name):
+    """Every value a key ("model.b", "run.init_stress") takes over the parameter points, and the
+    name to give it ("sweep.b" if swept)."""
+    section, key = name.split(".")
+    for swept, values in cfg.sweep:
+        if section == "model" and swept == key:
+            return f"sweep.{key}", values
+    return name, (getattr(getattr(cfg, section), key),)
+
+
+def _first_onset_bound(b, nu, init_stress):
+    """Latest time of the first onset from the initial state, as ensemble/model/onset.py finds it.
+
+    Every block starts at theta = 1 with its force up to init_stress below threshold;
+    onset_delay forms L = ln(b / nu) + init_stress / b + nu / b (at most), takes a root
+    y <= max(2 L, 1) and returns (y - nu / b) * b / nu.
+    """
+    ratio = b / nu
+    L = (math.log(ratio) if ratio > 0 else -math.inf) + init_stress / b + nu / b
+    return max(2 * L, 1.0) * ratio
+
+
+# Parameter points whose numbers the kernels' float arithmetic cannot hold. Each entry: the
+# keys it reads, the number (must come out finite) and what that number is. The kernel is the
+# wrong place to find out: with b / nu = 1e310 (b = 1e300, nu = 1e-10) a run looped forever
+# inside the kernel, deaf to SIGTERM, and with nu / b = 1e310 it corrupted memory ("double
+# free"). Each term that can overflow is largest at a corner of the sweep (smallest or largest
+# b, nu, l), so only the corners are checked.
+_OVERFLOW_RULES = (
+    (("model.l",), lambda l: l * l,   # noqa: E741 - the model's name
+     "l^2 (the stiffness between blocks, integrators.kernel_args)"),
+    (("model.b", "model.nu", "run.init_stress"), _first_onset_bound,
+     "the time of the first onset, up to 2 b/nu (ln(b/nu) + init_stress/b + nu/b) (model/onset.py)"),
+)
+
+
+def _check_overflow(cfg):
+    for keys, number, meaning in _OVERFLOW_RULES:
+        named = [_values(cfg, key) for key in keys]
+        for corner in itertools.product(*[(min(v), max(v)) for _, v in named]):
+            if not math.isfinite(number(*corner)):
+                given = ", ".join(f"{name} = {x!r}" for (name, _), x in zip(named, corner))
+                raise ConfigError(f"{given}: {meaning} overflows a float")
+
+
+def from_dict(raw, overridden=None):
+    """Validate a parsed TOML document into a Config.
+
+    overridden: {(section, key): "section.key=value"} of the values that came from --set.
+    """
+    overridden = overridden or {}
     allowed = set(SECTIONS) | {"sweep"}
     for name in raw:
         if name not in allowed:
             raise ConfigError(f"unknown section [{name}] (known: {', '.join(sorted(allowed))})")
-    parts = {name: _section(name, raw.get(name, {})) for name in SECTIONS}
-    cfg = Config(sweep=_sweep(raw.get("sweep", {})), **parts)
+    parts = {name: _section(name, raw.get(name, {}), overridden) for name in SECTIONS}
+    cfg = Config(sweep=_sweep(raw.get("sweep", {}), overridden), **parts)
     if cfg.integrator.method not in _integrator_names():
         raise ConfigError(f"integrator.method must be one of {', '.join(_integrator_names())}, "
                           f"got {cfg.integrator.method!r}")
+    _check_overflow(cfg)
     return cfg
 
 
@@ -203,27 +286,71 @@ def parse_override(text):
     return section, key, value
 
 
-def load(path, overrides=()):
-    """Read a TOML file, apply 'section.key=value' overrides and validate."""
-    try:
-        with open(path, "rb") as fh:
-            raw = tomllib.load(fh)
-    except FileNotFoundError:
-        raise ConfigError(f"{path}: no such config file") from None
-    except tomllib.TOMLDecodeError as err:
-        raise ConfigError(f"{path}: not valid TOML ({err})") from None
-    for text in overrides:
-        section, key, value = parse_override(text)
+def _apply_overrides(raw, overrides):
+    """Set parsed overrides [(text, (section, key, value))] into a document; {(section, key): text}."""
+    overridden = {}
+    for text, (section, key, value) in overrides:
         raw.setdefault(section, {})
         if not isinstance(raw[section], dict):
-            raise ConfigError(f"[{section}] must be a table")
+            raise ConfigError(f"[{section}] must be a table (from --set {text})")
         raw[section][key] = value
-    return from_dict(raw)
+        overridden[section, key] = text
+    return overridden
 
 
-def loads(text):
-    """Validate TOML text (e.g. the config stored in a catalog)."""
-    return from_dict(tomllib.loads(text))
+def loads(text, overrides=(), source=None):
+    """Validate TOML text (e.g. the config stored in a catalog) with 'section.key=value' overrides.
+
+    text: str, or bytes (UTF-8). Overrides are applied as by `load` (`--set` on the command
+    line). source: where the text came from (a file, "the config stored in X"); errors start
+    with it, except those of an override's syntax, which is not in the text.
+    """
+    overrides = [(o, parse_override(o)) for o in overrides]
+    try:
+        if isinstance(text, bytes):
+            text = _decode(text)
+        try:
+            raw = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as err:
+            raise ConfigError(f"not valid TOML ({err})") from None
+        return from_dict(raw, _apply_overrides(raw, overrides))
+    except ConfigError as err:
+        if source is None:
+            raise
+        raise ConfigError(f"{source}: {err}") from None
+
+
+def _decode(data):
+    if b"\0" in data:   # valid UTF-8 or not, NUL bytes mean binary data
+        raise ConfigError("binary data (NUL bytes), not a TOML config")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise ConfigError(f"not UTF-8 text (byte 0x{data[err.start]:02x} at offset {err.start}), "
+                          "not a TOML config") from None
+
+
+def load(path, overrides=()):
+    """Read a TOML file, apply 'section.key=value' overrides and validate.
+
+    A path that cannot be a config (missing, a directory, unreadable, an HDF5 catalog or
+    summary, binary data, too large) is a ConfigError whose one line names the file.
+    """
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read(filekind.TOML_SIZE_LIMIT + 1)
+    except FileNotFoundError:
+        raise ConfigError(f"{path}: no such config file") from None
+    except IsADirectoryError:
+        raise ConfigError(f"{path} is a directory, not a TOML config") from None
+    except OSError as err:
+        raise ConfigError(f"{path} cannot be read ({err.strerror or filekind.one_line(err)})") from None
+    if data.startswith(filekind.HDF5_SIGNATURE):
+        # say which: a catalog or summary given for its config is the likely slip
+        filekind.require(path, "config", ConfigError)
+    if len(data) > filekind.TOML_SIZE_LIMIT:
+        raise ConfigError(f"{path} is larger than {filekind.TOML_SIZE_LIMIT >> 20} MiB, not a TOML config")
+    return loads(data, overrides, source=path)
 
 
 def replace(cfg, section, **changes):

@@ -45,19 +45,21 @@ def commit_crc(task, slot, fields):
     return crc(np.asarray([task, slot, *fields], dtype=np.int64))
 
 
-def event_problems(ev, n_blocks, per_task_rows=None):
-    """Range checks of one task's events (dict of arrays); returns a list of what is wrong."""
-    problems = []
-    epi, first, last = ev["epicenter"], ev["first"], ev["last"]
-    if np.any((epi < 0) | (epi >= n_blocks)):
-        problems.append("epicenter outside [0, N)")
-    if np.any((first < 0) | (last >= n_blocks) | (first > last)):
-        problems.append("first/last outside [0, N) or first > last")
-    if np.any((ev["n_slipped"] < 1) | (ev["n_slipped"] > n_blocks)):
-        problems.append("n_slipped outside [1, N]")
-    if not (np.all(np.isfinite(ev["t"])) and np.all(np.isfinite(ev["mu"]))
-            and np.all(ev["slip"] > 0) and np.all(ev["duration"] >= 0)):
-        problems.append("non-finite time or magnitude, or non-positive slip")
-    if len(ev["t"]) > 1 and np.any(np.diff(ev["t"]) < 0):
-        problems.append("onset times decrease")
-    return problems
+def event_problems(ev, n_blocks, first_row=0, t_before=-np.inf):
+    """Range checks of a run of one task's events (dict of arrays starting at row `first_row`,
+    after an event at time t_before); returns what is wrong, naming the first bad row of each kind."""
+    epi, first, last, t, mu = ev["epicenter"], ev["first"], ev["last"], ev["t"], ev["mu"]
+    previous = np.concatenate([[t_before], t[:-1]])
+    checks = (
+        ((epi < 0) | (epi >= n_blocks), lambda i: f"epicenter {int(epi[i])} outside the chain of {n_blocks} blocks"),
+        ((first < 0) | (last >= n_blocks) | (first > last),
+         lambda i: f"slipped blocks {int(first[i])}..{int(last[i])} outside the chain of {n_blocks} blocks"),
+        ((ev["n_slipped"] < 1) | (ev["n_slipped"] > n_blocks), lambda i: f"n_slipped {int(ev['n_slipped'][i])}"),
+        (~np.isfinite(t), lambda i: f"time {float(t[i])}"),
+        (~np.isfinite(mu), lambda i: f"magnitude {float(mu[i])}"),
+        (~(ev["slip"] > 0) | ~(ev["duration"] >= 0),
+         lambda i: f"slip {float(ev['slip'][i])}, duration {float(ev['duration'][i])}"),
+        (t < previous, lambda i: f"time {float(t[i])!r} before the event ahead of it ({float(previous[i])!r})"),
+    )
+    return [f"event {first_row + int(np.argmax(flags))}: {what(int(np.argmax(flags)))}"
+            for flags, what in checks if flags.any()]

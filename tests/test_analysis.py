@@ -14,7 +14,8 @@ from .conftest import run_cli, write_config
 
 
 def run_analysis(*args):
-    return subprocess.run([sys.executable, "-m", "analysis", *map(str, args)], capture_output=True, text=True)
+    return subprocess.run([sys.executable, "-m", "analysis", *map(str, args)], capture_output=True, text=True,
+                          timeout=300)
 
 
 @pytest.fixture(scope="module")
