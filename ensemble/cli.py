@@ -89,6 +89,15 @@ def _resume_config(args):
     return cfg, path, cfg.integrator if rerun else None
 
 
+def _log(*args, **kwargs):
+    """print for a run's log: flushed line by line, and a closed stdout (`run ... | head`) does
+    not stop the run (its log goes to /dev/null from there on)."""
+    try:
+        print(*args, **kwargs, flush=True)
+    except BrokenPipeError:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+
+
 def _late_signal(signum, frame):
     """After the work (and before it starts): a signal is acknowledged, not obeyed, so that a
     run that has renamed its catalog cannot end with the signal's exit status over a good catalog."""
@@ -111,12 +120,13 @@ def _run(args):
             if cfg is None:
                 if os.path.exists(path):
                     if rank == 0:
-                        print(f"{path} is complete; nothing to resume")
+                        _log(f"{path} is complete; nothing to resume")
                     return 0
                 raise Refused(f"{partial_path(path)}: no interrupted run to resume")
-            return run(cfg, path, comm, resume=True, rerun=rerun, command=command)
+            return run(cfg, path, comm, resume=True, rerun=rerun, command=command, log=_log)
         cfg = _config(args)
-        return run(cfg, cfg.output.path, comm, resume=args.resume, force=args.force, command=command)
+        return run(cfg, cfg.output.path, comm, resume=args.resume, force=args.force, command=command,
+                   log=_log)
     except (ConfigError, LockError, Refused) as err:
         # raised on every rank alike (decisions are made on rank 0 and broadcast)
         if rank == 0:

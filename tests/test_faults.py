@@ -424,3 +424,22 @@ def test_status_of_the_partial_name_and_of_a_damaged_catalog(interrupted, tmp_pa
     res = cli("status", damaged)
     assert res.returncode == 1 and "damaged.h5" in res.stderr
     assert len(res.stderr.strip().splitlines()) == 1
+
+
+def test_a_closed_stdout_does_not_stop_the_run(small, tmp_path):
+    """`run ... | head -1`: the log's reader goes away, the run goes on to a complete catalog."""
+    d, cfg = small
+    proc = subprocess.Popen([sys.executable, "-m", "ensemble", "run", cfg, "-o", tmp_path / "p.h5",
+                             "--set", "output.progress_seconds=0.01"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env())
+    watchdog = threading.Timer(TIMEOUT, proc.kill)
+    watchdog.start()
+    try:
+        proc.stdout.readline()
+        proc.stdout.close()                   # as head does after its line
+        err = proc.stderr.read().decode()
+        proc.wait()
+    finally:
+        watchdog.cancel()
+    assert proc.returncode == 0, err
+    same_events(d / "full.h5", tmp_path / "p.h5")
