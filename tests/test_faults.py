@@ -443,3 +443,13 @@ def test_a_closed_stdout_does_not_stop_the_run(small, tmp_path):
         watchdog.cancel()
     assert proc.returncode == 0, err
     same_events(d / "full.h5", tmp_path / "p.h5")
+
+
+def test_status_names_what_a_wrong_file_is(small, tmp_path):
+    """A config or a directory given to `status`: one line naming the file and what it is."""
+    d, cfg = small
+    (tmp_path / "adir.h5").mkdir()
+    for path, words in ((cfg, "TOML"), (tmp_path / "adir.h5", "directory")):
+        res = cli("status", path)
+        assert res.returncode == 1 and str(path) in res.stderr and words in res.stderr, res.stderr
+        assert len(res.stderr.strip().splitlines()) == 1
