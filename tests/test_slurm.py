@@ -377,16 +377,18 @@ def test_single_run_job_equals_serial_run(cluster, tmp_path, launcher):
 @pytest.mark.slow
 def test_walltime_job_requeues_resumes_and_equals_uninterrupted_run(cluster, tmp_path):
     """A one-minute limit, USR1 30 s ahead: Slurm checks every ~30 s, so the signal comes 0-30 s
-    after each start and is held until 20 s (--startup-seconds). The run needs about 40 s on two
-    ranks plus the kernels' compile into the job-local cache: at least one requeue."""
-    cfg = tiny_config(tmp_path / "long.toml", sweep={"b": [20.0]}, run={"seeds": 4, "events": 2000},
+    after each start and is held until 20 s (--startup-seconds). The run needs about 90 s of
+    computing on two ranks (80000 events at ~900 events/s here), more than the limit itself, so
+    at least one requeue happens however Slurm's checks fall (with 2000 events per task the run
+    could end before the signal came)."""
+    cfg = tiny_config(tmp_path / "long.toml", sweep={"b": [20.0]}, run={"seeds": 4, "events": 20000},
                       output={"progress_seconds": 5.0})
     reference_run(cfg, tmp_path / "full.h5", ranks=2)   # = serial (tests/test_mpi.py)
     job = tmp_path / "job"
     run_id, reduce_id = submitted(cluster.cli("slurm", cfg, "--ntasks", 2, "--time", 1,
                                               "--signal-seconds", 30, "--startup-seconds", 20,
                                               "--max-requeues", 10, "-o", job, "--submit"))
-    run, reduce = cluster.wait([run_id, reduce_id], 480)
+    run, reduce = cluster.wait([run_id, reduce_id], 900)
     text = logs(job)
     assert run["JobState"] == "COMPLETED", text
     assert int(run["Restarts"]) >= 1, text
