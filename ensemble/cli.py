@@ -10,6 +10,7 @@ import signal
 import sys
 
 from . import __version__
+from .abort import abort
 from .catalog import CatalogError, partial_path, read_tasks
 from .config import ConfigError, load, loads, parse_override, replace
 from .lock import LockError
@@ -76,7 +77,7 @@ def _resume_config(args):
     partial = partial_path(path)
     if not os.path.exists(partial):
         return None, path, None
-    _, tasks, attrs = read_tasks(partial)
+    _, _, attrs = read_tasks(partial)
     rerun = False
     for text in args.set:
         section, key, _ = parse_override(text)
@@ -134,7 +135,7 @@ def _run(args):
         return 2
     except CatalogError as err:
         if comm.Get_size() > 1 and not err.collective:
-            _abort(comm, rank, err)
+            abort(comm, err)
         if rank == 0 or not err.collective:
             print(f"error: {err}", file=sys.stderr, flush=True)
         if err.broken:
@@ -143,14 +144,8 @@ def _run(args):
             os._exit(1)
         return 1
     except Exception as err:  # noqa: BLE001 - the guard that turns any failure into an abort
-        _abort(comm, rank, err)
+        abort(comm, err)     # with more ranks it does not return
         return 1
-
-
-def _abort(comm, rank, err):
-    """Print the error of this rank; with more ranks, abort them all (serial: the caller returns 1)."""
-    from .abort import abort
-    abort(comm, err)
 
 
 def _slurm(args):

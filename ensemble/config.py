@@ -117,9 +117,14 @@ class Config:
                 out.append("")
             out.append(f"[{name}]")
             section = getattr(self, name)
-            out += [f"{f.name} = {_toml_value(getattr(section, f.name))}" for f in fields(cls)]
+            out += section_lines(section)
             out.append("")
         return "\n".join(out)
+
+
+def section_lines(section):
+    """`key = value` TOML lines of one section's dataclass, in field order."""
+    return [f"{f.name} = {_toml_value(getattr(section, f.name))}" for f in fields(section)]
 
 
 def _toml_value(v):

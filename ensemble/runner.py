@@ -9,13 +9,12 @@ import os
 import sys
 import time
 import tomllib
-from dataclasses import fields
 
 import numpy as np
 
 from . import catalog
 from .catalog import FAILED, FINISHED, Checkpoint, CatalogError
-from .config import ConfigError, _toml_value, from_dict, loads
+from .config import ConfigError, from_dict, loads, section_lines
 from .integrators import kernel_args
 from .lock import RunLock
 from .model.chain import simulate
@@ -104,7 +103,7 @@ def event_rows(task, t, epicenter, diag):
 
 def integrator_text(integrator):
     """A task's [integrator] as TOML text (stored per task in the catalog)."""
-    return "\n".join(f"{f.name} = {_toml_value(getattr(integrator, f.name))}" for f in fields(integrator))
+    return "\n".join(section_lines(integrator))
 
 
 def parse_integrator(text, where):

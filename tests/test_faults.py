@@ -269,7 +269,8 @@ def test_a_signal_just_after_the_rename_leaves_exit_0(small, tmp_path):
 
 def test_resume_continues_from_the_stored_config_without_retyping_overrides(long_cfg, tmp_path):
     """A run started with --set options, interrupted, is continued by `resume CATALOG` alone."""
-    sets = ["--set", "run.events=90", "--set", "model.b=30", "--set", "output.flush_seconds=0.2"]
+    sets = ["--set", "run.events=1500", "--set", "model.b=30", "--set", "integrator.dt=5e-4",
+            "--set", "output.flush_seconds=0.2"]
     ref = tmp_path / "ref.h5"
     assert cli("run", long_cfg, "-o", ref, *sets).returncode == 0
     out = tmp_path / "cut.h5"
