@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# The paper's runs at full size (2e5 events after 1e4 per point), one catalog per panel under runs/paper/.
+#   bash examples/paper/run_full.sh [RANKS] [PANEL ...]     (default 2 ranks; all panels)
+# A panel whose catalog is complete is skipped; one that was interrupted (a .partial is left) is continued
+# with `ensemble resume`, so the script can be stopped and started again at any time.
+# Reduce and plot afterwards with examples/paper/reduce_full.sh.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+RANKS=${1:-2}
+shift || true
+PANELS=${*:-fig1_b fig1_a fig1_c fig2 large_b}
+PY=.venv/bin/python
+export NUMBA_CACHE_DIR=${NUMBA_CACHE_DIR:-$PWD/.numba_cache} OMP_NUM_THREADS=1 NUMBA_NUM_THREADS=1
+mkdir -p runs/paper
+for name in $PANELS; do
+  out=runs/paper/$name.h5
+  if [ -f "$out" ]; then
+    echo "$name: $out is complete"
+  elif [ -f "$out.partial" ]; then
+    mpiexec -n "$RANKS" $PY -m ensemble resume "$out" --set output.progress_seconds=300 2>&1 | tee -a runs/paper/$name.log
+  else
+    mpiexec -n "$RANKS" $PY -m ensemble run examples/paper/$name.toml -o "$out" \
+      --set output.progress_seconds=300 2>&1 | tee -a runs/paper/$name.log
+  fi
+done
