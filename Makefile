@@ -5,7 +5,7 @@ export OMP_NUM_THREADS := 1
 export NUMBA_NUM_THREADS := 1
 export OPENBLAS_NUM_THREADS := 1
 
-.PHONY: setup run test test-all
+.PHONY: setup run test test-all mutations
 
 setup:
 	bash scripts/setup.sh
@@ -18,3 +18,7 @@ test: setup
 
 test-all: setup
 	$(PY) -m pytest -q
+
+# plausible bugs applied one at a time to a copy of the repository; every one must be caught (tests/mutations.py)
+mutations: setup
+	$(PY) tests/mutations.py

@@ -1,0 +1,264 @@
+"""Mutation check: would the suite catch the bugs that matter?
+
+Each entry of MUTATIONS is one plausible bug: a file, a piece of its text and what to put
+there instead, with the tests that should notice. For each mutation this script copies the
+repository (the files git knows, as they are in the working tree) to a scratch directory,
+applies the change, runs those tests there and reports whether they failed ("killed") or
+passed ("SURVIVED"). A survivor is a hole in the suite: write the test that kills it.
+
+    python tests/mutations.py                 # all mutations (make mutations); ~40 minutes on 2 cores
+    python tests/mutations.py --list          # the list, nothing run
+    python tests/mutations.py kernel-free-end-degree reduce-interior-inverted   # some of them
+
+Exit status 0 when every mutation was killed, 1 when one survived or could not be applied
+(its text no longer occurs exactly once: the code moved on, update the entry).
+
+Adding a mutation: append a Mutation to MUTATIONS with a unique name, the path relative to
+the repository, `old` (text that must occur exactly once in that file, so the entry breaks
+loudly when the code changes), `new`, the tests (pytest node ids or files) that should
+fail, and `why` (one line: the bug a user would meet). Run it alone by its name and see it
+killed. Kernel code is compiled by numba, whose cache does not notice a change in another
+module: mutations under ensemble/model/ run with an empty cache (a few minutes of compiling
+each), the others share one warmed by the baseline.
+"""
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+TIMEOUT = 1800          # seconds per mutation; a hang counts as killed (the suite's own timeouts fail it first)
+
+
+@dataclass(frozen=True)
+class Mutation:
+    name: str
+    path: str
+    old: str
+    new: str
+    tests: tuple
+    why: str
+
+
+MUTATIONS = (
+    # -- kernel: the event ------------------------------------------------------------------
+    Mutation("kernel-free-end-degree", "ensemble/model/event.py",
+             "deg = (1 if i > 0 else 0) + (1 if i < n - 1 else 0)", "deg = 2",
+             ("tests/test_sequences.py",),
+             "free ends treated as interior blocks in the force update after an event"),
+    Mutation("kernel-mirror-right-end", "ensemble/model/friction.py",
+             "return i + 1 if i < n - 1 else i\n", "return i + 1 if i < n - 1 else i - 1\n",
+             ("tests/test_physics.py", "tests/test_sequences.py"),
+             "a mirror neighbour (u_{N} = u_{N-2}) at the right end instead of a free end"),
+    Mutation("kernel-energy-no-loading-work", "ensemble/model/event.py",
+             "e_change += -nu * tau * slip + nu * slip_time", "e_change += -nu * tau * slip",
+             ("tests/test_physics.py::test_energy_balance_per_event",),
+             "the loading work dropped from the energy balance"),
+    Mutation("kernel-no-healing-at-rest-in-event", "ensemble/model/event.py",
+             "return W[j, P] + math.log1p((tau - W[j, TR]) * math.exp(-W[j, P]))",
+             "return W[j, P]",
+             ("tests/test_sequences.py", "tests/test_physics.py"),
+             "a block that stopped during an event does not heal (theta frozen) until the event ends"),
+    Mutation("kernel-aging-law-half-velocity", "ensemble/model/friction.py",
+             "return math.exp(-psi) - vp", "return math.exp(-psi) - 0.5 * vp",
+             ("tests/test_physics.py", "tests/test_sequences.py"),
+             "the state equation theta' = 1 - v theta with a wrong velocity factor"),
+    Mutation("kernel-stick-not-located", "ensemble/model/event.py",
+             "if W[i, V] <= 0.0 and W[i, V0] > 0.0:", "if W[i, V] < -1e300 and W[i, V0] > 0.0:",
+             ("tests/test_convergence.py",),
+             "sticking by clamping v at the end of a step instead of cutting the step at v = 0"),
+    Mutation("kernel-rk4-weight", "ensemble/model/steppers.py",
+             "frac, weight = 0.5, 2.0", "frac, weight = 0.5, 2.05",
+             ("tests/test_convergence.py", "tests/test_physics.py"),
+             "a wrong weight in the classical RK4 stages"),
+    # -- kernel: loading between events and the schedule -------------------------------------
+    Mutation("onset-late", "ensemble/model/onset.py",
+             "return (y - y_theta) * (b / nu)", "return (y - y_theta) * (b / nu) * (1.0 + 1e-6)",
+             ("tests/test_onset.py", "tests/test_sequences.py"),
+             "the onset of a block at rest reported late by one part in a million"),
+    Mutation("schedule-lazy-loading-lost", "ensemble/model/schedule.py",
+             "W[i, F0] += nu * dt\n", "W[i, F0] += nu * dt * (1.0 - 1e-3)\n",
+             ("tests/test_schedule.py", "tests/test_sequences.py"),
+             "a block brought forward lazily misses part of its loading"),
+    Mutation("schedule-neighbours-not-rescheduled", "ensemble/model/event.py",
+             "        for j in (left(i), i, right(i, n)):\n            tree_set(tree, j, onset_key(W, since, j, nu, b))",
+             "        for j in (i,):\n            tree_set(tree, j, onset_key(W, since, j, nu, b))",
+             ("tests/test_schedule.py", "tests/test_sequences.py"),
+             "the neighbours of the blocks an event moved keep their stale onset times"),
+    Mutation("schedule-tree-picks-max", "ensemble/model/schedule.py",
+             "k = 2 * k + 1 if tree[2 * k + 1] < tree[2 * k] else 2 * k",
+             "k = 2 * k + 1 if tree[2 * k + 1] > tree[2 * k] else 2 * k",
+             ("tests/test_schedule.py",),
+             "the onset tree descends to the latest block instead of the earliest"),
+    Mutation("clock-low-part-dropped", "ensemble/model/schedule.py",
+             "clock[1] += (clock[0] - (s - bp)) + (dt - bp)", "clock[1] += 0.0",
+             ("tests/test_convergence.py::test_clock_offset_does_not_change_events",),
+             "the compensated clock loses its low-order part (times at t ~ 1e15 resolve only ~0.1)"),
+    # -- runner and catalog -----------------------------------------------------------------
+    Mutation("runner-seed-per-point", "ensemble/tasks.py",
+             "spawn_key=(task.index,)", "spawn_key=(task.point,)",
+             ("tests/test_cli.py",),
+             "all seeds of a parameter point draw the same initial state"),
+    Mutation("runner-boundary-flag", "ensemble/runner.py",
+             '"boundary": (first == 0) | (last == task.model.N - 1)',
+             '"boundary": (first == 0) & (last == task.model.N - 1)',
+             ("tests/test_cli.py", "tests/test_reduction.py"),
+             "an event reaching one end of the chain is recorded as interior"),
+    Mutation("runner-resume-clock-low-part", "ensemble/runner.py",
+             "self.clock = checkpoint.clock.copy()", "self.clock = np.array([checkpoint.clock[0], 0.0])",
+             ("tests/test_faults.py::test_crash_at_every_write_of_a_batch_resumes_to_the_uninterrupted_catalog",),
+             "a resumed task restarts from a slightly different time than the one it stopped at"),
+    Mutation("catalog-oldest-commit-wins", "ensemble/catalog.py",
+             "if best is None or seq > best.seq:", "if best is None or seq < best.seq:",
+             ("tests/test_faults.py::test_crash_at_every_write_of_a_batch_resumes_to_the_uninterrupted_catalog",),
+             "resume continues from the older of the two checkpoints"),
+    Mutation("catalog-one-checkpoint-slot", "ensemble/catalog.py",
+             "slot = 0 if head is None else 1 - head.slot", "slot = 0",
+             ("tests/test_faults.py::test_crash_at_every_write_of_a_batch_resumes_to_the_uninterrupted_catalog",),
+             "every checkpoint overwrites the only valid one, so a crash while writing it loses the task"),
+    Mutation("catalog-state-crc-unchecked", "ensemble/catalog.py",
+             "if crc(flat) != head.state_crc:", "if False:",
+             ("tests/test_faults.py::test_a_one_byte_flip_fails_resume_and_read_naming_the_task",),
+             "a corrupt checkpoint is resumed from without notice"),
+    Mutation("catalog-event-crc-unchecked", "ensemble/catalog.py",
+             "if running.combined() != expected:", "if False:",
+             ("tests/test_faults.py::test_a_one_byte_flip_fails_resume_and_read_naming_the_task",),
+             "corrupt events are read and reduced without notice"),
+    # -- reduction --------------------------------------------------------------------------
+    Mutation("reduce-interior-inverted", "analysis/reduce.py",
+             "_bin_add(out.tnu_interior, rblock[interior], tnu[interior], opt.tnu_edges)",
+             "_bin_add(out.tnu_interior, rblock[~interior], tnu[~interior], opt.tnu_edges)",
+             ("tests/test_reduction.py", "tests/test_analysis.py"),
+             "the interior recurrence statistics drawn from the events that reach an end"),
+    Mutation("stats-interval-level", "analysis/stats.py",
+             "q = 50 * (1 - level)", "q = 25 * (1 - level)",
+             ("tests/test_reduction.py", "tests/test_analysis.py"),
+             "a 97.5% interval reported as 95%"),
+    Mutation("recurrence-window-edge", "analysis/recurrence.py",
+             "if abs(epicenter[j] - pending_epi[k]) <= window:", "if abs(epicenter[j] - pending_epi[k]) < window:",
+             ("tests/test_reduction.py", "tests/test_analysis.py"),
+             "the recurrence window excludes its edge (10 blocks away)"),
+    Mutation("reduce-mode-from-interior", "analysis/reduce.py",
+             "mode = stats.centers(opt.tnu_edges)[np.argmax(tnu)] if tnu.sum() > 0 else np.nan",
+             "mode = stats.centers(opt.tnu_edges)[np.argmax(row[widths[0] + widths[1]:widths[0] + 2 * widths[1]])] if tnu.sum() > 0 else np.nan",
+             ("tests/test_reduction.py",),
+             "the mode of T nu taken from the interior events' histogram"),
+    Mutation("stats-b-value-natural-log", "analysis/stats.py",
+             "return LOG10_E / excess if excess > 0 else np.nan", "return 1.0 / excess if excess > 0 else np.nan",
+             ("tests/test_reduction.py", "tests/test_analysis.py"),
+             "the Gutenberg-Richter b-value with the natural instead of the decimal logarithm"),
+    Mutation("stats-density-not-per-width", "analysis/stats.py",
+             "counts / (np.maximum(total, 1) * widths)", "counts / np.maximum(total, 1)",
+             ("tests/test_reduction.py", "tests/test_analysis.py"),
+             "R(mu) normalised as a probability per bin instead of a density"),
+)
+
+
+def applied(text, mutation):
+    """The file text with the mutation applied; ValueError unless `old` occurs exactly once."""
+    count = text.count(mutation.old)
+    if count != 1:
+        raise ValueError(f"{mutation.name}: its text occurs {count} times in {mutation.path} (update the entry)")
+    return text.replace(mutation.old, mutation.new)
+
+
+def copy_repository(dest):
+    """The files git knows (tracked and untracked-but-not-ignored), as in the working tree."""
+    names = subprocess.run(["git", "ls-files", "-z", "--cached", "--others", "--exclude-standard"],
+                           cwd=ROOT, check=True, capture_output=True, timeout=60).stdout.split(b"\0")
+    for name in filter(None, names):
+        src = ROOT / name.decode()
+        if src.is_file():
+            (dest / name.decode()).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(src, dest / name.decode())
+
+
+def run_tests(copy, tests, cache, timeout):
+    """(outcome, seconds, first failing test or last output line) of pytest on `tests` in `copy`."""
+    env = dict(os.environ, PYTHONPATH=str(copy), NUMBA_CACHE_DIR=str(cache), OMP_NUM_THREADS="1",
+               NUMBA_NUM_THREADS="1", PYTHONDONTWRITEBYTECODE="1")
+    start = time.monotonic()
+    proc = subprocess.Popen([sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", *tests],
+                            cwd=copy, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                            start_new_session=True)
+    try:
+        out, _ = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, 9)
+        proc.communicate()
+        return "killed (timeout)", time.monotonic() - start, f"no result within {timeout} s"
+    seconds = time.monotonic() - start
+    lines = out.strip().splitlines() or [""]
+    failed = next((ln.split(" - ")[0] for ln in lines if ln.startswith(("FAILED", "ERROR"))), lines[-1])
+    outcome = {0: "SURVIVED", 1: "killed"}.get(proc.returncode, f"error (pytest exit {proc.returncode})")
+    return outcome, seconds, failed
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("names", nargs="*", help="mutations to run (default: all)")
+    parser.add_argument("--list", action="store_true", help="list the mutations and exit")
+    parser.add_argument("--timeout", type=float, default=TIMEOUT, help="seconds per mutation")
+    args = parser.parse_args(argv)
+    known = {m.name: m for m in MUTATIONS}
+    unknown = [n for n in args.names if n not in known]
+    if unknown:
+        parser.error(f"unknown mutation(s): {', '.join(unknown)}")
+    chosen = [known[n] for n in args.names] or list(MUTATIONS)
+    if args.list:
+        for m in chosen:
+            print(f"{m.name:38s} {m.path:28s} {m.why}")
+        return 0
+    texts = {}
+    problems = []
+    for m in chosen:
+        original = texts.setdefault(m.path, (ROOT / m.path).read_text())
+        try:
+            applied(original, m)
+        except ValueError as err:
+            problems.append(str(err))
+    for p in problems:
+        print(f"error: {p}", file=sys.stderr)
+    chosen = [m for m in chosen if not any(p.startswith(m.name + ":") for p in problems)]
+    with tempfile.TemporaryDirectory(prefix="bk-mutants-") as scratch:
+        scratch = Path(scratch)
+        copy = scratch / "repo"
+        copy_repository(copy)
+        shared = scratch / "cache"
+        baseline = sorted({t for m in chosen for t in m.tests if (copy / t.split("::")[0]).exists()})
+        print(f"baseline: {len(baseline)} test files/ids unmutated", flush=True)
+        outcome, seconds, detail = run_tests(copy, baseline, shared, args.timeout * 2)
+        if outcome != "SURVIVED":
+            print(f"error: the unmutated tests do not pass ({outcome}: {detail}); fix them first", file=sys.stderr)
+            return 1
+        print(f"baseline passed in {seconds:.0f} s", flush=True)
+        results = []
+        for m in chosen:
+            target = copy / m.path
+            missing = [t for t in m.tests if not (copy / t.split("::")[0]).exists()]
+            if missing:
+                results.append((m, "error (missing tests)", 0.0, ", ".join(missing)))
+                continue
+            target.write_text(applied(texts[m.path], m))
+            cache = scratch / f"cache-{m.name}" if m.path.startswith("ensemble/model/") else shared
+            try:
+                outcome, seconds, detail = run_tests(copy, m.tests, cache, args.timeout)
+            finally:
+                shutil.copy2(ROOT / m.path, target)   # the original text and time stamp
+                if cache != shared:
+                    shutil.rmtree(cache, ignore_errors=True)
+            results.append((m, outcome, seconds, detail))
+            print(f"{m.name:38s} {outcome:18s} {seconds:6.0f} s  {detail}", flush=True)
+    survivors = [r for r in results if not r[1].startswith("killed")]
+    print(f"\n{len(results) - len(survivors)} of {len(results)} mutations killed"
+          + (f"; not killed: {', '.join(r[0].name for r in survivors)}" if survivors else ""))
+    return 0 if not survivors and not problems else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
