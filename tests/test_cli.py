@@ -13,7 +13,7 @@ from .conftest import run_cli, write_config
 def small_run(tmp_path_factory):
     d = tmp_path_factory.mktemp("run")
     cfg = write_config(d / "cfg.toml", sweep={"b": [20.0, 30.0]}, run={"seeds": 2, "events": 30},
-                       integrator={"dt": 5e-4})
+                       integrator={"dt": 5e-4}, output={"batch": 8})   # several commits per task
     res = run_cli("run", cfg)
     assert res.returncode == 0, res.stderr
     return d, cfg
@@ -30,6 +30,8 @@ def test_catalog_schema_and_content(small_run):
         mine = events["task"] == k
         assert np.count_nonzero(mine) == 30
         assert np.all(np.diff(events["t"][mine]) > 0)           # time order within a task
+    for k in (0, 2):    # the two seeds of a point are independent realisations
+        assert not np.array_equal(events["slip"][events["task"] == k], events["slip"][events["task"] == k + 1])
     np.testing.assert_allclose(events["mu"], np.log10(events["slip"]))
     assert np.all(events["first"] <= events["epicenter"]) and np.all(events["epicenter"] <= events["last"])
     assert np.all(events["n_slipped"] <= events["last"] - events["first"] + 1)
