@@ -10,6 +10,7 @@ from analysis import stats, summary
 from analysis.recurrence import RecurrenceScanner
 from ensemble import catalog
 
+from . import reduction_reference as ref
 from .conftest import run_cli, write_config
 
 
@@ -63,6 +64,17 @@ def test_merged_histograms_equal_histogram_of_pooled_events(reduced):
         pooled_t, _ = np.histogram(tnu, bins=s["bins/tnu"])
         np.testing.assert_array_equal(s["per_task/tnu"][tasks["point"] == point].sum(axis=(0, 1)), pooled_t)
         assert s["points/numbers/n_recurrences"][point][0] == len(tnu) > 10
+
+
+def test_real_summary_equals_brute_force(reduced):
+    """Every dataset of the real catalog's summary (and so of its 2-rank twin, which
+    test_serial_and_mpi_reduction_agree finds identical) against the plain reference."""
+    events, tasks, _ = catalog.read(reduced / "cat.h5")
+    opt = {"mu_edges": np.linspace(0, 7, 71), "tnu_edges": np.linspace(0, 2000, 81), "mu_c": 3.5,
+           "window": 10, "b_cut": 3.0, "bootstrap": 200, "level": 0.95, "blocks": 20, "seed": 0}
+    expected = ref.expected_summary(events, tasks, opt)
+    assert expected["points/numbers/n_recurrences"][:, 0].min() > 10
+    ref.check_summary(ref.read_summary(reduced / "sum.h5"), expected, tasks, opt, reduced / "cat.h5")
 
 
 @pytest.mark.parametrize("chunk", [1, 7, 10000])
