@@ -13,6 +13,7 @@ enough to tell 95% from 97.5%.
 import itertools
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -225,13 +226,65 @@ def test_catalogs_exercise_the_edges(references):
     assert np.isfinite(exp_1["points/numbers/b_value"][0, 0]) and np.isfinite(exp_1["points/peaks"][0, 0, 0])
 
 
+@pytest.fixture(scope="module")
+def summaries(catalogs, references):
+    """summary_of(case, chunk): path of the case's summary, reduced (once) in chunks of `chunk` rows."""
+    made = {}
+
+    def summary_of(case, chunk):
+        if (case, chunk) not in made:
+            path, _, opt, _ = references[case]
+            out = catalogs[0] / f"{case}_{chunk}.summary.h5"
+            run(reduce_command(chunk, path, out, opt["level"], opt["blocks"]))
+            made[case, chunk] = out
+        return made[case, chunk]
+    return summary_of
+
+
 @pytest.mark.parametrize("case, chunk", [("seeds", 7), ("blocks", 3), ("one_unit", 1 << 16)])
-def test_summary_equals_brute_force(references, catalogs, case, chunk):
+def test_summary_equals_brute_force(references, summaries, case, chunk):
     """The whole summary, reduced with the catalog streamed in chunks of `chunk` rows."""
     path, tasks, opt, exp = references[case]
-    out = catalogs[0] / f"{case}_{chunk}.summary.h5"
-    run(reduce_command(chunk, path, out, opt["level"], opt["blocks"]))
-    ref.check_summary(ref.read_summary(out), exp, tasks, opt, path)
+    ref.check_summary(ref.read_summary(summaries(case, chunk)), exp, tasks, opt, path)
+
+
+def test_report_states_every_number_and_the_level(references, summaries):
+    """`analysis report`: each number of each point, its interval and the peaks, to the 4 digits
+    it prints, and the interval level as given (a 97.5% interval is not "97%")."""
+    from analysis import report, summary
+    _, _, opt, exp = references["blocks"]
+    s = summary.read(summaries("blocks", 3))
+    text = report.table(s)
+    assert "90% intervals from 200 bootstrap resamples" in text.splitlines()[0]
+    blocks = text.split("\npoint ")[1:]
+    assert len(blocks) == 3
+    number = r"-?\d+(?:\.\d*)?(?:e[-+]\d+)?|nan"
+
+    def same(printed, values):
+        want = [v for v in values if math.isfinite(v)]
+        got = [float(x) for x in re.findall(number, printed)]
+        assert len(got) == len(want), (printed, values)
+        for g, w in zip(got, want):
+            assert g == pytest.approx(w, rel=5e-4, abs=0), (printed, values)   # .4g
+
+    for i, block in enumerate(blocks):
+        lines = block.splitlines()
+        assert "resampling blocks, 7 units" in lines[0]
+        for name, line in zip(ref.NUMBERS, lines[1:]):
+            est, lo, hi = exp[f"points/numbers/{name}"][i]
+            printed = line.split(report.LABELS[name], 1)[1]
+            if math.isfinite(est):
+                same(printed, [est, lo, hi])
+            else:
+                assert printed.strip() == "-"
+        peaks = lines[1 + len(ref.NUMBERS)].split("T*nu peaks", 1)[1]
+        rows = [row for row in exp["points/peaks"][i] if math.isfinite(row[0])]
+        assert (peaks.strip() == "-") == (not rows)
+        for part, row in zip(peaks.split(";"), rows):
+            same(part, row)
+    for level, text in ((0.975, "97.5%"), (0.29, "29%"), (0.95, "95%")):
+        s["attrs"]["level"] = level
+        assert f" {text} intervals" in report.table(s).splitlines()[0]
 
 
 @pytest.mark.mpi
