@@ -143,6 +143,8 @@ transient = 5
 SEEDS_WRITTEN = [400, 400, 400, 400, 0, 250, 400, 400, 3, 400, 137, 400]
 # three points x one seed: block bootstrap over stretches, one task shorter than the stretches, one empty
 BLOCKS_WRITTEN = [400, 5, 0]
+# two points x two seeds (the fewest that resample seeds), one of them empty
+PAIRS_WRITTEN = [400, 220, 0, 400]
 
 
 @pytest.fixture(scope="module")
@@ -151,7 +153,8 @@ def catalogs(tmp_path_factory):
     made = {}
     for name, sweep, seeds, written in (
             ("seeds", "nu = [1.0, 0.5]\nb = [20.0, 30.0]", 3, SEEDS_WRITTEN),
-            ("blocks", "nu = [2.0, 1.0, 0.5]", 1, BLOCKS_WRITTEN)):
+            ("blocks", "nu = [2.0, 1.0, 0.5]", 1, BLOCKS_WRITTEN),
+            ("pairs", "nu = [1.0, 2.0]", 2, PAIRS_WRITTEN)):
         path = d / f"{name}.h5"
         events = write_catalog(path, CONFIG.format(N=N_CHAIN, sweep=sweep, seeds=seeds), written, seed=len(name))
         made[name] = (path, events)
@@ -161,7 +164,8 @@ def catalogs(tmp_path_factory):
 # case: (catalog, level, stretches per task)
 CASES = {"seeds": ("seeds", 0.95, 4),      # 3 seeds per point: the tasks are the units
          "blocks": ("blocks", 0.9, 7),     # 1 seed per point: 7 stretches of its trajectory are
-         "one_unit": ("blocks", 0.95, 1)}  # ... or 1 stretch: a single unit, no intervals
+         "one_unit": ("blocks", 0.95, 1),  # ... or 1 stretch: a single unit, no intervals
+         "two_seeds": ("pairs", 0.8, 3)}   # 2 seeds per point: the tasks
 
 
 @pytest.fixture(scope="module")
@@ -224,6 +228,10 @@ def test_catalogs_exercise_the_edges(references):
     _, _, _, exp_1 = references["one_unit"]
     assert list(exp_1["points/units"]) == [1] * 3 and np.isnan(exp_1["points/numbers/b_value"][:, 1:]).all()
     assert np.isfinite(exp_1["points/numbers/b_value"][0, 0]) and np.isfinite(exp_1["points/peaks"][0, 0, 0])
+    # two seeds per point, one of them an empty task, still resample the seeds
+    _, _, _, exp_2 = references["two_seeds"]
+    assert list(exp_2["points/method"]) == ["seeds"] * 2 and list(exp_2["points/units"]) == [2, 2]
+    assert np.all(exp_2["points/numbers/n_events"][:, 2] > exp_2["points/numbers/n_events"][:, 1])
 
 
 @pytest.fixture(scope="module")
@@ -241,7 +249,7 @@ def summaries(catalogs, references):
     return summary_of
 
 
-@pytest.mark.parametrize("case, chunk", [("seeds", 7), ("blocks", 3), ("one_unit", 1 << 16)])
+@pytest.mark.parametrize("case, chunk", [("seeds", 7), ("blocks", 3), ("one_unit", 1 << 16), ("two_seeds", 64)])
 def test_summary_equals_brute_force(references, summaries, case, chunk):
     """The whole summary, reduced with the catalog streamed in chunks of `chunk` rows."""
     path, tasks, opt, exp = references[case]
