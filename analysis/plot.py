@@ -5,7 +5,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .report import point_label, varying  # noqa: E402
+from .report import level_text, point_label, varying  # noqa: E402
 from .stats import centers  # noqa: E402
 
 
@@ -73,7 +73,7 @@ def plot(s, figure, path, title=None):
         fig = plt.figure(figsize=(5.5 * min(n, 2), 4 * int(np.ceil(n / 2))))
         recurrence(s, fig)
     a = s["attrs"]
-    fig.suptitle(title or f"{a['catalog']}  (bands: {int(a['level'] * 100)}% bootstrap)", fontsize=9)
+    fig.suptitle(title or f"{a['catalog']}  (bands: {level_text(a['level'])} bootstrap)", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)

@@ -10,6 +10,11 @@ LABELS = {
 }
 
 
+def level_text(level):
+    """An interval level as a percentage: 0.975 -> "97.5%" (int(100 * level) would say 97%)."""
+    return f"{100 * level:g}%"
+
+
 def varying(s):
     """Model parameters that differ between points (for labels and legends)."""
     return [p for p in PARAMS if len(np.unique(s[f"points/{p}"])) > 1] or ["b"]
@@ -31,7 +36,7 @@ def _fmt(est, lo, hi):
 def table(s):
     a = s["attrs"]
     lines = [f"summary of {a['catalog']}: mu_c = {a['mu_c']}, window = {a['window']} blocks, "
-             f"b-value above mu = {a['b_cut']}, {int(a['level'] * 100)}% intervals from "
+             f"b-value above mu = {a['b_cut']}, {level_text(a['level'])} intervals from "
              f"{a['bootstrap']} bootstrap resamples", ""]
     for i in range(len(s["points/N"])):
         lines.append(f"point {i}: " + point_label(s, i, list(PARAMS)) +

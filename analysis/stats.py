@@ -30,14 +30,16 @@ def find_peaks(counts, edges, rel_height=0.3, min_separation=4):
     """Positions of the local maxima of a [1, 4, 6, 4, 1]-smoothed histogram.
 
     A peak must reach rel_height of the highest one and lie at least
-    min_separation bins from a higher peak. Returned in decreasing height.
+    min_separation bins from a higher peak. Returned in decreasing height; of equal
+    heights the lower bin counts as the higher (a stable sort: numpy's default sort
+    orders ties differently on different CPUs, so the peaks kept would too).
     """
     c = np.asarray(counts, dtype=float)
     if c.sum() <= 0:
         return np.zeros(0)
     s = np.convolve(np.pad(c, 2, mode="edge"), np.array([1, 4, 6, 4, 1]) / 16, mode="valid")
     is_max = np.r_[s[0] > s[1], (s[1:-1] >= s[:-2]) & (s[1:-1] > s[2:]), s[-1] > s[-2]]
-    candidates = [i for i in np.argsort(-s) if is_max[i] and s[i] >= rel_height * s.max()]
+    candidates = [i for i in np.argsort(-s, kind="stable") if is_max[i] and s[i] >= rel_height * s.max()]
     chosen = []
     for i in candidates:
         if all(abs(i - j) >= min_separation for j in chosen):

@@ -1,0 +1,398 @@
+"""A plain, independent recomputation of everything `python -m analysis reduce` writes.
+
+Shares no code with analysis/: only the documented definitions (docs/running.md, the
+docstrings of analysis/summary.py, stats.py, recurrence.py and reduce.py), each written
+here the slow and obvious way, from the raw events:
+
+- bins are half-open [lo, hi), the last one too (a value on the top edge is out of range);
+  values outside the bins still count in the totals that normalise the densities;
+- R(mu) = counts / (n_events * width); the T nu densities = counts / (recurrences * width),
+  for all recurrences and for those whose starting event is interior (boundary false);
+- the recurrence time of a large event i (mu_i >= mu_c) is t_j - t_i for the first j > i of
+  the same task with mu_j >= mu_c and |epicenter_j - epicenter_i| <= window (O(n^2) loop);
+- a task of n events is cut into k stretches; event i belongs to stretch floor(i k / n) and a
+  recurrence to the stretch of its starting event;
+- the mode is the centre of the highest bin of the T nu histogram (the lowest such bin on a tie);
+- Aki's b = log10(e) / (mean(mu >= cut) - cut), NaN with fewer than two magnitudes;
+- the KS distance compares, at the upper edge of each bin lying at or above the cut, the share
+  of the binned magnitudes (from the first such bin to the top edge) below that edge with the
+  fitted law 1 - 10^(-b (edge - cut));
+- resampling units: the tasks of a point if it has two or more, else the stretches of its one
+  task; bootstrap resamples drawn as rng.integers(0, units, (bootstrap, units)) from
+  default_rng(SeedSequence(seed, spawn_key=(point,))), first for the numbers and curves, then
+  (if there is a peak and >= 2 units) for the peaks; intervals are the (1 - level) / 2 and
+  (1 + level) / 2 quantiles of the resampled values, NaNs left out (linear interpolation
+  between order statistics);
+- peaks: PEAK_RULE below, a plain transcription of the rule documented in stats.find_peaks;
+  each peak's interval from the nearest peak of every resample within PEAK_RULE["match_bins"].
+
+expected_summary(events, tasks, opt) gives every dataset of the summary; check_summary compares
+a summary file with it, key by key (a key it does not know fails: new outputs need a check).
+"""
+import math
+
+import h5py
+import numpy as np
+
+LOG10_E = math.log10(math.e)
+NUMBERS = ("n_events", "n_large", "fraction_large", "n_recurrences", "mean_tnu", "mode_tnu",
+           "mean_tnu_interior", "b_value", "ks_gr")
+# columns of /per_task/numbers, in the order analysis/stats.py documents
+PER_TASK_COLUMNS = ("n_events", "n_large", "n_rec", "sum_tnu", "n_rec_int", "sum_tnu_int",
+                    "n_gr", "sum_mu_gr")
+PARAMS = ("N", "l", "nu", "a", "b", "c")
+
+# -- the documented peak rule, in one place (replace this block when the finder changes) -----
+
+PEAK_RULE = {
+    "kernel": (1, 4, 6, 4, 1),   # smoothing weights (/ 16), the histogram padded with its edge values
+    "rel_height": 0.3,           # a peak reaches this share of the highest smoothed value
+    "min_separation": 4,         # bins from any higher peak already chosen (of equal heights the
+                                 # lower bin counts as the higher)
+    "match_bins": 5,             # a resample's nearest peak counts for a base peak within this many bins
+}
+
+
+def _candidates(counts):
+    """(smoothed histogram, candidate bins highest first) by PEAK_RULE; None for an empty one."""
+    c = [float(x) for x in counts]
+    n = len(c)
+    if sum(c) <= 0:
+        return None
+    w = PEAK_RULE["kernel"]
+    padded = [c[0], c[0]] + c + [c[-1], c[-1]]
+    s = [sum(w[k] * padded[i + k] for k in range(5)) / sum(w) for i in range(n)]
+    candidates = []
+    for i in range(n):
+        if i == 0:
+            is_max = s[0] > s[1]
+        elif i == n - 1:
+            is_max = s[i] > s[i - 1]
+        else:   # the right end of a plateau is its maximum
+            is_max = s[i] >= s[i - 1] and s[i] > s[i + 1]
+        if is_max and s[i] >= PEAK_RULE["rel_height"] * max(s):
+            candidates.append(i)
+    candidates.sort(key=lambda i: (-s[i], i))
+    return s, candidates
+
+
+def plain_peaks(counts, edges):
+    """Peak positions (bin centres) of a histogram, highest first, by PEAK_RULE."""
+    found = _candidates(counts)
+    if found is None:
+        return []
+    chosen = []
+    for i in found[1]:
+        if all(abs(i - j) >= PEAK_RULE["min_separation"] for j in chosen):
+            chosen.append(i)
+    return [0.5 * (edges[i] + edges[i + 1]) for i in chosen]
+
+
+def tied_peaks(counts):
+    """True if two candidates within min_separation have the same height (the tie rule decides)."""
+    found = _candidates(counts)
+    if found is None:
+        return False
+    s, cand = found
+    return any(s[i] == s[j] and abs(i - j) < PEAK_RULE["min_separation"]
+               for a, i in enumerate(cand) for j in cand[a + 1:])
+
+
+# -- plain statistics ---------------------------------------------------------------------
+
+def percentile(values, q):
+    """q-th percentile (0..100) of the finite values, linear between order statistics; NaN if none."""
+    x = sorted(v for v in values if not math.isnan(v))
+    if not x:
+        return math.nan
+    h = (len(x) - 1) * q / 100.0
+    i = int(math.floor(h))
+    if i + 1 >= len(x):
+        return x[-1]
+    return x[i] + (h - i) * (x[i + 1] - x[i])
+
+
+def histogram(values, edges):
+    """Counts in half-open bins [e_k, e_k+1), the last one too."""
+    v = np.asarray(values, dtype=float)
+    return np.histogram(v[v < edges[-1]], bins=edges)[0]
+
+
+def density(counts, edges, total):
+    if total == 0:
+        return np.full(len(edges) - 1, np.nan)
+    return np.asarray(counts) / total / np.diff(edges)
+
+
+def recurrences(t, epi, mu, boundary, mu_c, window):
+    """[(index of the starting event, T, interior, index of the closing event)], the O(n^2) way."""
+    t, epi, mu, boundary = (list(map(float, t)), list(map(int, epi)), list(map(float, mu)),
+                            list(map(bool, boundary)))
+    out = []
+    for i in range(len(t)):
+        if mu[i] < mu_c:
+            continue
+        for j in range(i + 1, len(t)):
+            if mu[j] >= mu_c and abs(epi[j] - epi[i]) <= window:
+                out.append((i, t[j] - t[i], not boundary[i], j))
+                break
+    return out
+
+
+def b_value(mu, cut):
+    m = [x for x in mu if x >= cut]
+    if len(m) < 2:
+        return math.nan
+    excess = sum(m) / len(m) - cut
+    return LOG10_E / excess if excess > 0 else math.nan
+
+
+def ks_distance(mu, edges, cut, b):
+    if not math.isfinite(b):
+        return math.nan
+    kept = [k for k in range(len(edges) - 1) if edges[k] >= cut]
+    if not kept:
+        return math.nan
+    lo, top = edges[kept[0]], edges[-1]
+    inside = [x for x in mu if lo <= x < top]
+    if not inside:
+        return math.nan
+    gaps = []
+    for k in kept:
+        upper = edges[k + 1]
+        empirical = sum(1 for x in inside if x < upper) / len(inside)
+        gaps.append(abs(empirical - (1.0 - 10.0 ** (-b * (upper - cut)))))
+    return max(gaps)
+
+
+def statistics(mu, tnu, interior, opt):
+    """Curves and numbers of pooled raw data: mu (all events), tnu and interior (recurrences)."""
+    mu = np.asarray(mu, dtype=float)
+    tnu = np.asarray(tnu, dtype=float)
+    interior = np.asarray(interior, dtype=bool)
+    me, te = opt["mu_edges"], opt["tnu_edges"]
+    h_t = histogram(tnu, te)
+    mode = math.nan
+    if h_t.sum() > 0:
+        best = 0
+        for k in range(len(h_t)):
+            if h_t[k] > h_t[best]:
+                best = k
+        mode = 0.5 * (te[best] + te[best + 1])
+    n, n_large = len(mu), int(np.count_nonzero(mu >= opt["mu_c"]))
+    b = b_value(mu, opt["b_cut"])
+    numbers = {
+        "n_events": n, "n_large": n_large, "fraction_large": n_large / n if n else math.nan,
+        "n_recurrences": len(tnu), "mean_tnu": tnu.sum() / len(tnu) if len(tnu) else math.nan,
+        "mode_tnu": mode,
+        "mean_tnu_interior": tnu[interior].sum() / interior.sum() if interior.any() else math.nan,
+        "b_value": b, "ks_gr": ks_distance(mu, me, opt["b_cut"], b),
+    }
+    curves = {"mu": density(histogram(mu, me), me, n),
+              "tnu": density(h_t, te, len(tnu)),
+              "tnu_interior": density(histogram(tnu[interior], te), te, int(interior.sum()))}
+    return curves, numbers
+
+
+# -- the whole summary ------------------------------------------------------------------
+
+class Task:
+    """One task's raw events and its recurrences (T nu), each with its stretch."""
+
+    def __init__(self, ev, nu, opt):
+        n = len(ev["t"])
+        k = opt["blocks"]
+        self.n = n
+        self.mu = np.asarray(ev["mu"], dtype=float)
+        self.stretch = np.array([i * k // n for i in range(n)], dtype=np.int64)
+        rec = recurrences(ev["t"], ev["epicenter"], ev["mu"], ev["boundary"], opt["mu_c"], opt["window"])
+        self.rec_start = np.array([r[0] for r in rec], dtype=np.int64)
+        self.rec_end = np.array([r[3] for r in rec], dtype=np.int64)
+        self.tnu = np.array([r[1] * nu for r in rec], dtype=float)
+        self.interior = np.array([r[2] for r in rec], dtype=bool)
+        self.rec_stretch = self.stretch[self.rec_start] if len(rec) else np.zeros(0, dtype=np.int64)
+
+    def unit(self, stretch=None):
+        """(mu, tnu, interior) of the whole task or of one stretch."""
+        if stretch is None:
+            return self.mu, self.tnu, self.interior
+        e, r = self.stretch == stretch, self.rec_stretch == stretch
+        return self.mu[e], self.tnu[r], self.interior[r]
+
+    def per_stretch(self, opt):
+        k, me, te = opt["blocks"], opt["mu_edges"], opt["tnu_edges"]
+        mu_h = np.zeros((k, len(me) - 1), dtype=np.int64)
+        t_h = np.zeros((k, len(te) - 1), dtype=np.int64)
+        ti_h = np.zeros((k, len(te) - 1), dtype=np.int64)
+        numbers = np.zeros((k, len(PER_TASK_COLUMNS)))
+        for s in range(k):
+            mu, tnu, interior = self.unit(s)
+            mu_h[s], t_h[s], ti_h[s] = histogram(mu, me), histogram(tnu, te), histogram(tnu[interior], te)
+            gr = mu[mu >= opt["b_cut"]]
+            numbers[s] = [len(mu), np.count_nonzero(mu >= opt["mu_c"]), len(tnu), tnu.sum(),
+                          interior.sum(), tnu[interior].sum(), len(gr), gr.sum()]
+        return mu_h, t_h, ti_h, numbers
+
+
+def _pool(units, pick):
+    return tuple(np.concatenate([units[p][c] for p in pick]) for c in range(3))
+
+
+def point(tasks, point_index, opt):
+    """Estimates, intervals, peaks, method and unit count of one parameter point."""
+    if len(tasks) >= 2:
+        units, method = [t.unit() for t in tasks], "seeds"
+    else:
+        units, method = [tasks[0].unit(s) for s in range(opt["blocks"])], "blocks"
+    m = len(units)
+    curves, numbers = statistics(*_pool(units, range(m)), opt)
+    rng = np.random.default_rng(np.random.SeedSequence(opt["seed"], spawn_key=(point_index,)))
+    q = 50.0 * (1.0 - opt["level"])
+    out = {"method": method, "units": m, "curves": {}, "numbers": {}}
+    if m >= 2:
+        picks = rng.integers(0, m, size=(opt["bootstrap"], m))
+        resampled = [statistics(*_pool(units, p), opt) for p in picks]
+    for name, est in curves.items():
+        if m >= 2:
+            rows = np.array([r[0][name] for r in resampled])
+            lo = np.array([percentile(rows[:, j], q) for j in range(len(est))])
+            hi = np.array([percentile(rows[:, j], 100 - q) for j in range(len(est))])
+        else:
+            lo = hi = np.full(len(est), np.nan)
+        out["curves"][name] = (est, lo, hi)
+    for name, est in numbers.items():
+        if m >= 2:
+            values = [r[1][name] for r in resampled]
+            out["numbers"][name] = (est, percentile(values, q), percentile(values, 100 - q))
+        else:
+            out["numbers"][name] = (est, math.nan, math.nan)
+    out["peaks"], out["tied"] = _peaks(units, m, opt, rng, q)
+    return out
+
+
+def _peaks(units, m, opt, rng, q):
+    te = opt["tnu_edges"]
+    hist = [histogram(u[1], te) for u in units]
+    base = plain_peaks(sum(hist), te)
+    tied = tied_peaks(sum(hist))
+    if not base or m < 2:
+        return [(b, math.nan, math.nan) for b in base], tied
+    width = te[1] - te[0]
+    found = [[] for _ in base]
+    for pick in rng.integers(0, m, size=(opt["bootstrap"], m)):
+        counts = sum(hist[p] for p in pick)
+        tied = tied or tied_peaks(counts)
+        resampled = plain_peaks(counts, te)
+        for i, b in enumerate(base):
+            if not resampled:
+                continue
+            near = resampled[0]
+            for r in resampled[1:]:
+                if abs(r - b) < abs(near - b):
+                    near = r
+            if abs(near - b) <= PEAK_RULE["match_bins"] * width:
+                found[i].append(near)
+    rows = [(b, percentile(f, q), percentile(f, 100 - q)) if f else (b, math.nan, math.nan)
+            for b, f in zip(base, found)]
+    return rows, tied
+
+
+def expected_summary(events, tasks, opt):
+    """What the summary of a catalog must hold: {summary key: array}, plus 'tied' (peak ties met).
+
+    events: dict of columns of every committed event (catalog.read); tasks: the task table.
+    opt: mu_edges, tnu_edges, mu_c, window, b_cut, bootstrap, level, blocks, seed.
+    """
+    n_tasks = len(tasks["point"])
+    per_task = [Task({c: events[c][events["task"] == k] for c in ("t", "mu", "epicenter", "boundary")},
+                     float(tasks["nu"][k]), opt) for k in range(n_tasks)]
+    exp = {"bins/mu": opt["mu_edges"], "bins/tnu": opt["tnu_edges"]}
+    stacks = [t.per_stretch(opt) for t in per_task]
+    for j, name in enumerate(("mu", "tnu", "tnu_interior", "numbers")):
+        exp[f"per_task/{name}"] = np.stack([s[j] for s in stacks])
+    points = sorted(set(int(p) for p in tasks["point"]))
+    results = []
+    for p in points:
+        ids = [k for k in range(n_tasks) if tasks["point"][k] == p]
+        r = point([per_task[k] for k in ids], p, opt)
+        r["params"] = {name: tasks[name][ids[0]] for name in PARAMS}
+        results.append(r)
+    for name in PARAMS:
+        exp[f"points/{name}"] = np.array([r["params"][name] for r in results])
+    exp["points/method"] = np.array([r["method"] for r in results])
+    exp["points/units"] = np.array([r["units"] for r in results])
+    for name in ("mu", "tnu", "tnu_interior"):
+        for j, suffix in enumerate(("density", "lo", "hi")):
+            exp[f"points/{name}_{suffix}"] = np.stack([r["curves"][name][j] for r in results])
+    for name in NUMBERS:
+        exp[f"points/numbers/{name}"] = np.array([r["numbers"][name] for r in results], dtype=float)
+    most = max([len(r["peaks"]) for r in results] + [1])
+    peaks = np.full((len(results), most, 3), np.nan)
+    for i, r in enumerate(results):
+        if r["peaks"]:
+            peaks[i, :len(r["peaks"])] = r["peaks"]
+    exp["points/peaks"] = peaks
+    exp["tied"] = any(r["tied"] for r in results)
+    exp["raw"] = per_task      # for the tests' preconditions (what the catalog exercises)
+    return exp
+
+
+# -- the comparison ------------------------------------------------------------------------
+
+def read_summary(path):
+    """Every dataset and attribute of a summary, read with h5py alone."""
+    out = {}
+    with h5py.File(path, "r") as h5:
+        h5.visititems(lambda name, obj: out.__setitem__(name, obj[...]) if isinstance(obj, h5py.Dataset) else None)
+        out["attrs"] = dict(h5.attrs)
+    return out
+
+
+# Floating-point tolerances. Counts, bins, peak positions, modes and unit counts are compared
+# exactly. Sums and quotients are computed here in another order or form (a sum over a list
+# against np.add.at, counts / n / width against counts / (n * width), our percentile against
+# numpy's): the largest relative differences measured (tests/test_reduction.py's summaries and the
+# real catalog's of tests/test_analysis.py) were 1.5e-14 for
+# ks_gr (a small difference of nearly equal CDFs, inheriting b's ulps through 10 ** (-b x)),
+# 2.5e-15 for b_value, 3.7e-15 for interval ends and 4e-16 for the per-task sums. 1e-12 leaves
+# room for other data and still tells any real change apart.
+RTOL = 1e-12
+
+
+def check_summary(s, expected, tasks, opt, catalog_path):
+    """Every dataset and attribute of summary `s` (read_summary) against expected_summary."""
+    tasks_keys = {f"tasks/{k}" for k in tasks}
+    numbers = {f"points/numbers/{n}" for n in NUMBERS}
+    curves = {f"points/{c}_{x}" for c in ("mu", "tnu", "tnu_interior") for x in ("density", "lo", "hi")}
+    known = ({"bins/mu", "bins/tnu", "points/method", "points/units", "points/peaks", "attrs"}
+             | {f"per_task/{k}" for k in ("mu", "tnu", "tnu_interior", "numbers")}
+             | {f"points/{p}" for p in PARAMS} | tasks_keys | numbers | curves)
+    # a new output must get its brute-force check here
+    assert set(s) == known, f"unchecked {set(s) - known}, missing {known - set(s)}"
+    a = s["attrs"]
+    for key in ("mu_c", "window", "b_cut", "bootstrap", "level", "blocks", "seed"):
+        assert a[key] == opt[key], key
+    assert a["catalog"] == str(catalog_path) and a["format"].startswith("bk-summary-")
+    with h5py.File(catalog_path, "r") as h5:
+        assert a["config"] == h5.attrs["config"]
+    for k, v in tasks.items():
+        got = s[f"tasks/{k}"]
+        want = np.char.encode(v) if v.dtype.kind == "U" else v
+        np.testing.assert_array_equal(got, want, err_msg=k)
+    for key in ("bins/mu", "bins/tnu", "per_task/mu", "per_task/tnu", "per_task/tnu_interior",
+                "points/units", *(f"points/{p}" for p in PARAMS)):
+        np.testing.assert_array_equal(s[key], expected[key], err_msg=key)
+    assert [m.decode() for m in s["points/method"]] == list(expected["points/method"])
+    got, want = s["per_task/numbers"], expected["per_task/numbers"]
+    counts = [PER_TASK_COLUMNS.index(c) for c in ("n_events", "n_large", "n_rec", "n_rec_int", "n_gr")]
+    np.testing.assert_array_equal(got[..., counts], want[..., counts], err_msg="per_task/numbers counts")
+    np.testing.assert_allclose(got, want, rtol=RTOL, atol=0, err_msg="per_task/numbers sums")
+    for key in sorted(curves):
+        np.testing.assert_allclose(s[key], expected[key], rtol=RTOL, atol=0, err_msg=key)
+    for key in sorted(numbers):
+        np.testing.assert_allclose(s[key], expected[key], rtol=RTOL, atol=0, err_msg=key)
+    for name in ("n_events", "n_large", "n_recurrences", "fraction_large", "mode_tnu"):
+        np.testing.assert_array_equal(s[f"points/numbers/{name}"][:, 0], expected[f"points/numbers/{name}"][:, 0])
+    assert s["points/peaks"].shape == expected["points/peaks"].shape
+    np.testing.assert_array_equal(s["points/peaks"][..., 0], expected["points/peaks"][..., 0])
+    np.testing.assert_allclose(s["points/peaks"], expected["points/peaks"], rtol=RTOL, atol=0, err_msg="peaks")
