@@ -108,8 +108,8 @@ _BISECTIONS = 60
 
 
 @nb.njit(cache=True)
-def _rk4_step(t, h, u, v, psi, moving, nu, l2, a, b, c):
-    """(u, v, psi) after one classical RK4 step of length h from time t (new arrays)."""
+def _rk4_step(t, t_lo, h, u, v, psi, moving, nu, l2, a, b, c):
+    """(u, v, psi) after one classical RK4 step of length h from time t + t_lo (new arrays)."""
     n = u.shape[0]
     ku = np.zeros((4, n))
     kv = np.zeros((4, n))
@@ -123,7 +123,7 @@ def _rk4_step(t, h, u, v, psi, moving, nu, l2, a, b, c):
             su = u + f * ku[s - 1]
             sv = v + f * kv[s - 1]
             sp = psi + f * kp[s - 1]
-        _rates(t + fracs[s] * h, su, sv, sp, moving, nu, l2, a, b, c, ku[s], kv[s], kp[s])
+        _rates(t + (t_lo + fracs[s] * h), su, sv, sp, moving, nu, l2, a, b, c, ku[s], kv[s], kp[s])
     w = h / 6.0
     return (u + w * (ku[0] + 2 * ku[1] + 2 * ku[2] + ku[3]),
             v + w * (kv[0] + 2 * kv[1] + 2 * kv[2] + kv[3]),
@@ -164,7 +164,8 @@ def _sequence(u, v, psi, t, n_events, nu, l2, a, b, c, dt, alpha, max_steps,
     n = u.shape[0]
     moving = np.zeros(n, dtype=np.bool_)
     u_onset = u.copy()
-    t_onset = t
+    t_onset, t_onset_lo = t, 0.0
+    t_lo = 0.0     # time is the unevaluated sum t + t_lo: ~1e6 steps at t ~ 1e5 would drift
     k = 0
     steps = 0
     while k < n_events and steps < max_steps:
@@ -174,21 +175,23 @@ def _sequence(u, v, psi, t, n_events, nu, l2, a, b, c, dt, alpha, max_steps,
             h = min(h, alpha * np.exp(psi[i]))
             if moving[i] and v[i] > 0.0:
                 h = min(h, alpha / v[i])
-        u1, v1, psi1 = _rk4_step(t, h, u, v, psi, moving, nu, l2, a, b, c)
-        if _changes(t + h, u1, v1, psi1, moving, nu, l2, b, c) > 0:
+        u1, v1, psi1 = _rk4_step(t, t_lo, h, u, v, psi, moving, nu, l2, a, b, c)
+        if _changes(t + (t_lo + h), u1, v1, psi1, moving, nu, l2, b, c) > 0:
             lo, hi = 0.0, h
             for _ in range(_BISECTIONS):
                 mid = 0.5 * (lo + hi)
-                um, vm, psim = _rk4_step(t, mid, u, v, psi, moving, nu, l2, a, b, c)
-                if _changes(t + mid, um, vm, psim, moving, nu, l2, b, c) > 0:
+                um, vm, psim = _rk4_step(t, t_lo, mid, u, v, psi, moving, nu, l2, a, b, c)
+                if _changes(t + (t_lo + mid), um, vm, psim, moving, nu, l2, b, c) > 0:
                     hi = mid
                 else:
                     lo = mid
             h = hi
-            u1, v1, psi1 = _rk4_step(t, h, u, v, psi, moving, nu, l2, a, b, c)
+            u1, v1, psi1 = _rk4_step(t, t_lo, h, u, v, psi, moving, nu, l2, a, b, c)
         was_sliding = moving.any()
         u, v, psi = u1, v1, psi1
-        t += h
+        s = t + h     # two-sum: t + t_lo += h exactly
+        t_lo += (t - (s - (s - t))) + (h - (s - t))
+        t = s
         # regime changes at t: stops first, then onsets of blocks that were at rest
         resting = ~moving
         for i in range(n):
@@ -199,19 +202,19 @@ def _sequence(u, v, psi, t, n_events, nu, l2, a, b, c, dt, alpha, max_steps,
         largest = 0.0
         for i in range(n):
             if resting[i]:
-                excess = _driving_force(t, u, i, nu, l2) - (c + b * psi[i])
+                excess = _driving_force(t + t_lo, u, i, nu, l2) - (c + b * psi[i])
                 if excess > 0.0:
                     moving[i] = True
                     if excess > largest:
                         largest = excess
                         first = i
         if not was_sliding and first >= 0:
-            t_onset = t
+            t_onset, t_onset_lo = t, t_lo
             u_onset[:] = u
             epicenter[k] = first
         if was_sliding and not moving.any():
-            onset[k] = t_onset
-            duration[k] = t - t_onset
+            onset[k] = t_onset + t_onset_lo
+            duration[k] = (t - t_onset) + (t_lo - t_onset_lo)
             slip[k, :] = u - u_onset
             k += 1
     return k

@@ -44,16 +44,21 @@ EVENTS = 16        # events per task in the catalog (no transient: the first is 
 REF_DT = 1e-3
 ALPHA = 0.01
 
-# method: (its [integrator], events compared, relative tolerance of onset time and slip,
-#          absolute tolerance of the duration)
+# method: (its [integrator], events compared, relative tolerance of the first event's onset
+# time and slip, absolute tolerance of the durations). The tolerance of event k is the first
+# one times 10^(k/2): the differences grow as fast (chaos; below, measured / tolerance).
 METHODS = {
-    # measured against the reference over the first 10 events: onset time 1.5e-8, slip 4.5e-8,
-    # duration 1.6e-6 (the 11th event differs by 3.3e-7, and the 14th by ~1e-5)
-    "rk4": ({"method": "rk4", "dt": REF_DT}, 10, 1e-6, 2e-5),
-    # the default method at its default tolerances (rtol 1e-5): measured over the first 4
-    # events onset time 2.2e-6, slip 1.1e-5, duration 1.8e-4 (the 5th differs by 1.8e-4 in slip,
-    # the 7th by 1.3e-3)
-    "ark4": ({"method": "ark4"}, 4, 1e-4, 2e-3),
+    # onset time and slip of events 0..9: 6e-12, 7e-12, 9e-11, 6e-10, 1.1e-8, 9e-9, 8e-8, 2.3e-7,
+    # 8e-8, 5e-8 against 1e-9 .. 3.2e-5 (at least 9x below), durations 7.9e-6 (the 11th
+    # event: 1.6e-6, the 14th: 1.3e-5, the 16th: 8e-2). The same run with the reference's time
+    # summed in plain float64 measured 4.5e-8 at most (3.6e-10 at event 4): round-off decides
+    # the numbers, the envelope does not.
+    "rk4": ({"method": "rk4", "dt": REF_DT}, 10, 1e-9, 1e-4),
+    # the default method at its default tolerances (rtol 1e-5): events 0..8 measured 1.1e-8,
+    # 2.9e-7, 1.5e-6, 1.1e-5, 1.8e-4, 1.1e-4, 1.3e-3, 7.6e-4, 5.6e-4 against 1e-5 .. 1e-1 (at
+    # least 5x below); durations 0.11 (the 7th event, of 11.7: a duration ends at the last
+    # stick, where v(t) reaches 0 nearly tangentially, so it magnifies any difference)
+    "ark4": ({"method": "ark4"}, 9, 1e-5, 0.5),
 }
 
 # relative slip tolerance of each task's first event: measured 9.3e-12 (rk4: the same steps as
@@ -112,7 +117,8 @@ def task_events(events, k):
 def test_sequence_agrees_with_the_reference(catalogs, references, method):
     """Task 0's first events: epicenter, the blocks that slipped, onset time, slip, duration."""
     events, tasks, attrs = catalogs[method]
-    _, n, rtol, dur_atol = METHODS[method]
+    _, n, tol0, dur_atol = METHODS[method]
+    rtol = tol0 * 10 ** (np.arange(n) / 2)
     for name, value in MODEL.items():
         assert tasks[name][0] == value
     ours = task_events(events, 0)
@@ -134,8 +140,8 @@ def test_sequence_agrees_with_the_reference(catalogs, references, method):
     np.testing.assert_array_equal(ours["last"][:n], last)
     # the comparison covers what it is meant to: events reaching a free end, and local ones
     assert ours["boundary"][:n].sum() >= 2 and np.any(ours["n_slipped"][:n] == 1)
-    assert rel_t.max() < rtol and rel_slip.max() < rtol
-    np.testing.assert_allclose(ours["mu"][:n], np.log10(ref["slip"][:n]), rtol=0, atol=rtol)
+    assert np.all(rel_t < rtol) and np.all(rel_slip < rtol)
+    assert np.all(np.abs(ours["mu"][:n] - np.log10(ref["slip"][:n])) < rtol)
     assert d_dur.max() < dur_atol
 
 
