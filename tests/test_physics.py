@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from ensemble.config import Integrator, Model
-from ensemble.events import check, physical_state, run_event
+from ensemble.events import advance_to_onset, check, physical_state, run_event
 
 from .conftest import developed_state, next_event
 from .reference import reference_event
@@ -32,16 +32,42 @@ def test_single_block_instability_threshold(block, stiffness):
 
 
 def test_energy_balance_per_event():
-    """dE_elastic + friction work - loading work vanishes for every event (to the integration error)."""
-    model = Model(N=80, b=20.0, a=5.0)
+    """dE_elastic + friction work - loading work vanishes for every event, against each term.
+
+    The residual is compared with each of the three terms, not only with their sum: at the
+    paper's nu = 1e-8 the loading work of an event is ~1e-8 of the others (measured residual
+    / loading work up to 1e-2 there), so dropping it from the balance would pass any test
+    relative to the energy scale. At nu = 1e-2 every term is large; the elastic term is also
+    recomputed here from the event's slip profile and pre-event forces.
+    """
+    model = Model(N=80, b=20.0, a=5.0, nu=1e-2)
     force, psi = developed_state(model, 200)
-    residuals = []
+    rows = []
     for _ in range(30):
-        _, ev = next_event(force, psi, model, 1e-3)
-        residuals.append(ev.relative_energy_residual)
+        epicenter, _, f, p = advance_to_onset(force, psi, model)
+        f[epicenter] = model.b * p[epicenter]
+        ev = check(run_event(f, p, epicenter, model, Integrator(method="rk4", dt=1e-3)))
+        y = ev.profile
+        elastic = -np.sum(y * f) + 0.5 * np.sum(y * y) + 0.5 * model.l ** 2 * np.sum(np.diff(y) ** 2)
+        rows.append((ev.energy_residual, ev.elastic_change, ev.friction_work, ev.load_work, elastic,
+                     ev.relative_energy_residual))
         force, psi = ev.force, ev.psi
-    print(f"max relative energy residual over 30 events: {max(residuals):.2e}")
-    assert max(residuals) < 1e-6
+    residual, elastic, friction, load, elastic_here, relative = np.array(rows).T
+    # the kernel's elastic term is the one its docstring defines: measured 4.4e-16 (round-off)
+    mismatch = np.max(np.abs(elastic / elastic_here - 1))
+    np.testing.assert_allclose(elastic, elastic_here, rtol=1e-12)
+    ratios = {"elastic change": np.abs(residual / elastic), "friction work": np.abs(residual / friction),
+              "loading work": np.abs(residual / load)}
+    print("max |residual| / |term| over 30 events: " + ", ".join(f"{k} {v.max():.1e}" for k, v in ratios.items())
+          + f"; / energy scale {relative.max():.1e}; elastic term against the profile: {mismatch:.1e}")
+    # measured 2.3e-11, 2.3e-11 and 4.1e-9 (RK4 at dt = 1e-3 conserves energy to its truncation
+    # error): each bound 40x above. A term dropped from the kernel's residual makes its own ratio
+    # 1 (tried for each: the largest ratio of another term was then 6.5e-3 and up)
+    assert ratios["elastic change"].max() < 1e-9
+    assert ratios["friction work"].max() < 1e-9
+    assert ratios["loading work"].max() < 1e-7
+    # relative to the sum of the terms' magnitudes (D_ENERGY_SCALE): measured 6.5e-12
+    assert relative.max() < 1e-10
 
 
 def test_c_invariance_from_equivalent_physical_states():
