@@ -8,8 +8,9 @@ from .integrators import kernel_args
 from .model.event import integrate_event
 from .model.onset import onset_delay
 from .model.schedule import build_schedule, tree_min
-from .model.workspace import (D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ENERGY_SCALE, D_REJECTED, D_RESIDUAL, D_SLIP,
-                              D_STEPS, D_VMAX, D_WORK, NTRACE, OK, STATUS_TEXT, Workspace)
+from .model.workspace import (D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D_ENERGY_SCALE, D_LOAD_WORK,
+                              D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK, NTRACE, OK, STATUS_TEXT,
+                              Workspace)
 
 
 @dataclass
@@ -25,6 +26,8 @@ class EventResult:
     friction_work: float    # int sum(Phi v) dt, c-free frame
     energy_residual: float  # dE_elastic + friction work - loading work
     energy_scale: float     # sum of the magnitudes of the terms of that balance
+    elastic_change: float   # dE_elastic: the slip's, at the load of the onset (workspace.D_ELASTIC)
+    load_work: float        # work of the load's advance since the onset (workspace.D_LOAD_WORK)
     profile: np.ndarray     # slip of every block
     force: np.ndarray       # state after the event (c-free frame)
     psi: np.ndarray
@@ -89,7 +92,8 @@ def run_event(force, psi, epicenter, model, integrator, v_start=0.0, trace=None)
     d = ws.diag
     return EventResult(status, d[D_SLIP], d[D_DURATION], int(d[D_STEPS]), int(d[D_BLOCK_STEPS]),
                        int(d[D_REJECTED]), int(d[D_CUTS]), d[D_VMAX], d[D_WORK],
-                       d[D_RESIDUAL], d[D_ENERGY_SCALE], profile, force, psi, seconds)
+                       d[D_RESIDUAL], d[D_ENERGY_SCALE], d[D_ELASTIC], d[D_LOAD_WORK], profile, force,
+                       psi, seconds)
 
 
 def check(result, what="event"):

@@ -15,8 +15,11 @@ def test_takes_far_fewer_steps_than_rk4_in_slow_nucleation(events):
     f[epicenter] = model.b * p[epicenter]
     rk4 = check(run_event(f, p, epicenter, model, Integrator(method="rk4", dt=1e-3)))
     ark = check(run_event(f, p, epicenter, model, Integrator(method="ark3", rtol=1e-7)))
-    print(f"a = 30 event of duration {rk4.duration:.0f}: RK4 {rk4.steps} steps, ARK3 {ark.steps}")
-    assert ark.slip == pytest.approx(rk4.slip, rel=1e-5)
+    print(f"a = 30 event of duration {rk4.duration:.0f}: RK4 {rk4.steps} steps, ARK3 {ark.steps}; slip "
+          f"{ark.slip / rk4.slip - 1:.1e} off RK4's")
+    # measured 5.9e-11 apart (at rtol 1e-7 ark3's slip errors are ~0.05 rtol, test_ark4.py)
+    assert ark.slip == pytest.approx(rk4.slip, rel=1e-7)
+    # measured 17.7x fewer steps (30528 against 540692)
     assert ark.steps < rk4.steps / 5
 
 

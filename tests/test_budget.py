@@ -4,6 +4,10 @@ Any budget must give the events of one unlimited call bit for bit, and while an 
 paused the workspace must give back the exact state after the last completed event
 (Workspace.between_events), from which a fresh workspace continues bit for bit: that is what a
 checkpoint taken during a long event holds.
+
+No tolerances: everything is compared bit for bit. The counts asserted are coverage (the
+pauses did fall inside events): measured 12-16 of 16 events paused in, 4-6 resumed in a fresh
+workspace, against at least 8 and 3.
 """
 import numpy as np
 import pytest

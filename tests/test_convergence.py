@@ -9,8 +9,14 @@ from ensemble.model.workspace import NDIAG, UNLIMITED, Workspace
 from .conftest import developed_state, next_event
 
 
-def test_event_slip_converges_with_order_at_least_3():
-    """From a fixed pre-event state of a developed chain, halving dt cuts the slip error 2^p-fold, p >= 3."""
+def test_event_slip_converges_with_order_4():
+    """From a fixed pre-event state of a developed chain, halving dt cuts the slip error 2^p-fold, p ~ 4.
+
+    RK4 with every stick and onset located on the step's Hermite interpolant (event.py) keeps
+    its fourth order: measured p = 4.04 .. 4.13 (slip and profile, three events). The bound 3.5
+    fails for a method or a transition location of order 3 (p ~ 3) as well as for clamping v
+    at step ends (order 2).
+    """
     model = Model(N=50, b=20.0)
     force, psi = developed_state(model, 300)
     dts = [1e-3, 5e-4, 2.5e-4]   # 2e-3 is beyond RK4 stability for some events at b = 20
@@ -25,8 +31,8 @@ def test_event_slip_converges_with_order_at_least_3():
         force, psi = events[-1].force, events[-1].psi
     print("measured orders (slip, profile):", orders)
     for slip_order, profile_order in orders:
-        assert np.all(slip_order >= 3.0)
-        assert np.all(profile_order >= 3.0)
+        assert np.all(slip_order >= 3.5)
+        assert np.all(profile_order >= 3.5)
 
 
 def test_clock_offset_does_not_change_events():
@@ -46,5 +52,8 @@ def test_clock_offset_does_not_change_events():
         out.append((t - start, epi, diag))
     np.testing.assert_array_equal(out[0][2], out[1][2])
     np.testing.assert_array_equal(out[0][1], out[1][1])
+    print(f"recurrence intervals at 1e15 against 0: largest difference "
+          f"{np.max(np.abs(np.diff(out[0][0]) - np.diff(out[1][0]))):.3f}")
     # onset times keep their spacing: the recurrence intervals agree to float64 resolution at 1e15
+    # (one ulp is 0.125 there): measured 0.093
     np.testing.assert_allclose(np.diff(out[0][0]), np.diff(out[1][0]), atol=0.5)

@@ -4,6 +4,12 @@ Every case runs with fixed-step RK4 (the paper's method, which needs its step ch
 b = 100 slips at v ~ 7000, beyond RK4's stability limit dt * v < 2.785 at dt = 1e-3, so it
 runs at dt = 2e-4) and with each adaptive method at its default tolerances and no per-case
 tuning. The full sizes (N = 800, 6400) are benchmarks/hard_cases.py.
+
+The two c cases cannot fail for a kernel bug that the other cases would not show: c never
+reaches the kernels (the c-free frame removes it exactly; kernel_args does not pass it, and the
+initial state does not depend on it), so "c = 1e2" and "c = 1e6" run bit-identical events (as
+the printed numbers show). They stay as a guard that c keeps out of the kernels; the kernel's
+physics with c is checked against references that keep c (test_physics.py, test_sequences.py).
 """
 import numpy as np
 import pytest
@@ -22,7 +28,7 @@ METHODS = ["rk4", *ADAPTIVE]
 CASES = {
     "very fast slip b = 100": (Model(N=100, b=100.0), 2e-4, 40),
     "strong strengthening a = 30": (Model(N=60, a=30.0), 1e-3, 8),
-    "c = 1e2": (Model(N=100, c=1e2), 1e-3, 40),
+    "c = 1e2": (Model(N=100, c=1e2), 1e-3, 40),    # identical events: c never reaches the kernel
     "c = 1e6": (Model(N=100, c=1e6), 1e-3, 40),
     "nu = 1e-6": (Model(N=100, nu=1e-6), 1e-3, 40),
     "nu = 1e-10": (Model(N=100, nu=1e-10), 1e-3, 40),
@@ -36,13 +42,20 @@ def integrator(method, rk4_dt=1e-3):
 
 
 def residual_bounds(method):
-    """(max, median) relative energy residual: RK4 at these steps is exact to round-off; an adaptive
-    method follows its tolerance (median ~0.2 rtol measured), with rare outliers where the friction
-    work is a small difference of large terms (max 2.5e-4 = 250 rtol once in 2800 events at N = 100)."""
+    """(max, median) relative energy residual over a case's events.
+
+    RK4 at these steps conserves energy to round-off: measured max 4.8e-12 (a = 30; 5.1e-12 in
+    the slow run past 1e16), largest median 3.5e-12. An adaptive method follows its tolerance:
+    largest median measured 0.077 rtol (ark4, N = 6400), largest max 0.26 rtol here (ark3,
+    b = 100; 0.15 rtol in the slow run), with rare outliers elsewhere where the friction work
+    is a small difference of large terms (2.5e-4 = 250 rtol once in 2800 events at N = 100,
+    benchmarks/hard_cases.py): hence the max bound 1000 rtol, and the median bound 1 rtol,
+    which is what sees a systematic error.
+    """
     if method == "rk4":
-        return 1e-8, 1e-10
+        return 1e-10, 1e-10
     rtol = Integrator().rtol
-    return 1000 * rtol, 10 * rtol
+    return 1000 * rtol, rtol
 
 
 def trajectory(model, integ):
@@ -88,9 +101,10 @@ def check_long_run(method, N, t_end, compare=5):
 
     Both continue from the same physical state (the restart has it brought to one time, which
     changes round-off only), so their first events agree up to chaotic growth of round-off:
-    ~10x per event from 1e-16, measured below 1e-9 after 5 events. A dependence on the absolute
-    time (e.g. a time since rest of ~1e-3 taken as a difference of two times near 1e15 in single
-    float64, resolution 0.125) would show here as errors of order 1.
+    measured at most 9e-15 past 1e15 (every method), 1e-8 past 1e16 (ark3; rk4 and ark4
+    2e-13). A dependence on the absolute time (e.g. a time since rest of ~1e-3 taken as a
+    difference of two times near 1e15 in single float64, resolution 0.125) would show here as
+    errors of order 1.
     """
     model = Model(N=N, nu=1e-10)        # ~ 5e12 time units per event: 1e15 after ~200 events
     traj = trajectory(model, integrator(method))
@@ -111,8 +125,8 @@ def check_long_run(method, N, t_end, compare=5):
     np.testing.assert_array_equal(epi_late, epi_reset)
     # A dependence on the absolute time would show as differences of order 1; what remains is
     # round-off of the restarted state, amplified by the chaotic dynamics (more so with adaptive
-    # steps, whose sequence changes discretely: ark4 measured 4e-6 by the 5th event).
-    assert rel_t.max() < 1e-3 and rel_slip.max() < 1e-3
+    # steps, whose sequence changes discretely): measured at most 1e-8 (above), bound 100x that.
+    assert rel_t.max() < 1e-6 and rel_slip.max() < 1e-6
 
 
 @pytest.mark.parametrize("method", METHODS)

@@ -5,6 +5,8 @@ computed from a NaN (the onset tree used to descend into its padding) would writ
 work arrays silently. The last test runs the hard cases and the bad inputs in one subprocess
 compiled with bounds checks, in its own numba cache (the checked build must not replace the
 normal one).
+
+No tolerances: statuses and block indices are exact.
 """
 import json
 import math

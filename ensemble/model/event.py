@@ -32,10 +32,10 @@ from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
 from .steppers import ERROR_WEIGHTS, ark3_step, ark4_step, ark5_step, block_error, rk4_step
 from .tableaux import ARK324, ARK436, ARK548
 from .undo import clear_log, log_block
-from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ENERGY_SCALE, D_FIRST, D_LAST,
-                        D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK, EV_BLOCK_STEPS,
-                        EV_CUTS, EV_EPICENTER, EV_ERR_PREV, EV_FAR, EV_H_NEXT, EV_NA, EV_NT, EV_PHASE,
-                        EV_REJECTED, EV_SLIP_TIME, EV_STEPS, EV_T_FAR, EV_TAU, EV_TRACED, EV_VMAX,
+from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D_ENERGY_SCALE, D_FIRST,
+                        D_LAST, D_LOAD_WORK, D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK,
+                        EV_BLOCK_STEPS, EV_CUTS, EV_EPICENTER, EV_ERR_PREV, EV_FAR, EV_H_NEXT, EV_NA, EV_NT,
+                        EV_PHASE, EV_REJECTED, EV_SLIP_TIME, EV_STEPS, EV_T_FAR, EV_TAU, EV_TRACED, EV_VMAX,
                         EV_WORK, EV_YREST, F0, HD0, HD1, IN_EVENT, K1V, NEVENT, NONFINITE, NUNDO, OK,
                         P, P0, PAUSED, T_AGE, T_BLOCK, T_ERROR, T_H, T_OWN, T_PART, T_PSI, T_SLIDING,
                         T_TAU, T_V, TOO_LONG, TR, TS, UNLIMITED, UNSTABLE, V, V0, Y, Y0, YS)
@@ -522,6 +522,7 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, l2, nu, b, work
             stored += 0.5 * l2 * (y - W[i - 1, Y]) ** 2
         e_change += stored - y * W[i, F0]
         gross += stored + abs(y * W[i, F0])
+    elastic = e_change     # the terms apart (workspace.py): D_ELASTIC, D_LOAD_WORK
     e_change += -nu * tau * slip + nu * slip_time
     gross += nu * tau * slip + nu * slip_time
     diag[D_DURATION] = tau
@@ -532,6 +533,8 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, l2, nu, b, work
     diag[D_WORK] = work
     diag[D_RESIDUAL] = e_change + work
     diag[D_ENERGY_SCALE] = gross
+    diag[D_ELASTIC] = elastic
+    diag[D_LOAD_WORK] = nu * tau * slip - nu * slip_time
     # The touched blocks move to the end time (loading, state grown since they
     # stopped); their untouched neighbours stay at t0, which is just as valid.
     # Then the slip changes the forces (free ends: an end block has one spring).

@@ -25,6 +25,12 @@ duration tau, W_f = int sum(Phi v) dt the friction work, W_load the work of the 
 so residual = dE_elastic + W_f - W_load needs only the blocks that slipped. Its scale
 (D_ENERGY_SCALE) is the sum of the magnitudes of all these terms and of W_f: in the c-free frame
 W_f alone can nearly cancel (b psi changes sign while a block slides), so it is no scale.
+The terms are also kept apart, split where the force on a sliding block splits,
+F0 + nu t - y + l^2 lap y: D_ELASTIC = -sum(y F0) + sum(y^2)/2 + l^2 sum((dy)^2)/2 is the
+energy change from the slip with the driver held where it was at the onset, and
+D_LOAD_WORK = nu tau sum(y) - nu int_0^tau sum(y) dt = nu int_0^tau t sum(v) dt the work of the
+driver's advance since the onset on the sliding blocks; the rest of the two energy changes
+(the driver alone pulling every block) cancels. residual = D_ELASTIC + D_WORK - D_LOAD_WORK.
 """
 import numpy as np
 
@@ -44,8 +50,8 @@ NCOLS = LOGGED + 1
 
 # entries of the per-event diagnostics vector
 (D_DURATION, D_SLIP, D_FIRST, D_LAST, D_NSLIP, D_WORK, D_RESIDUAL, D_STEPS, D_VMAX,
- D_BLOCK_STEPS, D_REJECTED, D_CUTS, D_ENERGY_SCALE) = range(13)
-NDIAG = 13
+ D_BLOCK_STEPS, D_REJECTED, D_CUTS, D_ENERGY_SCALE, D_ELASTIC, D_LOAD_WORK) = range(15)
+NDIAG = 15
 
 # columns of the optional step trace of an event (one row per step tried, rejected ones included)
 (T_TAU, T_H, T_SLIDING, T_ERROR, T_BLOCK, T_PART, T_AGE, T_V, T_PSI, T_OWN) = range(10)
