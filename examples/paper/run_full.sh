@@ -3,6 +3,8 @@
 #   bash examples/paper/run_full.sh [RANKS] [PANEL ...]     (default 2 ranks; all panels)
 # A panel whose catalog is complete is skipped; one that was interrupted (a .partial is left) is continued
 # with `ensemble resume`, so the script can be stopped and started again at any time.
+# Each panel has its own root seed, so the points that panels share (b = 20, c = 1e3, N = 800 in fig1_b,
+# fig1_c and fig2) are independent trajectories that `analysis reduce` can pool.
 # Reduce and plot afterwards with examples/paper/reduce_full.sh.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
