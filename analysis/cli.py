@@ -1,26 +1,29 @@
 """python -m analysis reduce|plot|report ...
 
-reduce streams a catalog into per-task histograms (ranks split the tasks under
-mpirun and rank 0 merges them), then computes per parameter point the merged
-densities and summary numbers with bootstrap intervals and writes a summary.
+reduce streams one or more catalogs into per-task histograms (ranks split the tasks of all
+catalogs under mpirun and rank 0 merges them), pools the tasks of equal parameters (N, l, nu,
+a, b, c) into one point whichever catalog holds them, computes per point the merged densities
+and summary numbers with bootstrap intervals and writes a summary. The same trajectory (random
+stream and parameters) in two catalogs is refused; so is an unfinished run (a *.partial
+catalog, unfinished tasks) unless --partial is given.
 
 Exit codes: 0 done, 1 file error (missing, damaged or of the wrong kind: a summary or a
-config given for a catalog, ...), 2 bad options. Under mpirun an error on one rank aborts all.
+config given for a catalog, an unfinished run without --partial, ...), 2 bad options (and the
+same trajectory given twice). Under mpirun an error on one rank aborts all.
 """
 import argparse
 import os
 import sys
 
-import numpy as np
-
 from ensemble import filekind
 from ensemble.catalog import CatalogError
 
-from . import summary
+from . import merge, summary
 from .reduce import Options, parse_bins
 
 # errors that reduce's rank 0 finds before the work starts and every rank then raises alike
 # (ensemble.abort.on_root), with their exit codes; any other error on any rank aborts them all
+# (merge.MergeError is a ValueError: exit 2)
 COLLECTIVE = {ValueError: 2, CatalogError: 1, summary.SummaryError: 1, OSError: 1}
 
 
@@ -28,9 +31,13 @@ def _parser():
     p = argparse.ArgumentParser(prog="python -m analysis", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
-    r = sub.add_parser("reduce", help="catalog -> summary HDF5")
-    r.add_argument("catalog")
-    r.add_argument("-o", "--output", help="summary path (default: CATALOG with .summary.h5)")
+    r = sub.add_parser("reduce", help="catalog(s) -> summary HDF5")
+    r.add_argument("catalogs", nargs="+", metavar="catalog",
+                   help="event catalog(s); the tasks of equal parameters pool into one point")
+    r.add_argument("-o", "--output", help="summary path (default with one catalog: CATALOG with "
+                                          ".summary.h5; required with several)")
+    r.add_argument("--partial", action="store_true",
+                   help="reduce unfinished runs as far as written (the summary and report say so)")
     r.add_argument("--mu-bins", default="0:7:70", help="magnitude bins lo:hi:n (default 0:7:70)")
     r.add_argument("--tnu-bins", default="0:2000:80", help="T*nu bins lo:hi:n (default 0:2000:80)")
     r.add_argument("--mu-c", type=float, default=4.0, help="large-event magnitude (default 4)")
@@ -60,49 +67,71 @@ def _reduce(args):
     return run_guarded(comm, lambda: _reduce_on(comm, args), COLLECTIVE)
 
 
+def _default_output(catalogs):
+    if len(catalogs) > 1:
+        raise ValueError("reducing several catalogs into one summary: give its path with -o")
+    name = str(catalogs[0])
+    if name.endswith(".partial"):   # X.h5.partial -> X.partial.summary.h5, beside the final one's name
+        return name.removesuffix(".partial").removesuffix(".h5") + ".partial.summary.h5"
+    return name.removesuffix(".h5") + ".summary.h5"
+
+
 def _prepare(args):
-    """Options, output path, and the catalog's task table; every check before the work."""
-    from ensemble import catalog
+    """Options, output path, and the catalogs' task table (merge.Inputs); every check before the work."""
     opt = Options(parse_bins(args.mu_bins), parse_bins(args.tnu_bins), args.mu_c, args.window,
                   args.b_cut, args.bootstrap, args.level, args.blocks, args.seed)
     if not (0 < opt.level < 1) or opt.bootstrap < 1 or opt.blocks < 1 or opt.window < 0:
         raise ValueError("--level must be in (0, 1); --bootstrap, --blocks >= 1; --window >= 0")
-    out = args.output or str(args.catalog).removesuffix(".h5") + ".summary.h5"
-    filekind.require(args.catalog, "catalog", CatalogError)
+    out = args.output or _default_output(args.catalogs)
+    for path in args.catalogs:
+        filekind.require(path, "catalog", CatalogError)
     if os.path.exists(out):
         # checked now, not after the work; and --force replaces a summary, never anything else
         if not args.force:
             raise summary.SummaryError(f"{out}: summary exists (use --force to overwrite it)")
-        if os.path.samefile(out, args.catalog) or filekind.identify(out)[0] != "summary":
+        if (any(os.path.samefile(out, path) for path in args.catalogs)
+                or filekind.identify(out)[0] != "summary"):
             raise summary.SummaryError(f"{out} {filekind.describe(out)}; --force replaces only "
                                        "a reduction summary")
-    with filekind.reading(args.catalog, "the event catalog", CatalogError):
-        _, tasks, attrs = catalog.read_tasks(args.catalog)
-    return opt, out, tasks, attrs
+    return opt, out, merge.read(args.catalogs, allow_partial=args.partial)
+
+
+def _check_counts(inputs, per_task):
+    """Every rank reduced as many events as rank 0 read from the commit rows (a run still writing
+    the catalog could have committed more in between)."""
+    from .stats import N_EVENTS
+    for g, h in per_task.items():
+        if int(h.numbers[:, N_EVENTS].sum()) != int(inputs.tasks["events_written"][g]):
+            path = inputs.paths[inputs.tasks["catalog"][g]]
+            raise CatalogError(f"{path}: task {inputs.tasks['catalog_task'][g]}: its event count "
+                               "changed while it was reduced (is a run still writing it?)")
 
 
 def _reduce_on(comm, args):
     from ensemble.abort import abort_on_error, on_root
 
-    from .reduce import PARAMS, point_statistics, reduce_tasks
+    from .reduce import point_statistics
     rank, size = comm.Get_rank(), comm.Get_size()
-    opt, out, tasks, attrs = on_root(comm, lambda: _prepare(args), tuple(COLLECTIVE))
-    mine = [k for k in range(len(tasks["point"])) if k % size == rank]
+    opt, out, inputs = on_root(comm, lambda: _prepare(args), tuple(COLLECTIVE))
+    mine = [g for g in range(len(inputs.tasks["point"])) if g % size == rank]
     with abort_on_error(comm):   # rank 0 waits in gather for every other rank's part
-        parts = comm.gather(reduce_tasks(args.catalog, mine, opt), root=0)
+        parts = comm.gather(merge.reduce_share(inputs, mine, opt), root=0)
     if rank != 0:
         return 0
     per_task = {k: h for part in parts for k, h in part.items()}
+    _check_counts(inputs, per_task)
     points = []
-    for point in np.unique(tasks["point"]):
-        ids = [int(k) for k in np.flatnonzero(tasks["point"] == point)]
-        rng = np.random.default_rng(np.random.SeedSequence(opt.seed, spawn_key=(int(point),)))
-        result = point_statistics(per_task, ids, len(ids), opt, rng)
-        result["params"] = {name: tasks[name][ids[0]] for name in PARAMS}
+    for params, ids in inputs.points:
+        result = point_statistics(per_task, ids, len(ids), opt, merge.bootstrap_rng(opt.seed, params))
+        result["params"] = params
         points.append(result)
-    summary.write(out, args.catalog, attrs, tasks, per_task, points, opt, force=args.force)
+    summary.write(out, inputs, per_task, points, opt, force=args.force)
+    if inputs.partial:
+        print(inputs.partial)
     methods = sorted({p["method"] for p in points})
-    print(f"wrote {out}: {len(points)} parameter points, {len(per_task)} tasks; intervals from "
+    print(f"wrote {out}: {len(points)} parameter points, {len(per_task)} tasks"
+          + (f" from {len(inputs.paths)} catalogs" if len(inputs.paths) > 1 else "")
+          + "; intervals from "
           f"{opt.bootstrap} bootstrap resamples over {' / '.join(methods)}"
           + (" (one seed per point: block bootstrap over stretches of the trajectory)"
              if "blocks" in methods else ""))

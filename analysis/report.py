@@ -33,9 +33,16 @@ def _fmt(est, lo, hi):
     return f"{est:.4g}"
 
 
+def partial_text(s):
+    """The statement of a partial reduction ("" for a complete one; summaries before format 2 were)."""
+    return str(s["attrs"].get("partial", ""))
+
+
 def table(s):
+    """The report; a partial reduction says so on its first line."""
     a = s["attrs"]
-    lines = [f"summary of {a['catalog']}: mu_c = {a['mu_c']}, window = {a['window']} blocks, "
+    lines = [partial_text(s)] if partial_text(s) else []
+    lines += [f"summary of {a['catalog']}: mu_c = {a['mu_c']}, window = {a['window']} blocks, "
              f"b-value above mu = {a['b_cut']}, {level_text(a['level'])} intervals from "
              f"{a['bootstrap']} bootstrap resamples", ""]
     for i in range(len(s["points/N"])):

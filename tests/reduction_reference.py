@@ -17,19 +17,30 @@ here the slow and obvious way, from the raw events:
 - the KS distance compares, at the upper edge of each bin lying at or above the cut, the share
   of the binned magnitudes (from the first such bin to the top edge) below that edge with the
   fitted law 1 - 10^(-b (edge - cut));
+- catalogs (one or more, in the order given) pool: tasks of exactly equal (N, l, nu, a, b, c)
+  form one point, points numbered by first appearance (catalog by catalog, task by task); a
+  task's stream is its recorded (seed_entropy, spawn_key), or (run.seed of its catalog's config,
+  its index) where nothing is recorded (-1: not finished); the tasks of a point are its
+  resampling units in the order of their streams;
 - resampling units: the tasks of a point if it has two or more, else the stretches of its one
   task; bootstrap resamples drawn as rng.integers(0, units, (bootstrap, units)) from
-  default_rng(SeedSequence(seed, spawn_key=(point,))), first for the numbers and curves, then
-  (if there is a peak and >= 2 units) for the peaks; intervals are the (1 - level) / 2 and
-  (1 + level) / 2 quantiles of the resampled values, NaNs left out (linear interpolation
-  between order statistics);
+  default_rng(SeedSequence(seed, spawn_key=(N, bits(l), bits(nu), bits(a), bits(b), bits(c))))
+  with bits(x) the binary64 pattern of x as an unsigned integer, first for the numbers and
+  curves, then (if there is a peak and >= 2 units) for the peaks; intervals are the
+  (1 - level) / 2 and (1 + level) / 2 quantiles of the resampled values, NaNs left out (linear
+  interpolation between order statistics);
 - peaks: PEAK_RULE below, a plain transcription of the rule documented in stats.find_peaks;
-  each peak's interval from the nearest peak of every resample within PEAK_RULE["match_bins"].
+  each peak's interval from the nearest peak of every resample within PEAK_RULE["match_bins"];
+- a reduction is partial if a catalog's name ends in .partial or one of its tasks is not
+  finished (status 1) or holds fewer than events_per_task events; the summary then states the
+  events reduced of those expected and names those catalogs.
 
-expected_summary(events, tasks, opt) gives every dataset of the summary; check_summary compares
+expected_summary(catalogs, opt) gives every dataset of the summary; check_summary compares
 a summary file with it, key by key (a key it does not know fails: new outputs need a check).
 """
 import math
+import struct
+import tomllib
 
 import h5py
 import numpy as np
@@ -238,7 +249,12 @@ def _pool(units, pick):
     return tuple(np.concatenate([units[p][c] for p in pick]) for c in range(3))
 
 
-def point(tasks, point_index, opt):
+def bits(x):
+    """The IEEE-754 binary64 pattern of x as an unsigned integer."""
+    return struct.unpack("<Q", struct.pack("<d", float(x)))[0]
+
+
+def point(tasks, params, opt):
     """Estimates, intervals, peaks, method and unit count of one parameter point."""
     if len(tasks) >= 2:
         units, method = [t.unit() for t in tasks], "seeds"
@@ -246,7 +262,8 @@ def point(tasks, point_index, opt):
         units, method = [tasks[0].unit(s) for s in range(opt["blocks"])], "blocks"
     m = len(units)
     curves, numbers = statistics(*_pool(units, range(m)), opt)
-    rng = np.random.default_rng(np.random.SeedSequence(opt["seed"], spawn_key=(point_index,)))
+    key = (int(params["N"]),) + tuple(bits(params[name]) for name in PARAMS[1:])
+    rng = np.random.default_rng(np.random.SeedSequence(opt["seed"], spawn_key=key))
     q = 50.0 * (1.0 - opt["level"])
     out = {"method": method, "units": m, "curves": {}, "numbers": {}}
     if m >= 2:
@@ -297,25 +314,79 @@ def _peaks(units, m, opt, rng, q):
     return rows, tied
 
 
-def expected_summary(events, tasks, opt):
-    """What the summary of a catalog must hold: {summary key: array}, plus 'tied' (peak ties met).
+def _catalog_facts(path):
+    """(run.seed of the stored config, events_per_task) of a catalog, read with h5py and tomllib."""
+    with h5py.File(path, "r", locking=False) as h5:
+        config = tomllib.loads(h5.attrs["config"])
+        return int(config.get("run", {}).get("seed", 0)), int(h5.attrs["events_per_task"])
 
-    events: dict of columns of every committed event (catalog.read); tasks: the task table.
+
+def expected_tasks(catalogs):
+    """The summary's /tasks table of `catalogs` [(path, events, tasks)] and its points:
+    (table, [(params, rows in stream order)])."""
+    table = {}
+    for c, (path, _, tasks) in enumerate(catalogs):
+        seed, _ = _catalog_facts(path)
+        n = len(tasks["point"])
+        part = {name: np.asarray(values).copy() for name, values in tasks.items()}
+        for k in range(n):
+            if part["seed_entropy"][k] < 0 or part["spawn_key"][k] < 0:
+                part["seed_entropy"][k], part["spawn_key"][k] = seed, k
+        part["catalog"] = np.full(n, c, dtype=np.int64)
+        part["catalog_task"] = np.arange(n, dtype=np.int64)
+        part["catalog_point"] = part["point"].copy()
+        for name, values in part.items():
+            table.setdefault(name, []).append(values)
+    table = {name: np.concatenate(parts) for name, parts in table.items()}
+    keys = []
+    for g in range(len(table["point"])):
+        key = tuple(table[name][g].item() for name in PARAMS)
+        if key not in keys:
+            keys.append(key)
+        table["point"][g] = keys.index(key)
+    points = []
+    for i, key in enumerate(keys):
+        rows = [g for g in range(len(table["point"])) if table["point"][g] == i]
+        rows.sort(key=lambda g: (table["seed_entropy"][g], table["spawn_key"][g]))
+        points.append((dict(zip(PARAMS, key)), rows))
+    return table, points
+
+
+def expected_partial(catalogs):
+    """(events reduced, events expected, paths of the unfinished catalogs)."""
+    written = expected = 0
+    unfinished = []
+    for path, _, tasks in catalogs:
+        _, per_task = _catalog_facts(path)
+        written += int(sum(tasks["events_written"]))
+        expected += len(tasks["point"]) * per_task
+        if (str(path).endswith(".partial") or any(s != 1 for s in tasks["status"])
+                or any(w < per_task for w in tasks["events_written"])):
+            unfinished.append(str(path))
+    return written, expected, unfinished
+
+
+def expected_summary(catalogs, opt):
+    """What the summary of `catalogs` must hold: {summary key: array}, plus 'tied' (peak ties
+    met), 'tasks' (the /tasks table), 'partial' (expected_partial) and 'raw' (per-task data).
+
+    catalogs: [(path, events, tasks)] in the order given to reduce; events: dict of columns of
+    every committed event of the catalog (catalog.read), tasks: its task table.
     opt: mu_edges, tnu_edges, mu_c, window, b_cut, bootstrap, level, blocks, seed.
     """
-    n_tasks = len(tasks["point"])
-    per_task = [Task({c: events[c][events["task"] == k] for c in ("t", "mu", "epicenter", "boundary")},
-                     float(tasks["nu"][k]), opt) for k in range(n_tasks)]
+    table, points = expected_tasks(catalogs)
+    per_task = []
+    for path, events, tasks in catalogs:
+        per_task += [Task({c: events[c][events["task"] == k] for c in ("t", "mu", "epicenter", "boundary")},
+                          float(tasks["nu"][k]), opt) for k in range(len(tasks["point"]))]
     exp = {"bins/mu": opt["mu_edges"], "bins/tnu": opt["tnu_edges"]}
     stacks = [t.per_stretch(opt) for t in per_task]
     for j, name in enumerate(("mu", "tnu", "tnu_interior", "numbers")):
         exp[f"per_task/{name}"] = np.stack([s[j] for s in stacks])
-    points = sorted(set(int(p) for p in tasks["point"]))
     results = []
-    for p in points:
-        ids = [k for k in range(n_tasks) if tasks["point"][k] == p]
-        r = point([per_task[k] for k in ids], p, opt)
-        r["params"] = {name: tasks[name][ids[0]] for name in PARAMS}
+    for params, rows in points:
+        r = point([per_task[g] for g in rows], params, opt)
+        r["params"] = params
         results.append(r)
     for name in PARAMS:
         exp[f"points/{name}"] = np.array([r["params"][name] for r in results])
@@ -333,6 +404,9 @@ def expected_summary(events, tasks, opt):
             peaks[i, :len(r["peaks"])] = r["peaks"]
     exp["points/peaks"] = peaks
     exp["tied"] = any(r["tied"] for r in results)
+    exp["tasks"] = table
+    exp["partial"] = expected_partial(catalogs)
+    exp["paths"] = [str(path) for path, _, _ in catalogs]
     exp["raw"] = per_task      # for the tests' preconditions (what the catalog exercises)
     return exp
 
@@ -359,8 +433,9 @@ def read_summary(path):
 RTOL = 1e-12
 
 
-def check_summary(s, expected, tasks, opt, catalog_path):
+def check_summary(s, expected, opt):
     """Every dataset and attribute of summary `s` (read_summary) against expected_summary."""
+    tasks = expected["tasks"]
     tasks_keys = {f"tasks/{k}" for k in tasks}
     numbers = {f"points/numbers/{n}" for n in NUMBERS}
     curves = {f"points/{c}_{x}" for c in ("mu", "tnu", "tnu_interior") for x in ("density", "lo", "hi")}
@@ -372,9 +447,20 @@ def check_summary(s, expected, tasks, opt, catalog_path):
     a = s["attrs"]
     for key in ("mu_c", "window", "b_cut", "bootstrap", "level", "blocks", "seed"):
         assert a[key] == opt[key], key
-    assert a["catalog"] == str(catalog_path) and a["format"].startswith("bk-summary-")
-    with h5py.File(catalog_path, "r") as h5:
-        assert a["config"] == h5.attrs["config"]
+    paths = expected["paths"]
+    assert a["format"].startswith("bk-summary-")
+    configs = []
+    for path in paths:
+        with h5py.File(path, "r", locking=False) as h5:
+            configs.append(h5.attrs["config"])
+    assert list(a["catalogs"]) == paths and list(a["configs"]) == configs
+    if len(paths) == 1:
+        assert a["catalog"] == paths[0] and a["config"] == configs[0]
+    else:
+        assert "config" not in a
+        assert a["catalog"] == (", ".join(paths) if len(paths) <= 3
+                                else f"{paths[0]} ... {paths[-1]} ({len(paths)} catalogs)")
+    check_partial(a["partial"], expected["partial"], paths)
     for k, v in tasks.items():
         got = s[f"tasks/{k}"]
         want = np.char.encode(v) if v.dtype.kind == "U" else v
@@ -396,3 +482,15 @@ def check_summary(s, expected, tasks, opt, catalog_path):
     assert s["points/peaks"].shape == expected["points/peaks"].shape
     np.testing.assert_array_equal(s["points/peaks"][..., 0], expected["points/peaks"][..., 0])
     np.testing.assert_allclose(s["points/peaks"], expected["points/peaks"], rtol=RTOL, atol=0, err_msg="peaks")
+
+
+def check_partial(statement, partial, paths):
+    """The `partial` attribute: empty for finished runs; else it gives the events reduced of
+    those expected and names exactly the unfinished catalogs."""
+    written, expected, unfinished = partial
+    if not unfinished:
+        assert statement == ""
+        return
+    assert statement.startswith("PARTIAL") and f" {written} of {expected} events" in statement
+    for path in paths:
+        assert (f"{path} (" in statement) == (path in unfinished), (path, statement)

@@ -1,4 +1,6 @@
-"""Reduction: merged histograms, recurrence times, bootstrap coverage, b-value, serial vs MPI."""
+"""Reduction: merged histograms, recurrence times, bootstrap coverage, b-value, serial vs MPI;
+several catalogs reduced together."""
+import dataclasses
 import shutil
 import subprocess
 import sys
@@ -9,8 +11,10 @@ import pytest
 from analysis import stats, summary
 from analysis.recurrence import RecurrenceScanner
 from ensemble import catalog
+from ensemble.config import loads
 
 from . import reduction_reference as ref
+from .catalog_writer import write_events
 from .conftest import run_cli, write_config
 
 
@@ -72,9 +76,9 @@ def test_real_summary_equals_brute_force(reduced):
     events, tasks, _ = catalog.read(reduced / "cat.h5")
     opt = {"mu_edges": np.linspace(0, 7, 71), "tnu_edges": np.linspace(0, 2000, 81), "mu_c": 3.5,
            "window": 10, "b_cut": 3.0, "bootstrap": 200, "level": 0.95, "blocks": 20, "seed": 0}
-    expected = ref.expected_summary(events, tasks, opt)
+    expected = ref.expected_summary([(reduced / "cat.h5", events, tasks)], opt)
     assert expected["points/numbers/n_recurrences"][:, 0].min() > 10
-    ref.check_summary(ref.read_summary(reduced / "sum.h5"), expected, tasks, opt, reduced / "cat.h5")
+    ref.check_summary(ref.read_summary(reduced / "sum.h5"), expected, opt)
 
 
 @pytest.mark.parametrize("chunk", [1, 7, 10000])
@@ -171,3 +175,91 @@ def test_serial_and_mpi_reduction_agree(reduced):
     for key in a:
         if key != "attrs":
             np.testing.assert_array_equal(a[key], b[key], err_msg=key)
+
+
+# -- several catalogs ----------------------------------------------------------------------
+
+# The catalogs A and B hold exactly the four trajectories of the real catalog cat.h5 (b = 20, 30
+# x 2 seeds, root seed 0: task k has the stream (0, k)). The runner cannot write them: a run's
+# tasks are numbered from 0, so two runs with one root seed both hold stream (0, 0), and runs with
+# two root seeds cannot be one catalog. So they are written through the catalog writer from the
+# real run's events, each task with the stream (provenance) of the task it comes from: A from a
+# sweep b = [20, 30] with one seed (tasks 0 and 3 of cat.h5), B from b = [30, 20] (tasks 2 and 1).
+SPLIT = {"A": ((20.0, 30.0), (0, 3)), "B": ((30.0, 20.0), (2, 1))}
+# level 0.5: with two units per point a 95% interval spans the two units' values whatever the
+# resamples; quartiles depend on the resamples, so the comparisons see the order of the units
+# and the bootstrap's stream
+REDUCE_OPTIONS = ("--bootstrap", "200", "--mu-c", "3.5", "--level", "0.5")
+
+
+@pytest.fixture(scope="module")
+def merged(reduced):
+    events, tasks, attrs = catalog.read(reduced / "cat.h5")
+    cfg = loads(attrs["config"])
+    for name, (b_values, source) in SPLIT.items():
+        text = dataclasses.replace(cfg, sweep=(("b", b_values),),
+                                   run=dataclasses.replace(cfg.run, seeds=1)).to_toml()
+        parts = []
+        for k, task in enumerate(source):
+            assert tasks["b"][task] == b_values[k]
+            mine = events["task"] == task
+            parts.append({c: np.full(mine.sum(), k) if c == "task" else events[c][mine] for c in events})
+        write_events(reduced / f"{name}.h5", text, parts, [(0, task) for task in source])
+    for names, paths in (("whole", ["cat.h5"]), ("AB", ["A.h5", "B.h5"]), ("BA", ["B.h5", "A.h5"])):
+        res = run_analysis("reduce", *(reduced / p for p in paths), "-o", reduced / f"{names}.summary.h5",
+                           *REDUCE_OPTIONS)
+        assert res.returncode == 0, res.stderr
+    return reduced
+
+
+def test_merged_catalogs_equal_one_catalog_of_both(merged):
+    """Every curve, number, interval and peak of each point, and every per-task array and task
+    column of each trajectory: A + B (and B + A, whose points come in the other order) equal the
+    catalog that holds all four."""
+    whole = summary.read(merged / "whole.summary.h5")
+    keys = [k for k in whole if k.startswith("points/")]
+    assert len(keys) > 20
+    for names in ("AB", "BA"):
+        s = summary.read(merged / f"{names}.summary.h5")
+        assert sorted(s) == sorted(whole)
+        first = SPLIT[names[0]][0][0]
+        assert list(s["points/b"]) == [first, 50.0 - first]     # first appearance
+        for i, b in enumerate(whole["points/b"]):
+            j = int(np.flatnonzero(s["points/b"] == b)[0])
+            for key in keys:
+                np.testing.assert_array_equal(s[key][j], whole[key][i], err_msg=f"{names} {key}")
+        assert list(s["attrs"]["catalogs"]) == [str(merged / f"{n}.h5") for n in names]
+        assert list(s["tasks/catalog"]) == [0, 0, 1, 1] and list(s["tasks/catalog_task"]) == [0, 1, 0, 1]
+        for r in range(4):
+            q = int(np.flatnonzero((whole["tasks/spawn_key"] == s["tasks/spawn_key"][r])
+                                   & (whole["tasks/b"] == s["tasks/b"][r]))[0])
+            for key in ("per_task/mu", "per_task/tnu", "per_task/tnu_interior", "per_task/numbers"):
+                np.testing.assert_array_equal(s[key][r], whole[key][q], err_msg=f"{names} {key}")
+            for key in ("N", "l", "nu", "a", "b", "c", "events_written", "events_done", "status", "seed_entropy"):
+                assert s[f"tasks/{key}"][r] == whole[f"tasks/{key}"][q], key
+            assert s["points/b"][s["tasks/point"][r]] == whole["points/b"][whole["tasks/point"][q]]
+
+
+def test_merged_summary_equals_brute_force(merged):
+    """The merged summary against the reference (pooling, task order and bootstrap streams as
+    documented), from the catalogs' own events."""
+    inputs = [(merged / f"{n}.h5", *catalog.read(merged / f"{n}.h5")[:2]) for n in "AB"]
+    opt = {"mu_edges": np.linspace(0, 7, 71), "tnu_edges": np.linspace(0, 2000, 81), "mu_c": 3.5,
+           "window": 10, "b_cut": 3.0, "bootstrap": 200, "level": 0.5, "blocks": 20, "seed": 0}
+    expected = ref.expected_summary(inputs, opt)
+    assert list(expected["points/units"]) == [2, 2]
+    ref.check_summary(ref.read_summary(merged / "AB.summary.h5"), expected, opt)
+
+
+def test_merging_a_catalog_with_itself_or_its_trajectories_is_refused(merged):
+    for paths, words in (((merged / "A.h5", merged / "cat.h5"),
+                          f"{merged / 'A.h5'} task 0 and {merged / 'cat.h5'} task 0 are the same trajectory"),
+                         ((merged / "cat.h5", merged / "B.h5"),
+                          f"{merged / 'cat.h5'} task 1 and {merged / 'B.h5'} task 1 are the same trajectory"),
+                         ((merged / "A.h5", merged / "A.h5"), f"{merged / 'A.h5'} is given twice")):
+        res = run_analysis("reduce", *paths, "-o", merged / "dup.summary.h5")
+        assert res.returncode == 2 and len(res.stderr.strip().splitlines()) == 1, res.stderr
+        assert res.stderr.startswith(f"error: {words}")
+        assert not (merged / "dup.summary.h5").exists()
+    res = run_analysis("reduce", merged / "A.h5", merged / "B.h5")
+    assert res.returncode == 2 and "give its path with -o" in res.stderr

@@ -10,7 +10,6 @@ shares no code with analysis/. Intervals: the summary's equal the documented per
 the same bootstrap resamples, and the percentile interval has its nominal coverage, tightly
 enough to tell 95% from 97.5%.
 """
-import itertools
 import math
 import os
 import re
@@ -25,10 +24,10 @@ import pytest
 from analysis import stats
 from ensemble import catalog
 from ensemble.config import loads
-from ensemble.runner import integrator_text
 from ensemble.tasks import task_list
 
 from . import reduction_reference as ref
+from .catalog_writer import write_events
 
 ROOT = Path(__file__).resolve().parents[1]
 TIMEOUT = 300   # seconds for one reduction subprocess (they take a few)
@@ -45,9 +44,12 @@ REDUCE = ("import sys; from functools import partial; from analysis import cli, 
           "cli.Options = partial(reduce.Options, chunk=int(sys.argv[1])); sys.exit(cli.main(sys.argv[2:]))")
 
 
-def reduce_command(chunk, path, out, level, blocks):
+def reduce_command(chunk, paths, out, level, blocks):
+    """The reduction of one catalog (a path) or several (a list), with --partial: the synthetic
+    catalogs hold unfinished tasks."""
     o = OPT
-    return [sys.executable, "-c", REDUCE, str(chunk), "reduce", str(path), "-o", str(out),
+    paths = [str(p) for p in paths] if isinstance(paths, (list, tuple)) else [str(paths)]
+    return [sys.executable, "-c", REDUCE, str(chunk), "reduce", *paths, "-o", str(out), "--partial",
             "--mu-bins={}:{}:{}".format(*o["mu_bins"]), "--tnu-bins={}:{}:{}".format(*o["tnu_bins"]),
             "--mu-c", str(o["mu_c"]), "--window", str(o["window"]), "--b-cut", str(o["b_cut"]),
             "--bootstrap", str(o["bootstrap"]), "--seed", str(o["seed"]), "--level", str(level),
@@ -99,33 +101,14 @@ def synthetic_events(rng, task, n, gridded):
 
 
 def write_catalog(path, config_text, written, seed):
-    """A catalog through the project's writer: task k gets written[k] events, committed in
-    batches of varying size; tasks with all their events are finished, the others left open
+    """A catalog through the project's writer (catalog_writer.write_events): task k gets
+    written[k] synthetic events; tasks with all their events are finished, the others left open
     (an empty task never committed). Returns the events (dict of columns, tasks in order)."""
-    from mpi4py import MPI
-    cfg = loads(config_text)
-    tasks = task_list(cfg)
+    tasks = task_list(loads(config_text))
     assert len(tasks) == len(written)
     rng = np.random.default_rng(seed)
-    writer = catalog.Rank0Writer(str(path), MPI.COMM_SELF, cfg, tasks, integrator_text(cfg.integrator))
-    parts = []
-    for task in tasks:
-        n = written[task.index]
-        ev = synthetic_events(rng, task.index, n, gridded=task.index % 2 == 0)
-        parts.append(ev)
-        writer.record(task.index)
-        start, sizes = 0, itertools.cycle(np.roll([1, 57, 100, 13], task.index))
-        N = task.model.N
-        while start < n:
-            size = min(int(next(sizes)), n - start)
-            state = catalog.Checkpoint(np.zeros(N), np.zeros(N), np.zeros((N, 2)), np.zeros(2),
-                                       cfg.run.transient + start + size)
-            writer.commit(task.index, start, {c: v[start:start + size] for c, v in ev.items()}, state)
-            start += size
-        if n == cfg.run.events:
-            writer.finish(task.index, {"rank": 0, "wall_time": 1.0, "events_per_second": 1.0,
-                                       "seed_entropy": 0, "spawn_key": task.index})
-    writer.close()
+    parts = [synthetic_events(rng, t.index, written[t.index], gridded=t.index % 2 == 0) for t in tasks]
+    write_events(path, config_text, parts)
     return {c: np.concatenate([p[c] for p in parts]) for c in catalog.EVENT_FIELDS}
 
 
@@ -138,6 +121,7 @@ N = {N}
 seeds = {seeds}
 events = 400
 transient = 5
+seed = {seed}
 """
 # four points x three seeds: an empty task (never committed), a partly written one, a tiny one
 SEEDS_WRITTEN = [400, 400, 400, 400, 0, 250, 400, 400, 3, 400, 137, 400]
@@ -145,18 +129,25 @@ SEEDS_WRITTEN = [400, 400, 400, 400, 0, 250, 400, 400, 3, 400, 137, 400]
 BLOCKS_WRITTEN = [400, 5, 0]
 # two points x two seeds (the fewest that resample seeds), one of them empty
 PAIRS_WRITTEN = [400, 220, 0, 400]
+# merged with "seeds" (another root seed): point nu = 1 pools with the first point of "seeds"
+MORE_WRITTEN = [400, 90, 400, 400]
+# every task finished (a complete run)
+WHOLE_WRITTEN = [400, 400]
 
 
 @pytest.fixture(scope="module")
 def catalogs(tmp_path_factory):
     d = tmp_path_factory.mktemp("reduction")
     made = {}
-    for name, sweep, seeds, written in (
-            ("seeds", "nu = [1.0, 0.5]\nb = [20.0, 30.0]", 3, SEEDS_WRITTEN),
-            ("blocks", "nu = [2.0, 1.0, 0.5]", 1, BLOCKS_WRITTEN),
-            ("pairs", "nu = [1.0, 2.0]", 2, PAIRS_WRITTEN)):
+    for name, sweep, seeds, root, written in (
+            ("seeds", "nu = [1.0, 0.5]\nb = [20.0, 30.0]", 3, 0, SEEDS_WRITTEN),
+            ("blocks", "nu = [2.0, 1.0, 0.5]", 1, 0, BLOCKS_WRITTEN),
+            ("pairs", "nu = [1.0, 2.0]", 2, 0, PAIRS_WRITTEN),
+            ("more", "nu = [2.0, 1.0]", 2, 5, MORE_WRITTEN),
+            ("whole", "nu = [3.0]", 2, 7, WHOLE_WRITTEN)):
         path = d / f"{name}.h5"
-        events = write_catalog(path, CONFIG.format(N=N_CHAIN, sweep=sweep, seeds=seeds), written, seed=len(name))
+        events = write_catalog(path, CONFIG.format(N=N_CHAIN, sweep=sweep, seeds=seeds, seed=root), written,
+                               seed=len(name) + root)
         made[name] = (path, events)
     return d, made
 
@@ -179,7 +170,7 @@ def references(catalogs):
         for c in catalog.EVENT_FIELDS:     # the writer stored what was generated
             np.testing.assert_array_equal(got[c], events[c], err_msg=c)
         opt = options(level, blocks)
-        out[case] = (path, tasks, opt, ref.expected_summary(events, tasks, opt))
+        out[case] = (path, tasks, opt, ref.expected_summary([(path, events, tasks)], opt))
     return out
 
 
@@ -253,7 +244,7 @@ def summaries(catalogs, references):
 def test_summary_equals_brute_force(references, summaries, case, chunk):
     """The whole summary, reduced with the catalog streamed in chunks of `chunk` rows."""
     path, tasks, opt, exp = references[case]
-    ref.check_summary(ref.read_summary(summaries(case, chunk)), exp, tasks, opt, path)
+    ref.check_summary(ref.read_summary(summaries(case, chunk)), exp, opt)
 
 
 def test_report_states_every_number_and_the_level(references, summaries):
@@ -263,7 +254,9 @@ def test_report_states_every_number_and_the_level(references, summaries):
     _, _, opt, exp = references["blocks"]
     s = summary.read(summaries("blocks", 3))
     text = report.table(s)
-    assert "90% intervals from 200 bootstrap resamples" in text.splitlines()[0]
+    # the catalog holds unfinished tasks (reduced with --partial): the first line says so
+    assert text.splitlines()[0] == s["attrs"]["partial"] != ""
+    assert "90% intervals from 200 bootstrap resamples" in text.splitlines()[1]
     blocks = text.split("\npoint ")[1:]
     assert len(blocks) == 3
     number = r"-?\d+(?:\.\d*)?(?:e[-+]\d+)?|nan"
@@ -292,7 +285,7 @@ def test_report_states_every_number_and_the_level(references, summaries):
             same(part, row)
     for level, text in ((0.975, "97.5%"), (0.29, "29%"), (0.95, "95%")):
         s["attrs"]["level"] = level
-        assert f" {text} intervals" in report.table(s).splitlines()[0]
+        assert f" {text} intervals" in report.table(s).splitlines()[1]
 
 
 @pytest.mark.mpi
@@ -302,7 +295,140 @@ def test_mpi_summary_equals_brute_force(references, catalogs):
     path, tasks, opt, exp = references["seeds"]
     out = catalogs[0] / "seeds_mpi.summary.h5"
     run(["mpiexec", "-n", "2", *reduce_command(13, path, out, opt["level"], opt["blocks"])])
-    ref.check_summary(ref.read_summary(out), exp, tasks, opt, path)
+    ref.check_summary(ref.read_summary(out), exp, opt)
+
+
+# -- several catalogs, unfinished runs ---------------------------------------------------------
+
+def merged_reference(catalogs, names, level=0.9, blocks=5):
+    """(paths, opt, expected summary) of the named synthetic catalogs reduced together."""
+    _, made = catalogs
+    inputs = []
+    for name in names:
+        path, events = made[name]
+        inputs.append((path, events, catalog.read_tasks(path)[1]))
+    opt = options(level, blocks)
+    return [p for p, _, _ in inputs], opt, ref.expected_summary(inputs, opt)
+
+
+def run_status(cmd):
+    env = dict(os.environ, PYTHONPATH=str(ROOT),
+               NUMBA_CACHE_DIR=os.environ.get("NUMBA_CACHE_DIR", str(ROOT / ".numba_cache")))
+    return subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True, timeout=TIMEOUT)
+
+
+@pytest.fixture(scope="module")
+def merges(catalogs):
+    """merge_of(names): (path of the summary of the named catalogs reduced together, reduced once
+    in chunks of 13 rows; its options; its expected summary)."""
+    made = {}
+
+    def merge_of(names):
+        if names not in made:
+            paths, opt, exp = merged_reference(catalogs, names)
+            out = catalogs[0] / ("-".join(names) + ".summary.h5")
+            run(reduce_command(13, paths, out, opt["level"], opt["blocks"]))
+            made[names] = out, opt, exp
+        return made[names]
+    return merge_of
+
+
+@pytest.mark.parametrize("names", [("seeds", "more"), ("more", "seeds")])
+def test_merged_catalogs_equal_brute_force(merges, names):
+    """Two catalogs (root seeds 0 and 5) reduced together: point (nu = 1, b = 20) pools three
+    tasks of one with two of the other, the other points stand side by side in the order of
+    first appearance; every dataset against the reference, in both orders of the catalogs."""
+    out, opt, exp = merges(names)
+    pooled = [i for i in range(len(exp["points/nu"])) if exp["points/nu"][i] == 1.0 and exp["points/b"][i] == 20.0]
+    assert len(pooled) == 1 and exp["points/units"][pooled[0]] == 5 and len(exp["points/nu"]) == 5
+    ref.check_summary(ref.read_summary(out), exp, opt)
+
+
+def test_a_point_does_not_depend_on_the_order_of_the_catalogs(merges):
+    """The pooled point's tasks, streams, numbers, curves, intervals and peaks are the same
+    whichever catalog comes first (its units in stream order, its bootstrap keyed on its
+    parameters), though it is point 0 in one summary and point 1 in the other."""
+    one, two = (ref.read_summary(merges(names)[0]) for names in (("seeds", "more"), ("more", "seeds")))
+
+    def pooled(s):
+        return int(np.flatnonzero((s["points/nu"] == 1.0) & (s["points/b"] == 20.0))[0])
+    i, j = pooled(one), pooled(two)
+    assert (i, j) == (0, 1)
+    keys = [k for k in one if k.startswith("points/") and k not in ("points/method", "points/units")]
+    assert len(keys) > 20
+    for key in keys:
+        np.testing.assert_array_equal(one[key][i], two[key][j], err_msg=key)
+    streams = [sorted(zip(s["tasks/seed_entropy"][s["tasks/point"] == p], s["tasks/spawn_key"][s["tasks/point"] == p]))
+               for s, p in ((one, i), (two, j))]
+    assert streams[0] == streams[1] == [(0, 0), (0, 1), (0, 2), (5, 2), (5, 3)]
+
+
+@pytest.mark.mpi
+@pytest.mark.skipif(shutil.which("mpiexec") is None, reason="mpiexec not found")
+def test_mpi_merge_equals_brute_force(catalogs):
+    """Two ranks split the tasks of three catalogs (each rank reads tasks of every catalog);
+    points nu = 2 and nu = 1 pool a task of "blocks" with two of "more"."""
+    paths, opt, exp = merged_reference(catalogs, ("blocks", "more", "whole"), level=0.95, blocks=3)
+    assert list(exp["points/units"]) == [3, 3, 3, 2]
+    out = catalogs[0] / "three_mpi.summary.h5"
+    run(["mpiexec", "-n", "2", *reduce_command(29, paths, out, opt["level"], opt["blocks"])])
+    ref.check_summary(ref.read_summary(out), exp, opt)
+
+
+def test_the_same_trajectory_twice_is_refused(catalogs):
+    """"pairs" has the root seed of "seeds" and its point nu = 1, b = 20: tasks 0 and 1 of both are
+    the same trajectories. Refused before any work, one line naming both; so is a catalog given twice."""
+    d, made = catalogs
+    seeds, pairs = str(made["seeds"][0]), str(made["pairs"][0])
+    for paths, words in (([seeds, pairs], f"{seeds} task 0 and {pairs} task 0 are the same trajectory "
+                                         "(seed_entropy 0, spawn_key 0, N = 40, l = 3, nu = 1, a = 0, b = 20, "
+                                         "c = 1000): give each trajectory once"),
+                         ([seeds, f"{d}/./seeds.h5"], f"{d}/./seeds.h5 is given twice (also as {seeds}): "
+                                                      "give each catalog once")):
+        out = d / "refused.summary.h5"
+        res = run_status(reduce_command(64, paths, out, 0.95, 3))
+        lines = res.stderr.strip().splitlines()
+        assert res.returncode == 2 and lines == [f"error: {words}"], res.stderr
+        assert not out.exists() and not res.stdout
+
+
+def test_unfinished_runs_need_partial_and_say_so(catalogs):
+    """A catalog with unfinished tasks, or named *.partial, is refused (exit 1, one line) unless
+    --partial is given; then the summary's `partial` attribute (checked against the reference by
+    every test here) says how many events of how many and which catalogs, and so do the report's
+    first line. A complete run needs no --partial and says nothing."""
+    from analysis import report, summary
+    d, made = catalogs
+    whole = made["whole"][0]
+    named = shutil.copy(whole, d / "whole2.h5.partial")    # every task finished, name unfinished
+    for path, what in ((made["seeds"][0], "4 of 12 tasks unfinished"), (named, "named *.partial")):
+        cmd = [c for c in reduce_command(64, path, d / "x.summary.h5", 0.95, 3) if c != "--partial"]
+        res = run_status(cmd)
+        assert res.returncode == 1 and res.stderr.strip().splitlines() == [
+            f"error: {path} is an unfinished run ({what}); continue it with `python -m ensemble resume "
+            f"{str(path).removesuffix('.partial')}`, or reduce what it holds with --partial"], res.stderr
+        assert not (d / "x.summary.h5").exists()
+    # with --partial: both reduced as far as written; the statement names them
+    paths = [made["seeds"][0], named]
+    opt = options(0.9, 5)
+    exp = ref.expected_summary([(p, *catalog.read(p)[:2]) for p in paths], opt)
+    written, expected = sum(SEEDS_WRITTEN) + 2 * 400, 12 * 400 + 2 * 400
+    assert exp["partial"] == (written, expected, [str(p) for p in paths])
+    out = d / "partial.summary.h5"
+    res = run(reduce_command(64, paths, out, opt["level"], opt["blocks"]))
+    ref.check_summary(ref.read_summary(out), exp, opt)
+    s = summary.read(out)
+    statement = s["attrs"]["partial"]
+    head = f"PARTIAL reduction of unfinished runs: {written} of {expected} events ({100 * written / expected:.1f}%)"
+    assert statement == f"{head}; {paths[0]} (4 of 12 tasks unfinished), {named} (all tasks finished)"
+    assert res.stdout.splitlines()[0] == statement
+    assert report.table(s).splitlines()[0] == statement
+    # a complete run: no --partial needed, nothing said
+    out = d / "whole.summary.h5"
+    res = run_status([c for c in reduce_command(64, whole, out, 0.95, 3) if c != "--partial"])
+    assert res.returncode == 0, res.stderr
+    s = summary.read(out)
+    assert s["attrs"]["partial"] == "" and not report.table(s).startswith("PARTIAL")
 
 
 def test_peak_finder_follows_its_documented_rule():

@@ -1,0 +1,163 @@
+"""Catalogs -> the one task table a reduction works on: which tasks pool, in which order, and
+whether the input is complete.
+
+A trajectory is its random stream (seed_entropy, spawn_key) together with its parameters
+(N, l, nu, a, b, c). The runner records the stream of a task when the task finishes; for a task
+that has not finished it is the stream the runner uses, SeedSequence(run.seed of the catalog's
+config, spawn_key=(task index,)) (ensemble/tasks.py), and the summary stores it so.
+
+- Points. Tasks with exactly equal parameters pool into one parameter point, whichever catalog
+  they come from; points are numbered in the order of first appearance (catalogs in the order
+  given, tasks in catalog order).
+- Order inside a point. The tasks of a point are ordered by their stream, (seed_entropy,
+  spawn_key); these are the resampling units in that order. With `bootstrap_rng`, which depends
+  on the --seed and the point's parameters only, a point's numbers and intervals do not depend on
+  the order or grouping of the catalogs that hold its tasks, nor on the other points.
+- The same trajectory twice (two tasks of one point with the same stream) is refused.
+- Unfinished runs (a *.partial catalog, or tasks not finished or with fewer events than
+  events_per_task) are refused unless allowed; then `partial` says how much is missing.
+"""
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+from ensemble import catalog, filekind
+from ensemble.config import loads
+
+from .reduce import PARAMS, reduce_tasks
+
+
+class MergeError(ValueError):
+    """Catalogs that cannot be reduced together (the same trajectory twice); exit 2 like bad options."""
+
+
+@dataclass
+class Inputs:
+    """The catalogs of one reduction, as one task table.
+
+    tasks: the catalogs' task tables one after the other (catalog order), with
+      catalog, catalog_task   index of the task's catalog in `paths`, the task's index in it
+      catalog_point           the task's point in its catalog
+      point                   the task's point in the summary (index into `points`)
+      seed_entropy, spawn_key its stream (filled in for tasks that have not finished)
+    points: [(parameters {name: value}, [rows of `tasks` in stream order])], first appearance order
+    partial: "" for finished runs, else the one-line statement of what is missing
+    """
+    paths: list
+    configs: list
+    events_per_task: list
+    tasks: dict
+    points: list
+    partial: str
+
+
+def bootstrap_rng(seed, params):
+    """The bootstrap generator of the point with these parameters:
+    SeedSequence(seed, spawn_key=(N, bits(l), bits(nu), bits(a), bits(b), bits(c))), where bits(x)
+    is the IEEE-754 binary64 pattern of x as an unsigned integer."""
+    key = [int(params["N"])] + [int(np.float64(params[name]).view(np.uint64)) for name in PARAMS[1:]]
+    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=tuple(key)))
+
+
+def _streams(tasks, config_text):
+    """(seed_entropy, spawn_key) of every task, as recorded or as the runner will record them."""
+    entropy, key = tasks["seed_entropy"].copy(), tasks["spawn_key"].copy()
+    unrecorded = (entropy < 0) | (key < 0)
+    if unrecorded.any():
+        root = loads(config_text).run.seed
+        entropy[unrecorded] = root
+        key[unrecorded] = np.flatnonzero(unrecorded)
+    return entropy, key
+
+
+def _unfinished(path, tasks, per_task):
+    """Unfinished tasks of a catalog: (count, True if the file is a run's *.partial)."""
+    open_ = (tasks["status"] != catalog.FINISHED) | (tasks["events_written"] < per_task)
+    return int(np.count_nonzero(open_)), str(path).endswith(".partial")
+
+
+def read(paths, allow_partial=False):
+    """Inputs of the catalogs at `paths`; every check is made here, before any work."""
+    paths = [str(p) for p in paths]
+    for i, a in enumerate(paths):
+        filekind.require(a, "catalog", catalog.CatalogError)
+        for b in paths[:i]:
+            if os.path.samefile(a, b):
+                raise MergeError(f"{a} is given twice (also as {b}): give each catalog once")
+    tables, configs, per_tasks, unfinished = [], [], [], []
+    for path in paths:
+        with filekind.reading(path, "the event catalog", catalog.CatalogError):
+            per_task, tasks, attrs = catalog.read_tasks(path)
+        tasks["seed_entropy"], tasks["spawn_key"] = _streams(tasks, attrs["config"])
+        tables.append(tasks)
+        configs.append(str(attrs["config"]))
+        per_tasks.append(int(per_task))
+        unfinished.append(_unfinished(path, tasks, per_task))
+    partial = _partial_statement(paths, tables, per_tasks, unfinished)
+    if partial and not allow_partial:
+        path, tasks, (n_open, named) = next((p, t, u) for p, t, u in zip(paths, tables, unfinished)
+                                            if u[0] or u[1])
+        what = f"{n_open} of {len(tasks['point'])} tasks unfinished" if n_open else "named *.partial"
+        raise catalog.CatalogError(
+            f"{path} is an unfinished run ({what}); continue it with `python -m ensemble resume "
+            f"{path.removesuffix('.partial')}`, or reduce what it holds with --partial")
+    tasks = _concatenate(tables)
+    points = _points(paths, tasks)
+    return Inputs(paths, configs, per_tasks, tasks, points, partial)
+
+
+def _concatenate(tables):
+    out = {}
+    for name in tables[0]:
+        out[name] = np.concatenate([t[name] for t in tables])
+    out["catalog"] = np.concatenate([np.full(len(t["point"]), i, dtype=np.int64) for i, t in enumerate(tables)])
+    out["catalog_task"] = np.concatenate([np.arange(len(t["point"]), dtype=np.int64) for t in tables])
+    out["catalog_point"] = out["point"].copy()
+    return out
+
+
+def _points(paths, tasks):
+    """Pool the rows of `tasks` by exact parameters; set tasks["point"]; refuse repeated streams."""
+    where = {}
+    for g in range(len(tasks["point"])):
+        key = tuple(tasks[name][g].item() for name in PARAMS)
+        where.setdefault(key, []).append(g)
+    points = []
+    for i, (key, rows) in enumerate(where.items()):
+        rows.sort(key=lambda g: (int(tasks["seed_entropy"][g]), int(tasks["spawn_key"][g])))
+        for a, b in zip(rows, rows[1:]):
+            stream = (int(tasks["seed_entropy"][a]), int(tasks["spawn_key"][a]))
+            if stream == (int(tasks["seed_entropy"][b]), int(tasks["spawn_key"][b])):
+                def task(g):
+                    return f"{paths[tasks['catalog'][g]]} task {tasks['catalog_task'][g]}"
+                raise MergeError(
+                    f"{task(a)} and {task(b)} are the same trajectory (seed_entropy {stream[0]}, "
+                    f"spawn_key {stream[1]}, " + ", ".join(f"{n} = {v:g}" for n, v in zip(PARAMS, key))
+                    + "): give each trajectory once")
+        tasks["point"][rows] = i
+        points.append((dict(zip(PARAMS, key)), rows))
+    return points
+
+
+def _partial_statement(paths, tables, per_tasks, unfinished):
+    if not any(n or named for n, named in unfinished):
+        return ""
+    written = sum(int(t["events_written"].sum()) for t in tables)
+    expected = sum(len(t["point"]) * p for t, p in zip(tables, per_tasks))
+    share = f" ({100 * written / expected:.1f}%)" if expected else ""
+    which = [f"{p} ({n} of {len(t['point'])} tasks unfinished)" if n else f"{p} (all tasks finished)"
+             for p, t, (n, named) in zip(paths, tables, unfinished) if n or named]
+    return (f"PARTIAL reduction of unfinished runs: {written} of {expected} events{share}; "
+            + ", ".join(which))
+
+
+def reduce_share(inputs, rows, opt):
+    """TaskHistograms of the given rows of inputs.tasks (one rank's share), keyed by row."""
+    out = {}
+    for c, path in enumerate(inputs.paths):
+        mine = [g for g in rows if inputs.tasks["catalog"][g] == c]
+        if mine:
+            local = reduce_tasks(path, [int(inputs.tasks["catalog_task"][g]) for g in mine], opt)
+            out.update({g: local[int(inputs.tasks["catalog_task"][g])] for g in mine})
+    return out
