@@ -5,7 +5,8 @@ catalogs under mpirun and rank 0 merges them), pools the tasks of equal paramete
 a, b, c) into one point whichever catalog holds them, computes per point the merged densities
 and summary numbers with bootstrap intervals and writes a summary. The same trajectory (random
 stream and parameters) in two catalogs is refused; so is an unfinished run (a *.partial
-catalog, unfinished tasks) unless --partial is given.
+catalog, unfinished tasks) unless --partial is given. plot overlays the points of one or more
+summaries.
 
 Exit codes: 0 done, 1 file error (missing, damaged or of the wrong kind: a summary or a
 config given for a catalog, an unfinished run without --partial, ...), 2 bad options (and the
@@ -49,8 +50,8 @@ def _parser():
                    help="stretches per task, resampled when a point has one seed (default 20)")
     r.add_argument("--seed", type=int, default=0, help="seed of the bootstrap (default 0)")
     r.add_argument("--force", action="store_true", help="overwrite an existing summary")
-    pl = sub.add_parser("plot", help="summary -> figure")
-    pl.add_argument("summary")
+    pl = sub.add_parser("plot", help="summaries -> figure (their points overlaid)")
+    pl.add_argument("summaries", nargs="+", metavar="summary")
     pl.add_argument("--figure", choices=("magnitude", "recurrence"), required=True)
     pl.add_argument("-o", "--output", required=True, help="FILE.png or FILE.pdf")
     pl.add_argument("--title", default=None)
@@ -140,7 +141,8 @@ def _reduce_on(comm, args):
 
 def _plot(args):
     from .plot import plot
-    plot(summary.read(args.summary), args.figure, args.output, args.title)
+    plot([summary.read(path) for path in args.summaries], args.figure, args.output, args.title,
+         names=args.summaries)
     print(f"wrote {args.output}")
     return 0
 

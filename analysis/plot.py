@@ -1,11 +1,17 @@
-"""Figures from a summary: R(mu) with bootstrap bands; recurrence-time distributions."""
+"""Figures from one or more summaries: R(mu) of every point overlaid, with bootstrap bands;
+recurrence-time distributions, one panel per point. Points of several summaries are labelled by
+the parameters that differ between all the plotted points (legend_labels)."""
+import math
+import os
+
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .report import level_text, point_label, varying  # noqa: E402
+from .reduce import PARAMS  # noqa: E402
+from .report import level_text, partial_text  # noqa: E402
 from .stats import centers  # noqa: E402
 
 
@@ -19,34 +25,83 @@ def _band(ax, x, y, lo, hi, label, color, log=False, style="-"):
         ax.fill_between(x[okb], low[okb], hi[okb], color=color, alpha=0.25, lw=0)
 
 
-def magnitude(s, ax):
-    x = centers(s["bins/mu"])
-    keys = varying(s)
-    for i in range(len(s["points/N"])):
-        _band(ax, x, s["points/mu_density"][i], s["points/mu_lo"][i], s["points/mu_hi"][i],
-              point_label(s, i, keys), f"C{i}", log=True)
+def summary_name(path):
+    """A summary's name in labels and titles: its file name without .summary.h5 (or .h5)."""
+    base = os.path.basename(str(path))
+    return base.removesuffix(".h5").removesuffix(".summary")
+
+
+def legend_labels(summaries, names=None):
+    """(keys, labels) for the points of all `summaries`, in order (summary by summary).
+
+    keys: the parameters that differ between the plotted points (in PARAMS order; ["b"] if
+    none do); a label gives their values, e.g. "N = 1600, b = 40" (6 significant digits, or
+    all where that is needed to tell two points apart). A point whose parameters appear in
+    several summaries gets the summary's name appended, "b = 20 (run2)" (names: one per
+    summary, default "summary 1", "summary 2", ...).
+    """
+    names = list(names) if names is not None else [f"summary {j + 1}" for j in range(len(summaries))]
+    owner, rows = [], []
+    for j, s in enumerate(summaries):
+        for i in range(len(s["points/N"])):
+            owner.append(j)
+            rows.append(tuple(s[f"points/{k}"][i].item() for k in PARAMS))
+    keys = [k for n, k in enumerate(PARAMS) if len({r[n] for r in rows}) > 1] or ["b"]
+    for exact in (False, True):
+        labels = [", ".join(f"{k} = {repr(r[PARAMS.index(k)]) if exact else format(r[PARAMS.index(k)], 'g')}"
+                            for k in keys) for r in rows]
+        if all(labels[a] != labels[b] or rows[a] == rows[b]
+               for a in range(len(rows)) for b in range(a)):
+            break
+    repeated = {r for r in rows if rows.count(r) > 1}
+    labels = [f"{label} ({names[j]})" if r in repeated else label
+              for label, r, j in zip(labels, rows, owner)]
+    return keys, labels
+
+
+def _points(summaries):
+    """[(summary, point index)] of every plotted point."""
+    return [(s, i) for s in summaries for i in range(len(s["points/N"]))]
+
+
+def _colors(n):
+    if n <= 10:
+        return [f"C{i}" for i in range(n)]
+    return [plt.cm.viridis(i / (n - 1)) for i in range(n)]
+
+
+def magnitude(summaries, ax, keys, labels):
+    points = _points(summaries)
+    for (s, i), label, color in zip(points, labels, _colors(len(points))):
+        _band(ax, centers(s["bins/mu"]), s["points/mu_density"][i], s["points/mu_lo"][i],
+              s["points/mu_hi"][i], label, color, log=True)
     ax.set_yscale("log")
-    positive = s["points/mu_density"][s["points/mu_density"] > 0]
+    density = np.concatenate([s["points/mu_density"].ravel() for s in summaries])
+    positive = density[density > 0]
     if positive.size:
         ax.set_ylim(positive.min() / 3, positive.max() * 3)
     ax.set_xlabel(r"magnitude $\mu$")
     ax.set_ylabel(r"$R(\mu)$")
-    ax.legend(title="varying " + ", ".join(keys), fontsize=8)
+    ax.legend(title="varying " + ", ".join(keys), fontsize=8, ncol=math.ceil(len(points) / 12))
 
 
-def recurrence(s, fig):
-    n = len(s["points/N"])
-    cols = min(n, 2)
-    rows = int(np.ceil(n / cols))
-    x = centers(s["bins/tnu"])
-    keys = varying(s)
-    for i in range(n):
-        ax = fig.add_subplot(rows, cols, i + 1)
+def _grid(n):
+    """(rows, columns) of the recurrence panels: two columns, a square grid for many points."""
+    cols = min(n, 2) if n <= 6 else math.ceil(math.sqrt(n))
+    return math.ceil(n / cols), cols
+
+
+def recurrence(summaries, fig, labels):
+    points = _points(summaries)
+    rows, cols = _grid(len(points))
+    for k, ((s, i), label) in enumerate(zip(points, labels)):
+        x = centers(s["bins/tnu"])
+        ax = fig.add_subplot(rows, cols, k + 1)
         _band(ax, x, s["points/tnu_density"][i], s["points/tnu_lo"][i], s["points/tnu_hi"][i],
               "all large events", "C0")
         _band(ax, x, s["points/tnu_interior_density"][i], s["points/tnu_interior_lo"][i],
               s["points/tnu_interior_hi"][i], "interior events", "C3", style="--")
-        ax.set_title(point_label(s, i, keys), fontsize=9)
+        ax.set_title(label, fontsize=9)
         ax.set_xlabel(r"$T\nu$")
         ax.set_ylabel(r"$P(T\nu)$")
         ax.legend(fontsize=7, loc="upper right")
@@ -64,16 +119,39 @@ def recurrence(s, fig):
             inset.set_title("main peak", fontsize=6)
 
 
-def plot(s, figure, path, title=None):
+def title_text(summaries, names, title=None):
+    """The figure's title: `title` or the sources and the band level; then one line for each
+    partial reduction (events reduced of expected), whatever the title."""
+    levels = " / ".join(dict.fromkeys(level_text(s["attrs"]["level"]) for s in summaries))
+    if title is None:
+        source = (summaries[0]["attrs"]["catalog"] if len(summaries) == 1
+                  else ", ".join(names))
+        title = f"{source}  (bands: {levels} bootstrap)"
+    lines = [title]
+    for s, name in zip(summaries, names):
+        partial = partial_text(s).split(";")[0]
+        if partial:
+            lines.append(partial if len(summaries) == 1 else f"{name}: {partial}")
+    return "\n".join(lines)
+
+
+def plot(summaries, figure, path, title=None, names=None):
+    """Draw `figure` ("magnitude" or "recurrence") of the points of one summary (a dict from
+    summary.read) or several (a list), into `path`. names: the summaries' paths or names."""
+    if isinstance(summaries, dict):
+        summaries = [summaries]
+    names = ([summary_name(n) for n in names] if names is not None
+             else [f"summary {j + 1}" for j in range(len(summaries))])
+    keys, labels = legend_labels(summaries, names)
+    n = len(labels)
     if figure == "magnitude":
-        fig, ax = plt.subplots(figsize=(6, 4.5))
-        magnitude(s, ax)
+        fig, ax = plt.subplots(figsize=(6 + 2 * (math.ceil(n / 12) - 1), 4.5))
+        magnitude(summaries, ax, keys, labels)
     else:
-        n = len(s["points/N"])
-        fig = plt.figure(figsize=(5.5 * min(n, 2), 4 * int(np.ceil(n / 2))))
-        recurrence(s, fig)
-    a = s["attrs"]
-    fig.suptitle(title or f"{a['catalog']}  (bands: {level_text(a['level'])} bootstrap)", fontsize=9)
+        rows, cols = _grid(n)
+        fig = plt.figure(figsize=(5.5 * cols, 4 * rows))
+        recurrence(summaries, fig, labels)
+    fig.suptitle(title_text(summaries, names, title), fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)

@@ -1,5 +1,5 @@
 """Reduction: merged histograms, recurrence times, bootstrap coverage, b-value, serial vs MPI;
-several catalogs reduced together."""
+several catalogs reduced together; figures of several summaries."""
 import dataclasses
 import shutil
 import subprocess
@@ -263,3 +263,35 @@ def test_merging_a_catalog_with_itself_or_its_trajectories_is_refused(merged):
         assert not (merged / "dup.summary.h5").exists()
     res = run_analysis("reduce", merged / "A.h5", merged / "B.h5")
     assert res.returncode == 2 and "give its path with -o" in res.stderr
+
+
+# -- figures of several summaries ----------------------------------------------------------
+
+def fake_summary(**params):
+    """The point parameters of a summary (all that legend_labels reads)."""
+    n = len(next(iter(params.values())))
+    base = {"N": 800, "l": 3.0, "nu": 1e-8, "a": 0.0, "b": 20.0, "c": 1000.0}
+    return {f"points/{k}": np.array(params.get(k, [v] * n)) for k, v in base.items()}
+
+
+def test_legend_labels_name_what_differs_between_the_plotted_points():
+    from analysis.plot import legend_labels
+    one = fake_summary(b=[20.0, 30.0])
+    two = fake_summary(N=[1600, 800], b=[40.0, 20.0])
+    assert legend_labels([one]) == (["b"], ["b = 20", "b = 30"])
+    # N varies only across the summaries; the point in both gets its summary's name
+    assert legend_labels([one, two], ["one", "two"]) == (
+        ["N", "b"], ["N = 800, b = 20 (one)", "N = 800, b = 30", "N = 1600, b = 40", "N = 800, b = 20 (two)"])
+    assert legend_labels([fake_summary(a=[10.0]), fake_summary(a=[20.0], nu=[1e-6])], ["x", "y"]) == (
+        ["nu", "a"], ["nu = 1e-08, a = 10", "nu = 1e-06, a = 20"])
+    # nothing differs: b names the points; six digits that cannot tell two points apart: all digits
+    assert legend_labels([fake_summary(b=[20.0])]) == (["b"], ["b = 20"])
+    assert legend_labels([fake_summary(b=[20.0000001, 20.0000002])])[1] == ["b = 20.0000001", "b = 20.0000002"]
+
+
+def test_plot_overlays_several_summaries(merged):
+    for fig in ("magnitude", "recurrence"):
+        out = merged / f"overlay-{fig}.png"
+        res = run_analysis("plot", merged / "sum.h5", merged / "BA.summary.h5", "--figure", fig, "-o", out)
+        assert res.returncode == 0, res.stderr
+        assert out.stat().st_size > 10000

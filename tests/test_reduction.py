@@ -396,8 +396,8 @@ def test_unfinished_runs_need_partial_and_say_so(catalogs):
     """A catalog with unfinished tasks, or named *.partial, is refused (exit 1, one line) unless
     --partial is given; then the summary's `partial` attribute (checked against the reference by
     every test here) says how many events of how many and which catalogs, and so do the report's
-    first line. A complete run needs no --partial and says nothing."""
-    from analysis import report, summary
+    first line and the figure titles. A complete run needs no --partial and says nothing."""
+    from analysis import plot, report, summary
     d, made = catalogs
     whole = made["whole"][0]
     named = shutil.copy(whole, d / "whole2.h5.partial")    # every task finished, name unfinished
@@ -423,12 +423,14 @@ def test_unfinished_runs_need_partial_and_say_so(catalogs):
     assert statement == f"{head}; {paths[0]} (4 of 12 tasks unfinished), {named} (all tasks finished)"
     assert res.stdout.splitlines()[0] == statement
     assert report.table(s).splitlines()[0] == statement
+    assert plot.title_text([s], ["partial"]).splitlines()[1] == head
     # a complete run: no --partial needed, nothing said
     out = d / "whole.summary.h5"
     res = run_status([c for c in reduce_command(64, whole, out, 0.95, 3) if c != "--partial"])
     assert res.returncode == 0, res.stderr
     s = summary.read(out)
     assert s["attrs"]["partial"] == "" and not report.table(s).startswith("PARTIAL")
+    assert len(plot.title_text([s], ["whole"]).splitlines()) == 1
 
 
 def test_peak_finder_follows_its_documented_rule():
