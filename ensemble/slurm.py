@@ -8,7 +8,8 @@ the original later does not change a queued run), the catalog(s), logs/ and resu
 
 Kinds of run job (KINDS): "single" (one MPI run), "requeue" (walltime-safe: checkpoint before
 the limit, requeue, resume), "array" (one walltime-safe element per parameter point). Each comes
-with reduce.sbatch, submitted with --dependency=afterok on the run job.
+with reduce.sbatch, submitted with --dependency=afterok on the run job, which reduces the run's
+catalog (an array's per-point catalogs together) into one summary, its figures and report.
 """
 import dataclasses
 import os
@@ -51,8 +52,9 @@ PLACEHOLDERS = {
     "ARRAY": "array index range, e.g. 0-9 or 0-9%4",
     "POINTS_DIR": "per-point configs and catalogs of an array job",
     "REDUCE_NTASKS": "ranks of the reduction job",
-    "CATALOGS": "catalogs the reduction job reduces (space-separated)",
-    "SUMMARY_DIR": "where the reduction writes summaries, figures and reports",
+    "CATALOGS": "catalogs the reduction job reduces together into one summary (space-separated)",
+    "SUMMARY_DIR": "where the reduction writes the summary, figures and report",
+    "RESULT_NAME": "name of the summary, figures and report (catalog stem; the config's for an array)",
 }
 PATH_PLACEHOLDERS = ("WORK_DIR", "LOG_DIR", "PYTHON", "CONFIG", "CATALOG", "SCRIPT", "POINTS_DIR",
                      "SUMMARY_DIR")
@@ -98,6 +100,7 @@ class Rendered:
     catalogs: tuple
     summary_dir: Path
     files: tuple
+    summary: Path = None    # the summary the reduction writes (its figures and report beside it)
 
 
 def time_seconds(text):
@@ -232,6 +235,9 @@ def render(cfg: Config, opt: JobOptions, directory, name="run", templates=TEMPLA
     for d in (directory, directory / "logs"):
         d.mkdir(parents=True, exist_ok=True)
     values, files, catalogs = configs(cfg, directory)
+    # one summary of the run: named after its catalog, or after the config for an array's catalogs
+    result_name = Path(catalogs[0]).stem if opt.kind != "array" else name
+    _check_path(result_name)
     if opt.kind == "array" and opt.array_limit:
         values["ARRAY"] += f"%{opt.array_limit}"
     run_script = directory / template
@@ -246,7 +252,7 @@ def render(cfg: Config, opt: JobOptions, directory, name="run", templates=TEMPLA
         "SIGNAL_SECONDS": signal, "STARTUP_SECONDS": startup, "MAX_REQUEUES": opt.max_requeues,
         "SCRIPT": _check_path(run_script), "REDUCE_NTASKS": opt.reduce_ntasks,
         "CATALOGS": " ".join(_check_path(c) for c in catalogs),
-        "SUMMARY_DIR": _check_path(directory / "results"),
+        "SUMMARY_DIR": _check_path(directory / "results"), "RESULT_NAME": result_name,
     })
     reduce_script = directory / "reduce.sbatch"
     for src, dst in ((template, run_script), ("reduce.sbatch", reduce_script)):
@@ -261,7 +267,8 @@ def render(cfg: Config, opt: JobOptions, directory, name="run", templates=TEMPLA
     for script in (run_script, reduce_script, submit_sh):
         script.chmod(0o755)
     return Rendered(directory, run_script, reduce_script, tuple(catalogs), directory / "results",
-                    tuple([run_script, reduce_script, submit_sh] + files))
+                    tuple([run_script, reduce_script, submit_sh] + files),
+                    directory / "results" / f"{result_name}.summary.h5")
 
 
 def check_python(python):
@@ -393,5 +400,6 @@ def describe(cfg, opt, out):
     where = (_rel(out.catalogs[0]) if len(out.catalogs) == 1
              else f"{_rel(out.catalogs[0].parent)}/point-*.h5")
     lines.append(f"  catalog{'s' if len(out.catalogs) > 1 else ''}: {where}; "
-                 f"summaries, figures and reports: {_rel(out.summary_dir)}/")
+                 f"reduced {'together ' if len(out.catalogs) > 1 else ''}into {_rel(out.summary)} "
+                 f"(figures and report beside it)")
     return "\n".join(lines)

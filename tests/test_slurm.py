@@ -16,6 +16,7 @@ import time
 import numpy as np
 import pytest
 
+from analysis import summary
 from ensemble import catalog
 from ensemble.config import load, loads
 from ensemble.slurm import (KINDS, PLACEHOLDER, PLACEHOLDERS, TEMPLATES, JobOptions, SlurmError,
@@ -104,7 +105,13 @@ def test_rendered_scripts_are_complete_and_valid_bash(tmp_path, kind):
     assert f"PYTHON={sys.executable}" in text
     if kind != "single":
         assert "#SBATCH --signal=B:USR1@300" in header and "#SBATCH --requeue" in header
-    assert "#SBATCH --kill-on-invalid-dep=yes" in out.reduce_script.read_text()
+    reduce = out.reduce_script.read_text()
+    assert "#SBATCH --kill-on-invalid-dep=yes" in reduce
+    # one reduction of every catalog of the run into one summary, named after the catalog
+    assert f"CATALOGS=({' '.join(map(str, out.catalogs))})" in reduce and "NAME=tiny\n" in reduce
+    assert out.summary == out.directory / "results" / "tiny.summary.h5"
+    assert reduce.count("-m analysis reduce") == 1
+    assert '"${launch[@]}" "$PYTHON" -m analysis reduce "${CATALOGS[@]}" -o "$summary" --force' in reduce
     # without partition, account and locking advice those lines are gone
     plain = render(cfg, JobOptions(kind=kind, ntasks=2, time="30"), tmp_path / "plain", "tiny")
     text = plain.run_script.read_text()
@@ -124,7 +131,10 @@ def test_array_elements_are_standalone_configs_one_per_point(tmp_path):
         assert sub.run.seed == element_seed(7, i) and sub.output.path == str(out.catalogs[i])
         seeds.add(sub.run.seed)
     assert len(seeds) == 3
-    assert " ".join(map(str, out.catalogs)) in out.reduce_script.read_text()
+    # the reduction merges the elements' catalogs into one summary of the sweep, named after the config
+    reduce = out.reduce_script.read_text()
+    assert f"CATALOGS=({' '.join(map(str, out.catalogs))})" in reduce and "NAME=run\n" in reduce
+    assert out.summary == out.directory / "results" / "run.summary.h5"
 
 
 def test_bad_options_are_refused(tmp_path):
@@ -431,8 +441,13 @@ def test_array_sweep_then_reduction_only_after_every_element_succeeded(cluster, 
         events, tasks, attrs = catalog.read(good / "points" / f"point-{i:04d}.h5")
         assert list(tasks["b"]) == [b, b] and len(events["t"]) == 400
         assert loads(attrs["config"]).run.seed == element_seed(0, i)
-        for suffix in (".summary.h5", "-magnitude.png", "-recurrence.png", ".report.txt"):
-            assert (good / "results" / f"point-{i:04d}{suffix}").exists()
+    # one summary of the sweep from the elements' catalogs, its figures and report
+    for suffix in (".summary.h5", "-magnitude.png", "-recurrence.png", ".report.txt"):
+        assert (good / "results" / f"sweep{suffix}").exists(), suffix
+    s = summary.read(good / "results" / "sweep.summary.h5")
+    assert list(s["points/b"]) == [20.0, 30.0] and list(s["points/units"]) == [2, 2]
+    assert list(s["tasks/catalog"]) == [0, 0, 1, 1] and s["attrs"]["partial"] == ""
+    assert list(s["attrs"]["catalogs"]) == [str(good / "points" / f"point-{i:04d}.h5") for i in (0, 1)]
     # the failed element: the reduction never ran (Slurm cancelled it: --kill-on-invalid-dep)
     bad_elements = cluster.jobs(bad_run)
     assert sorted(e["JobState"] for e in bad_elements) == ["COMPLETED", "FAILED"], logs(bad)
