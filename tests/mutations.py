@@ -160,6 +160,24 @@ MUTATIONS = (
              "counts / (np.maximum(total, 1) * widths)", "counts / np.maximum(total, 1)",
              ("tests/test_reduction.py", "tests/test_analysis.py"),
              "R(mu) normalised as a probability per bin instead of a density"),
+    # -- several catalogs -------------------------------------------------------------------
+    Mutation("merge-units-in-catalog-order", "analysis/merge.py",
+             "points.append((dict(zip(PARAMS, key)), rows))", "points.append((dict(zip(PARAMS, key)), sorted(rows)))",
+             ("tests/test_reduction.py", "tests/test_analysis.py"),
+             "a pooled point's intervals change with the order in which its catalogs are given"),
+    Mutation("merge-bootstrap-by-point-index", "analysis/cli.py",
+             "merge.bootstrap_rng(opt.seed, params)",
+             "merge.np.random.default_rng(merge.np.random.SeedSequence(opt.seed, spawn_key=(len(points),)))",
+             ("tests/test_reduction.py", "tests/test_analysis.py"),
+             "a point's intervals change with the other points (and catalogs) of the reduction"),
+    Mutation("merge-same-trajectory-twice", "analysis/merge.py",
+             "if stream == (", "if False and stream == (",
+             ("tests/test_reduction.py", "tests/test_analysis.py"),
+             "one trajectory in two catalogs counted as two independent seeds"),
+    Mutation("merge-partial-accepted", "analysis/merge.py",
+             "if partial and not allow_partial:", "if False:",
+             ("tests/test_reduction.py::test_unfinished_runs_need_partial_and_say_so",),
+             "an unfinished run reduced as if it were complete"),
 )
 
 
