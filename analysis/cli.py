@@ -48,10 +48,14 @@ def _parser():
     r.add_argument("--level", type=float, default=0.95, help="interval coverage (default 0.95)")
     r.add_argument("--blocks", type=int, default=20,
                    help="stretches per task, resampled when a point has one seed (default 20)")
-    r.add_argument("--seed", type=int, default=0, help="seed of the bootstrap (default 0)")
+    r.add_argument("--seed", type=int, default=0,
+                   help="seed of the bootstrap; a point's resamples are drawn from it and the "
+                        "point's parameters (default 0)")
     r.add_argument("--force", action="store_true", help="overwrite an existing summary")
     pl = sub.add_parser("plot", help="summaries -> figure (their points overlaid)")
-    pl.add_argument("summaries", nargs="+", metavar="summary")
+    pl.add_argument("summaries", nargs="+", metavar="summary",
+                    help="one or more summaries: their points in one figure, labelled by the "
+                         "parameters that differ between them")
     pl.add_argument("--figure", choices=("magnitude", "recurrence"), required=True)
     pl.add_argument("-o", "--output", required=True, help="FILE.png or FILE.pdf")
     pl.add_argument("--title", default=None)
