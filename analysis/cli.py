@@ -49,6 +49,13 @@ def _parser():
     pl.add_argument("--title", default=None)
     rp = sub.add_parser("report", help="print the summary numbers as a table")
     rp.add_argument("summary")
+    from .export import FORMATS
+    ex = sub.add_parser("export", help="catalog (events, tasks) or summary (curves, numbers, peaks) -> "
+                                       "tables for other tools (docs/running.md)")
+    ex.add_argument("source", help="an event catalog or a reduction summary")
+    ex.add_argument("--format", choices=sorted(FORMATS), default="csv", help="file format (default csv)")
+    ex.add_argument("-o", "--output", required=True, help="directory of the tables (made if missing)")
+    ex.add_argument("--force", action="store_true", help="overwrite tables already in the directory")
     return p
 
 
@@ -122,10 +129,17 @@ def _report(args):
     return 0
 
 
+def _export(args):
+    from .export import write
+    for path in write(args.source, args.output, args.format, force=args.force):
+        print(f"wrote {path}")
+    return 0
+
+
 def main(argv=None):
     args = _parser().parse_args(argv)
     try:
-        return {"reduce": _reduce, "plot": _plot, "report": _report}[args.command](args)
+        return {"reduce": _reduce, "plot": _plot, "report": _report, "export": _export}[args.command](args)
     except BrokenPipeError:
         raise   # the reader of stdout went away: not a file error; __main__ ends quietly
     except (CatalogError, summary.SummaryError, ValueError, OSError) as err:
