@@ -91,7 +91,7 @@ def _prepare(args):
 def _reduce_on(comm, args):
     from ensemble.abort import abort_on_error, on_root
 
-    from .reduce import PARAMS, point_statistics, reduce_tasks
+    from .reduce import MIN_UNITS, PARAMS, point_statistics, reduce_tasks
     rank, size = comm.Get_rank(), comm.Get_size()
     opt, out, tasks, attrs = on_root(comm, lambda: _prepare(args), tuple(COLLECTIVE))
     mine = [k for k in range(len(tasks["point"])) if k % size == rank]
@@ -108,6 +108,11 @@ def _reduce_on(comm, args):
         result["params"] = {name: tasks[name][ids[0]] for name in PARAMS}
         points.append(result)
     summary.write(out, args.catalog, attrs, tasks, per_task, points, opt, force=args.force)
+    for i, p in enumerate(points):
+        if p["units"] < MIN_UNITS:
+            print(f"warning: point {i} ({', '.join(f'{k} = {v:g}' for k, v in p['params'].items())}): "
+                  f"intervals from {p['units']} {p['method']} are unreliable; at least {MIN_UNITS} are "
+                  f"needed", file=sys.stderr)
     methods = sorted({p["method"] for p in points})
     print(f"wrote {out}: {len(points)} parameter points, {len(per_task)} tasks; intervals from "
           f"{opt.bootstrap} bootstrap resamples over {' / '.join(methods)}"

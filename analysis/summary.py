@@ -3,7 +3,7 @@
     /bins/mu, /bins/tnu                         bin edges
     /tasks/*                                    the catalog's task table
     /per_task/{mu, tnu, tnu_interior}           (tasks, stretches, bins) counts
-    /per_task/numbers                           (tasks, stretches, 8) counts and sums (analysis.stats)
+    /per_task/numbers                           (tasks, stretches, 9) counts and sums (analysis.stats)
     /points/{N, l, nu, a, b, c}                 parameters of each point
     /points/method, /points/units               resampling used ("seeds" or "blocks") and unit count
     /points/{mu, tnu, tnu_interior}_density     (points, bins): estimate; *_lo, *_hi: interval
@@ -30,7 +30,7 @@ from ensemble import catalog, filekind
 
 from .reduce import NUMBERS, PARAMS
 
-FORMAT = filekind.SUMMARY_FORMAT_PREFIX + "1"
+FORMAT = filekind.SUMMARY_FORMAT_PREFIX + "2"   # 2: GR b and its standard error, 9 per-task sums, peaks by prominence
 
 # Every dataset, one line each: (unit, shape, meaning), units as in ensemble/catalog.py's DATASETS
 # (T nu, the plate's displacement during a recurrence time, is a model length).
@@ -150,5 +150,8 @@ def read(path):
                     out[name] = obj[...]
             h5.visititems(visit)
             out["attrs"] = {k: h5.attrs[k] for k in h5.attrs}
+        if out["attrs"].get("format") != FORMAT:
+            raise SummaryError(f"{path}: summary format {out['attrs'].get('format', '(none)')}, this version "
+                               f"reads {FORMAT}; reduce the catalog again")
         out["points/method"] = np.array([m.decode() for m in out["points/method"]])
     return out
