@@ -28,6 +28,7 @@ import numpy as np
 
 from ensemble import catalog, filekind
 
+from . import stats
 from .reduce import NUMBERS, PARAMS
 
 FORMAT = filekind.SUMMARY_FORMAT_PREFIX + "2"   # 2: GR b and its standard error, 9 per-task sums, peaks by prominence
@@ -51,7 +52,8 @@ NUMBER_MEANINGS = {   # name -> (unit, meaning), in the order of reduce.NUMBERS
     "mean_tnu": ("model length", "mean T nu of all recurrences"),
     "mode_tnu": ("model length", "centre of the highest T nu bin"),
     "mean_tnu_interior": ("model length", "mean T nu of the recurrences starting at an interior event"),
-    "b_value": ("1", "Aki's maximum-likelihood Gutenberg-Richter b above mu = b_cut"),
+    "gr_b": ("1", "Aki's maximum-likelihood Gutenberg-Richter b (not the model's b) above mu = b_cut"),
+    "gr_b_se": ("1", "Shi & Bolt standard error of gr_b (assumes independent events; trust the interval)"),
     "ks_gr": ("1", "Kolmogorov-Smirnov distance of the binned mu >= b_cut from the fitted GR law"),
 }
 DATASETS = {
@@ -65,9 +67,9 @@ DATASETS = {
                      "recurrences per T nu bin, per task and stretch of their starting event"),
     "per_task/tnu_interior": ("count", "(tasks, stretches, T nu bins)",
                               "the same for the recurrences starting at an interior event"),
-    "per_task/numbers": ("count or sum", "(tasks, stretches, 8)",
-                         "n_events, n_large, n_rec, sum_tnu, n_rec_int, sum_tnu_int, n_gr, sum_mu_gr "
-                         "(analysis/stats.py) per task and stretch"),
+    "per_task/numbers": ("count or sum", f"(tasks, stretches, {stats.N_STATS})",
+                         "n_events, n_large, n_rec, sum_tnu, n_rec_int, sum_tnu_int, n_gr, sum_mu_gr, "
+                         "sum_mu2_gr (analysis/stats.py) per task and stretch"),
     **{f"points/{name}": (unit, _POINTS, f"{meaning}, of the point's tasks")
        for name, (unit, _, meaning) in ((n, catalog.DATASETS[f"tasks/{n}"]) for n in PARAMS)},
     "points/method": ("text", _POINTS, "resampling units of the intervals: 'seeds' (the point's tasks) or "

@@ -231,7 +231,7 @@ MUTATIONS = (
     Mutation("export-peak-interval-swapped", "analysis/export.py",
              '"tnu_lo": peaks[point, rank, 1], "tnu_hi": peaks[point, rank, 2]',
              '"tnu_lo": peaks[point, rank, 2], "tnu_hi": peaks[point, rank, 1]',
-             ("tests/test_export.py::test_api_curves_numbers_peaks_are_the_summarys",),
+             ("tests/test_export.py::test_peaks_table_of_several_peaks_per_point",),
              "the exported peaks' interval ends swapped"),
     Mutation("export-curve-left-out", "analysis/export.py",
              'if f"points/{curve}_density" not in s:', 'if curve == "tnu_interior" or f"points/{curve}_density" not in s:',
