@@ -5,6 +5,7 @@ import sys
 import numpy as np
 import pytest
 
+from ensemble import catalog
 from ensemble.config import Integrator, Model
 from ensemble.events import advance_to_onset, check, run_event
 from ensemble.integrators import kernel_args
@@ -84,6 +85,15 @@ def next_event(force, psi, model, dt, v_start=0.0):
 def run_cli(*args, cwd=None, timeout=600):
     """`python -m ensemble ARGS` in a subprocess; a hang fails the test, showing the output."""
     return run_bounded([sys.executable, "-m", "ensemble", *args], timeout, cwd=cwd, env=child_env())
+
+
+def committed(out):
+    """True once the run writing catalog `out` has committed a batch of events (readable, not yet renamed)."""
+    try:
+        _, tasks, _ = catalog.read_tasks(catalog.partial_path(out))
+    except catalog.CatalogError:
+        return False      # not created yet, or open for writing at that moment
+    return tasks["events_written"].sum() > 0
 
 
 def write_config(path, **sections):

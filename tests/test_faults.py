@@ -20,7 +20,7 @@ import pytest
 from ensemble import catalog, lock
 from ensemble.integrity import commit_crc
 
-from .conftest import write_config
+from .conftest import committed, write_config
 from .inject import CRASH_CODE
 from .processes import ROOT, Started, child_env, run_bounded, wait_for
 
@@ -145,14 +145,6 @@ def test_an_out_of_range_commit_row_with_a_valid_checksum_is_refused(interrupted
 def start(cfg, out, *extra, **kwargs):
     """`run` in the background (a Started: use it in a `with` block)."""
     return Started([sys.executable, "-m", "ensemble", "run", cfg, "-o", out, *extra], env=child_env(), **kwargs)
-
-
-def committed(out):
-    try:
-        _, tasks, _ = catalog.read_tasks(catalog.partial_path(out))
-    except catalog.CatalogError:
-        return False
-    return tasks["events_written"].sum() > 0
 
 
 @pytest.fixture(scope="module")
