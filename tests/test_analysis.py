@@ -1,6 +1,5 @@
 """Reduction: merged histograms, recurrence times, bootstrap coverage, GR b, serial vs MPI."""
 import shutil
-import subprocess
 import sys
 
 import numpy as np
@@ -12,11 +11,11 @@ from ensemble import catalog
 
 from . import reduction_reference as ref
 from .conftest import run_cli, write_config
+from .processes import run_bounded
 
 
 def run_analysis(*args):
-    return subprocess.run([sys.executable, "-m", "analysis", *map(str, args)], capture_output=True, text=True,
-                          timeout=300)
+    return run_bounded([sys.executable, "-m", "analysis", *args], 300)
 
 
 @pytest.fixture(scope="module")
@@ -178,9 +177,8 @@ def test_report_and_figures(reduced):
 @pytest.mark.mpi
 @pytest.mark.skipif(shutil.which("mpiexec") is None, reason="mpiexec not found")
 def test_serial_and_mpi_reduction_agree(reduced):
-    res = subprocess.run(["mpiexec", "-n", "2", sys.executable, "-m", "analysis", "reduce", reduced / "cat.h5",
-                          "-o", reduced / "sum_mpi.h5", "--bootstrap", "200", "--mu-c", "3.5"],
-                         capture_output=True, text=True, timeout=300)
+    res = run_bounded(["mpiexec", "-n", "2", sys.executable, "-m", "analysis", "reduce", reduced / "cat.h5",
+                       "-o", reduced / "sum_mpi.h5", "--bootstrap", "200", "--mu-c", "3.5"], 300)
     assert res.returncode == 0, res.stderr
     a, b = summary.read(reduced / "sum.h5"), summary.read(reduced / "sum_mpi.h5")
     assert set(a) == set(b)
