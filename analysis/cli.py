@@ -61,6 +61,13 @@ def _parser():
     pl.add_argument("--title", default=None)
     rp = sub.add_parser("report", help="print the summary numbers as a table")
     rp.add_argument("summary")
+    from .export import FORMATS
+    ex = sub.add_parser("export", help="catalog (events, tasks) or summary (curves, numbers, peaks) -> "
+                                       "tables for other tools (docs/running.md)")
+    ex.add_argument("source", help="an event catalog or a reduction summary")
+    ex.add_argument("--format", choices=sorted(FORMATS), default="csv", help="file format (default csv)")
+    ex.add_argument("-o", "--output", required=True, help="directory of the tables (made if missing)")
+    ex.add_argument("--force", action="store_true", help="overwrite tables already in the directory")
     return p
 
 
@@ -115,7 +122,7 @@ def _check_counts(inputs, per_task):
 def _reduce_on(comm, args):
     from ensemble.abort import abort_on_error, on_root
 
-    from .reduce import point_statistics
+    from .reduce import MIN_UNITS, point_statistics
     rank, size = comm.Get_rank(), comm.Get_size()
     opt, out, inputs = on_root(comm, lambda: _prepare(args), tuple(COLLECTIVE))
     mine = [g for g in range(len(inputs.tasks["point"])) if g % size == rank]
@@ -133,6 +140,11 @@ def _reduce_on(comm, args):
     summary.write(out, inputs, per_task, points, opt, force=args.force)
     if inputs.partial:
         print(inputs.partial)
+    for i, p in enumerate(points):
+        if p["units"] < MIN_UNITS:
+            print(f"warning: point {i} ({', '.join(f'{k} = {v:g}' for k, v in p['params'].items())}): "
+                  f"intervals from {p['units']} {p['method']} are unreliable; at least {MIN_UNITS} are "
+                  f"needed", file=sys.stderr)
     methods = sorted({p["method"] for p in points})
     print(f"wrote {out}: {len(points)} parameter points, {len(per_task)} tasks"
           + (f" from {len(inputs.paths)} catalogs" if len(inputs.paths) > 1 else "")
@@ -157,10 +169,17 @@ def _report(args):
     return 0
 
 
+def _export(args):
+    from .export import write
+    for path in write(args.source, args.output, args.format, force=args.force):
+        print(f"wrote {path}")
+    return 0
+
+
 def main(argv=None):
     args = _parser().parse_args(argv)
     try:
-        return {"reduce": _reduce, "plot": _plot, "report": _report}[args.command](args)
+        return {"reduce": _reduce, "plot": _plot, "report": _report, "export": _export}[args.command](args)
     except BrokenPipeError:
         raise   # the reader of stdout went away: not a file error; __main__ ends quietly
     except (CatalogError, summary.SummaryError, ValueError, OSError) as err:

@@ -81,6 +81,7 @@ def reduce_task(chunks, written, nu, n_blocks_chain, opt):
         gr = mu >= opt.b_cut
         np.add.at(out.numbers[:, stats.N_GR], block[gr], 1)
         np.add.at(out.numbers[:, stats.SUM_MU_GR], block[gr], mu[gr])
+        np.add.at(out.numbers[:, stats.SUM_MU2_GR], block[gr], mu[gr] ** 2)
         src, T, interior = scanner.feed(t, epicenter, mu, boundary)
         rblock = (src * k) // written
         tnu = T * nu
@@ -110,7 +111,10 @@ def reduce_tasks(path, task_indices, opt):
 # -- per point ------------------------------------------------------------------------------
 
 NUMBERS = ("n_events", "n_large", "fraction_large", "n_recurrences", "mean_tnu", "mode_tnu",
-           "mean_tnu_interior", "b_value", "ks_gr")
+           "mean_tnu_interior", "gr_b", "gr_b_se", "ks_gr")
+# Fewer resampling units than this and the bootstrap intervals are not to be trusted (a
+# percentile interval from a handful of seeds is too narrow and jumps with each one added).
+MIN_UNITS = 10
 
 
 def _units(per_task, task_ids, seeds):
@@ -136,13 +140,14 @@ def point_statistics(per_task, task_ids, seeds, opt, rng):
 
     def numbers(row):
         mu, tnu, _, s = split(row)
-        b = stats.b_value(s[stats.N_GR], s[stats.SUM_MU_GR], opt.b_cut)
+        b = stats.gr_b(s[stats.N_GR], s[stats.SUM_MU_GR], opt.b_cut)
+        b_se = stats.gr_b_standard_error(s[stats.N_GR], s[stats.SUM_MU_GR], s[stats.SUM_MU2_GR], opt.b_cut)
         mode = stats.centers(opt.tnu_edges)[np.argmax(tnu)] if tnu.sum() > 0 else np.nan
         with np.errstate(invalid="ignore", divide="ignore"):
             return np.array([
                 s[stats.N_EVENTS], s[stats.N_LARGE], s[stats.N_LARGE] / s[stats.N_EVENTS],
                 s[stats.N_REC], s[stats.SUM_TNU] / s[stats.N_REC], mode,
-                s[stats.SUM_TNU_INT] / s[stats.N_REC_INT], b,
+                s[stats.SUM_TNU_INT] / s[stats.N_REC_INT], b, b_se,
                 stats.gr_ks_distance(mu, opt.mu_edges, opt.b_cut, b)])
 
     def curves(row):
@@ -167,19 +172,30 @@ def point_statistics(per_task, task_ids, seeds, opt, rng):
 
 
 def _peaks_with_intervals(tnu_units, opt, rng):
-    """Recurrence peaks of the merged histogram; each with the interval of the nearest peak
-    across bootstrap resamples. Rows: (position, lo, hi)."""
-    base = stats.find_peaks(tnu_units.sum(axis=0), opt.tnu_edges)
-    if len(base) == 0 or len(tnu_units) < 2:
+    """Significant recurrence peaks of the merged histogram (stats.find_peaks), each with the
+    interval of the nearest peak across bootstrap resamples. Rows: (position, lo, hi).
+
+    The noise of each smoothed bin is the standard deviation of its bootstrap resamples over the
+    units, at least the Poisson value (with one unit, or few, the bootstrap understates it).
+    """
+    total = tnu_units.sum(axis=0)
+    noise = stats.poisson_noise(total)
+    resampled = None
+    if len(tnu_units) >= 2 and total.sum() > 0:
+        picks = rng.integers(0, len(tnu_units), size=(opt.bootstrap, len(tnu_units)))
+        resampled = np.array([tnu_units[p].sum(axis=0) for p in picks])
+        spread = np.array([stats.smooth(c) for c in resampled]).std(axis=0, ddof=1)
+        noise = np.maximum(noise, spread)
+    base = stats.find_peaks(total, opt.tnu_edges, noise)
+    if len(base) == 0 or resampled is None:
         return np.array([[p, np.nan, np.nan] for p in base]).reshape(-1, 3)
     width = opt.tnu_edges[1] - opt.tnu_edges[0]
     found = [[] for _ in base]
-    picks = rng.integers(0, len(tnu_units), size=(opt.bootstrap, len(tnu_units)))
-    for p in picks:
-        resampled = stats.find_peaks(tnu_units[p].sum(axis=0), opt.tnu_edges)
+    for counts in resampled:
+        peaks = stats.find_peaks(counts, opt.tnu_edges, noise)
         for i, b in enumerate(base):
-            if len(resampled):
-                near = resampled[np.argmin(np.abs(resampled - b))]
+            if len(peaks):
+                near = peaks[np.argmin(np.abs(peaks - b))]
                 if abs(near - b) <= 5 * width:
                     found[i].append(near)
     rows = []

@@ -1,12 +1,13 @@
 """The summary numbers of every parameter point as a text table."""
 import numpy as np
 
-from .reduce import NUMBERS, PARAMS
+from .reduce import MIN_UNITS, NUMBERS, PARAMS
 
 LABELS = {
     "n_events": "events", "n_large": "large", "fraction_large": "frac(mu>=mu_c)",
     "n_recurrences": "recurrences", "mean_tnu": "mean T*nu", "mode_tnu": "mode T*nu",
-    "mean_tnu_interior": "mean T*nu (int.)", "b_value": "b-value", "ks_gr": "KS to GR",
+    "mean_tnu_interior": "mean T*nu (int.)", "gr_b": "GR b", "gr_b_se": "GR b std. error",
+    "ks_gr": "KS to GR",
 }
 
 
@@ -25,6 +26,17 @@ def point_label(s, i, keys=None):
     return ", ".join(f"{k} = {s[f'points/{k}'][i]:g}" for k in keys)
 
 
+def unreliable(s, i):
+    """A warning if point i's intervals rest on fewer than MIN_UNITS resampling units, else ''."""
+    units, method = int(s["points/units"][i]), s["points/method"][i]
+    if units >= MIN_UNITS:
+        return ""
+    what = ("seeds (run.seeds)" if method == "seeds"
+            else "stretches (reduce --blocks, with at least a few recurrences each)")
+    return (f"intervals unreliable: {units} resampling unit{'s' * (units != 1)} ({method}); "
+            f"at least {MIN_UNITS} {what} are needed")
+
+
 def _fmt(est, lo, hi):
     if not np.isfinite(est):
         return "-"
@@ -34,7 +46,7 @@ def _fmt(est, lo, hi):
 
 
 def partial_text(s):
-    """The statement of a partial reduction ("" for a complete one; summaries before format 2 were)."""
+    """The statement of a partial reduction ("" for a complete one)."""
     return str(s["attrs"].get("partial", ""))
 
 
@@ -43,11 +55,13 @@ def table(s):
     a = s["attrs"]
     lines = [partial_text(s)] if partial_text(s) else []
     lines += [f"summary of {a['catalog']}: mu_c = {a['mu_c']}, window = {a['window']} blocks, "
-             f"b-value above mu = {a['b_cut']}, {level_text(a['level'])} intervals from "
-             f"{a['bootstrap']} bootstrap resamples", ""]
+              f"GR b above mu = {a['b_cut']}, {level_text(a['level'])} intervals from "
+              f"{a['bootstrap']} bootstrap resamples", ""]
     for i in range(len(s["points/N"])):
         lines.append(f"point {i}: " + point_label(s, i, list(PARAMS)) +
                      f"  (resampling {s['points/method'][i]}, {s['points/units'][i]} units)")
+        if unreliable(s, i):
+            lines.append(f"    WARNING: {unreliable(s, i)}")
         for name in NUMBERS:
             est, lo, hi = s[f"points/numbers/{name}"][i]
             lines.append(f"    {LABELS[name]:>18s}  {_fmt(est, lo, hi)}")

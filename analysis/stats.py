@@ -1,4 +1,4 @@
-"""Estimators on histograms: densities, peaks, Gutenberg-Richter b-value, bootstrap.
+"""Estimators on histograms: densities, peaks, the Gutenberg-Richter exponent, bootstrap.
 
 Everything here works on additive per-unit quantities (histogram counts, sums),
 so a statistic of any set of units is a function of their sum: that is what
@@ -11,8 +11,8 @@ import numpy as np
 LOG10_E = math.log10(math.e)
 
 # columns of the per-unit statistics array
-(N_EVENTS, N_LARGE, N_REC, SUM_TNU, N_REC_INT, SUM_TNU_INT, N_GR, SUM_MU_GR) = range(8)
-N_STATS = 8
+(N_EVENTS, N_LARGE, N_REC, SUM_TNU, N_REC_INT, SUM_TNU_INT, N_GR, SUM_MU_GR, SUM_MU2_GR) = range(9)
+N_STATS = 9
 
 
 def density(counts, edges, total):
@@ -26,36 +26,79 @@ def centers(edges):
     return 0.5 * (edges[1:] + edges[:-1])
 
 
-def find_peaks(counts, edges, rel_height=0.3, min_separation=4):
-    """Positions of the local maxima of a [1, 4, 6, 4, 1]-smoothed histogram.
+SMOOTHING = np.array([1, 4, 6, 4, 1]) / 16   # the histogram is smoothed with these weights (edges padded)
+PEAK_Z = 3.0    # a peak's prominence must exceed this many noise standard deviations
 
-    A peak must reach rel_height of the highest one and lie at least
-    min_separation bins from a higher peak. Returned in decreasing height; of equal
-    heights the lower bin counts as the higher (a stable sort: numpy's default sort
-    orders ties differently on different CPUs, so the peaks kept would too).
+
+def smooth(counts):
+    """The [1, 4, 6, 4, 1] / 16 smoothed histogram (the edge bins repeated beyond the edges)."""
+    return np.convolve(np.pad(np.asarray(counts, dtype=float), 2, mode="edge"), SMOOTHING, mode="valid")
+
+
+def poisson_noise(counts):
+    """Standard deviation of each smoothed bin if the counts were independent Poisson variables."""
+    padded = np.pad(np.asarray(counts, dtype=float), 2, mode="edge")
+    return np.sqrt(np.convolve(padded, SMOOTHING ** 2, mode="valid"))
+
+
+def prominence(s, i):
+    """(prominence, base bin) of the local maximum i of s, as scipy.signal.peak_prominences defines it:
+    on each side the lowest value before a higher one (or the end); the higher of the two is the base."""
+    base, level = -1, -np.inf
+    for step in (-1, 1):
+        j, low, where = i + step, np.inf, -1
+        while 0 <= j < len(s) and s[j] <= s[i]:
+            if s[j] < low:
+                low, where = s[j], j
+            j += step
+        if where >= 0 and low > level:
+            level, base = low, where
+    return (s[i] - level, base) if base >= 0 else (s[i], i)
+
+
+def find_peaks(counts, edges, noise, z=PEAK_Z):
+    """Positions (bin centres) of the significant peaks of a histogram, highest first.
+
+    The histogram is smoothed (`smooth`) and padded with an empty bin on each side, so that a
+    maximum at an edge is a peak and the highest bin always has a base. A local maximum
+    (the right end of a plateau) is a peak when its prominence (`prominence`) exceeds
+    z * sqrt(noise[peak]^2 + noise[base]^2), `noise` being the standard deviation of each
+    smoothed bin (reduce.py: from the bootstrap over resampling units, at least the Poisson
+    value). On equal heights the lower bin comes first.
     """
-    c = np.asarray(counts, dtype=float)
-    if c.sum() <= 0:
-        return np.zeros(0)
-    s = np.convolve(np.pad(c, 2, mode="edge"), np.array([1, 4, 6, 4, 1]) / 16, mode="valid")
-    is_max = np.r_[s[0] > s[1], (s[1:-1] >= s[:-2]) & (s[1:-1] > s[2:]), s[-1] > s[-2]]
-    candidates = [i for i in np.argsort(-s, kind="stable") if is_max[i] and s[i] >= rel_height * s.max()]
-    chosen = []
-    for i in candidates:
-        if all(abs(i - j) >= min_separation for j in chosen):
-            chosen.append(i)
-    return centers(edges)[chosen]
+    s = np.concatenate([[0.0], smooth(counts), [0.0]])
+    sd = np.concatenate([[0.0], np.asarray(noise, dtype=float), [0.0]])
+    found = []
+    for i in range(1, len(s) - 1):
+        if s[i] >= s[i - 1] and s[i] > s[i + 1]:
+            height, base = prominence(s, i)
+            if height > z * math.hypot(sd[i], sd[base]):
+                found.append(i)
+    found.sort(key=lambda i: (-s[i], i))
+    return centers(edges)[np.array(found, dtype=np.int64) - 1]
 
 
-def b_value(n, sum_mu, cut):
-    """Aki's maximum-likelihood Gutenberg-Richter b for magnitudes >= cut (continuous).
-
-    b = log10(e) / (mean(mu) - cut); its standard error is b / sqrt(n).
-    """
+def gr_b(n, sum_mu, cut):
+    """Aki's maximum-likelihood Gutenberg-Richter exponent ("GR b", not the model's b) of the
+    n magnitudes >= cut (continuous, no binning correction): log10(e) / (mean(mu) - cut)."""
     if n < 2:
         return np.nan
     excess = sum_mu / n - cut
     return LOG10_E / excess if excess > 0 else np.nan
+
+
+def gr_b_standard_error(n, sum_mu, sum_mu2, cut):
+    """Shi & Bolt (1982) standard error of GR b: ln(10) b^2 sqrt(sum (mu - mean)^2 / (n (n - 1))).
+
+    For independent magnitudes it is close to Aki's b / sqrt(n); it assumes independent events,
+    so the bootstrap interval over seeds or stretches is the one to trust for a correlated catalog.
+    """
+    b = gr_b(n, sum_mu, cut)
+    if not np.isfinite(b):
+        return np.nan
+    mean = sum_mu / n
+    squares = max(sum_mu2 - n * mean * mean, 0.0)
+    return math.log(10.0) * b * b * math.sqrt(squares / (n * (n - 1)))
 
 
 def gr_ks_distance(counts, edges, cut, b):

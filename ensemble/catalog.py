@@ -9,29 +9,15 @@ objects, no attribute writes), so each rank writes its own task's rows with
 independent writes and nothing collective is left in the hot path; a process
 killed at any moment leaves a file whose metadata is intact.
 
-    /events/task        int64    task index
-    /events/t           float64  onset time of the event
-    /events/epicenter   int64    first block to slide (0-based)
-    /events/mu          float64  magnitude log10(slip)
-    /events/slip        float64  sum of the slips of all blocks
-    /events/first       int64    lowest block that slipped
-    /events/last        int64    highest block that slipped
-    /events/n_slipped   int64    number of blocks that slipped
-    /events/boundary    bool     rupture reached block 0 or N-1
-    /events/duration    float64  time from onset until all blocks are at rest
-    /tasks/{point, seed_index, N, l, nu, a, b, c}    one row per task
-    /tasks/events_written   events of the task stored so far
-    /tasks/{rank, wall_time, events_per_second, seed_entropy, spawn_key}   provenance
-    /tasks/status      int64  0 open (not started, running or interrupted), 1 finished, 2 failed
-    /tasks/error       bytes  why a failed task failed (empty otherwise)
-    /tasks/integrator  bytes  the task's [integrator] as TOML (a failed task may be rerun with another)
-    /checkpoint/state   float64  per task two slots of [force (N), psi (N), since (2N), clock (2)]:
-                                 block i's force and psi hold at the two-float time
-                                 since[i] = (since[2i], since[2i+1]); clock = (hi, lo) now
-    /checkpoint/offset  int64    start of each task's slots in /checkpoint/state
-    /checkpoint/commit  int64    per task and slot: [sequence, events done incl. transient, events
-                                 written, CRC of the state slot, CRC of the written events, CRC of the row]
+    /events/*       one row per event; task k owns rows [k * E, (k + 1) * E), E = events_per_task
+    /tasks/*        one row per task: its parameters, committed count, provenance, status
+    /checkpoint/*   per task two slots of its state and a commit row for each
     attributes of /: config (resolved TOML text), version, format, events_per_task, transient
+
+Every dataset is a line of the table DATASETS below (unit, shape, meaning; printed at the end of
+this docstring); each dataset carries that line as its `description` attribute, written once
+at creation, so `h5dump -A` or any HDF5 viewer explains the file. Catalogs written before the
+attribute existed read the same.
 
 Commit order. A batch is committed as: its event rows (past the rows any commit
 points to), then the checkpoint into the slot not in use, then that slot's commit
@@ -74,6 +60,79 @@ PROVENANCE_FIELDS = {
     "seed_entropy": np.int64, "spawn_key": np.int64,
 }
 TEXT_BYTES = 512                      # /tasks/error and /tasks/integrator: fixed-length text
+
+# Every dataset, one line each: (unit, shape, meaning). The model is dimensionless
+# (docs/numerics.md): "model time", "model length" (slips; the plate's displacement nu t) and
+# "model force" name its scaled quantities, "1" is a pure number. Written at creation as each
+# dataset's `description` attribute (description()); analysis/export.py heads its CSV columns with it.
+_EVENT_ROWS = "(tasks * events_per_task,), task k's rows from k * events_per_task, committed ones valid"
+_TASK_ROWS = "(tasks,)"
+DATASETS = {
+    "events/task": ("index", _EVENT_ROWS, "task that recorded the event (row of /tasks)"),
+    "events/t": ("model time", _EVENT_ROWS, "onset time of the event"),
+    "events/epicenter": ("index", _EVENT_ROWS, "first block to slide (0-based)"),
+    "events/mu": ("log10 model length", _EVENT_ROWS, "magnitude log10(slip)"),
+    "events/slip": ("model length", _EVENT_ROWS, "sum of the slips of all blocks"),
+    "events/first": ("index", _EVENT_ROWS, "lowest block that slipped"),
+    "events/last": ("index", _EVENT_ROWS, "highest block that slipped"),
+    "events/n_slipped": ("count", _EVENT_ROWS, "number of blocks that slipped"),
+    "events/boundary": ("bool", _EVENT_ROWS, "the rupture reached block 0 or N-1"),
+    "events/duration": ("model time", _EVENT_ROWS, "time from onset until all blocks are at rest"),
+    "tasks/point": ("index", _TASK_ROWS, "parameter point (position in the product of the [sweep] lists)"),
+    "tasks/seed_index": ("index", _TASK_ROWS, "realisation of its point; task = point * run.seeds + seed_index"),
+    "tasks/N": ("count", _TASK_ROWS, "number of blocks of the chain"),
+    "tasks/l": ("1", _TASK_ROWS, "inter-block spring stiffness l (l^2 relative to the driver spring)"),
+    "tasks/nu": ("model length / model time", _TASK_ROWS, "loading velocity of the driver plate"),
+    "tasks/a": ("model force", _TASK_ROWS, "velocity strengthening a ln(1 + v)"),
+    "tasks/b": ("model force", _TASK_ROWS, "state weakening b ln(theta)"),
+    "tasks/c": ("model force", _TASK_ROWS, "constant friction"),
+    "tasks/events_written": ("count", _TASK_ROWS,
+                             "events of the task stored so far (a mirror; readers use /checkpoint/commit)"),
+    "tasks/rank": ("index", _TASK_ROWS, "MPI rank that finished the task (-1 until then)"),
+    "tasks/wall_time": ("s", _TASK_ROWS, "wall-clock time the task took on that rank (NaN until finished)"),
+    "tasks/events_per_second": ("1/s", _TASK_ROWS,
+                                "recorded events per second of kernel time (NaN until finished)"),
+    "tasks/seed_entropy": ("1", _TASK_ROWS, "run.seed: the task drew from SeedSequence(seed_entropy, "
+                                            "spawn_key=(spawn_key,)) (-1 until finished)"),
+    "tasks/spawn_key": ("index", _TASK_ROWS, "spawn key of the task's SeedSequence, its task index (-1 until finished)"),
+    "tasks/status": ("code", _TASK_ROWS, "0 open (not started, running or interrupted), 1 finished, 2 failed"),
+    "tasks/error": ("text", _TASK_ROWS, f"why a failed task failed, empty otherwise (UTF-8, {TEXT_BYTES} bytes at most)"),
+    "tasks/integrator": ("text", _TASK_ROWS, "the task's [integrator] as TOML (a failed task may be rerun "
+                                             f"with another; UTF-8, {TEXT_BYTES} bytes at most)"),
+    "checkpoint/state": ("mixed", "(sum over tasks of 2 (4 N + 2),)",
+                         "per task two slots of [force (N, model force), psi = ln theta (N), since (2N, model "
+                         "time), clock (2, model time)]: block i's force and psi hold at the two-float time "
+                         "(since[2i], since[2i+1]); clock = (hi, lo) now"),
+    "checkpoint/offset": ("index", _TASK_ROWS, "start of each task's two slots in /checkpoint/state"),
+    "checkpoint/commit": ("count, CRC-32", "(tasks, 2 slots, 6)",
+                          "per task and slot: [sequence, events done incl. transient, events written, CRC of "
+                          "the state slot, CRC of the written events, CRC of the row]; the valid row with the "
+                          "highest sequence is the task's truth"),
+}
+# columns of Reader.tasks that are not /tasks datasets or are read from elsewhere
+READER_TASKS = {
+    "events_written": ("count", _TASK_ROWS, "events of the task committed (from its checksummed commit row)"),
+    "events_done": ("count", _TASK_ROWS, "events the task has simulated, its transient included (from its "
+                                         "commit row)"),
+}
+
+
+def description(entry):
+    """(unit, shape, meaning) -> the one line stored as a dataset's `description` attribute."""
+    unit, shape, meaning = entry
+    return f"{meaning} [{unit}]; shape {shape}"
+
+
+def schema(table=None):
+    """The table of datasets as text, one line per dataset (the end of this module's docstring)."""
+    table = DATASETS if table is None else table
+    width = max(len(name) for name in table) + 1
+    return "\n".join(f"    /{name:{width}s} {description(entry)}" for name, entry in table.items())
+
+
+if __doc__:    # (None under python -OO)
+    __doc__ += "\nDatasets (DATASETS):\n\n" + schema() + "\n"
+
 OPEN, FINISHED, FAILED = 0, 1, 2      # /tasks/status
 STATUS_NAMES = {OPEN: "open", FINISHED: "finished", FAILED: "failed"}
 _FILL = {np.int64: -1, np.float64: np.nan, np.bool_: False}
@@ -227,6 +286,10 @@ class _Layout:
                           dcpl=_early_allocation())
         cp.create_dataset("offset", data=offset)
         cp.create_dataset("commit", data=np.zeros((len(tasks), 2, NCOMMIT), dtype=np.int64))
+        # metadata, written once here like the rest of the layout; under mpio every rank runs
+        # this with the same values in the same order, as attribute writes are collective
+        for name, entry in DATASETS.items():
+            h5[name].attrs["description"] = description(entry)
 
     def _fail(self, task, what):
         return CatalogError(f"{self.path}: task {task}: {what} (corrupt catalog)")

@@ -1,18 +1,64 @@
+import faulthandler
 import os
-import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from ensemble import catalog
 from ensemble.config import Integrator, Model
 from ensemble.events import advance_to_onset, check, run_event
 from ensemble.integrators import kernel_args
 from ensemble.model.chain import simulate
 from ensemble.model.workspace import NDIAG, UNLIMITED, Workspace
 
-ROOT = Path(__file__).resolve().parents[1]
+from .processes import ROOT, child_env, run_bounded  # noqa: F401 (ROOT: test modules import it from here)
+
+# -- a backstop behind the per-test timeout ----------------------------------------------------
+# pytest-timeout (setup.cfg: `timeout`, method "signal") fails a test that runs too long and the
+# session goes on; the test's `finally` blocks kill what it started. Its SIGALRM is served between
+# bytecodes, though, and so is the thread method's timer thread (it needs the GIL): a numba kernel
+# looping for ever in this process holds the GIL and is out of reach of both. faulthandler's
+# watchdog is a C thread: BACKSTOP_SECONDS after the test's own limit it prints the stack of every
+# thread and ends the session (exit 1).
+BACKSTOP_SECONDS = 120
+_STDERR = pytest.StashKey[int]()
+
+
+def pytest_configure(config):
+    # stderr itself, kept for the watchdog: during a test fd 2 is pytest's capture file
+    config.stash[_STDERR] = os.dup(sys.stderr.fileno())
+
+
+def pytest_unconfigure(config):
+    os.close(config.stash[_STDERR])
+
+
+def timeout_of(item):
+    """The timeout pytest-timeout applies to `item` (marker > --timeout > PYTEST_TIMEOUT > ini), 0 for none."""
+    mark = item.get_closest_marker("timeout")
+    if mark is not None:
+        value = mark.args[0] if mark.args else mark.kwargs.get("timeout")
+    else:
+        value = item.config.getoption("timeout", None) or os.environ.get("PYTEST_TIMEOUT")
+        if value is None:
+            try:
+                value = item.config.getini("timeout")
+            except ValueError:      # pytest-timeout is not installed
+                value = None
+    return float(value or 0)
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_protocol(item, nextitem):
+    limit = timeout_of(item)
+    if limit > 0:
+        faulthandler.dump_traceback_later(limit + BACKSTOP_SECONDS, exit=True, file=item.config.stash[_STDERR])
+    try:
+        return (yield)
+    finally:
+        if limit > 0:
+            faulthandler.cancel_dump_traceback_later()
 
 
 def developed_state(model, events, seed=1, dt=1e-3):
@@ -37,10 +83,17 @@ def next_event(force, psi, model, dt, v_start=0.0):
 
 
 def run_cli(*args, cwd=None, timeout=600):
-    """`python -m ensemble ARGS` in a subprocess; a hang fails the test (TimeoutExpired) instead of the suite."""
-    env = dict(os.environ, NUMBA_CACHE_DIR=os.environ.get("NUMBA_CACHE_DIR", str(ROOT / ".numba_cache")))
-    return subprocess.run([sys.executable, "-m", "ensemble", *map(str, args)], cwd=cwd,
-                          capture_output=True, text=True, env=env, timeout=timeout)
+    """`python -m ensemble ARGS` in a subprocess; a hang fails the test, showing the output."""
+    return run_bounded([sys.executable, "-m", "ensemble", *args], timeout, cwd=cwd, env=child_env())
+
+
+def committed(out):
+    """True once the run writing catalog `out` has committed a batch of events (readable, not yet renamed)."""
+    try:
+        _, tasks, _ = catalog.read_tasks(catalog.partial_path(out))
+    except catalog.CatalogError:
+        return False      # not created yet, or open for writing at that moment
+    return tasks["events_written"].sum() > 0
 
 
 def write_config(path, **sections):

@@ -5,7 +5,9 @@
 Nothing here is imported by the package: the faults are injected by patching, from outside.
 """
 import os
+import signal
 import sys
+import time
 
 import h5py
 
@@ -64,17 +66,71 @@ def fail_on_rank(rank, after_calls=1):
     runner.event_rows = patched
 
 
+def _signal_self(signum):
+    os.kill(os.getpid(), signum)
+    signal.getsignal(signum)   # the handler runs between bytecodes: before this returns
+
+
+def signal_at_write(signum, what="write /events/task", nth=1):
+    """Send this process `signum` just before its `nth` write (or flush) named `what` (as log_writes
+    names them; by default: the first batch of events, which is then committed before the run
+    stops): an interruption at a known point of the run, however fast it is."""
+    seen = [0]
+
+    def on_write(i, name):
+        if name == what:
+            seen[0] += 1
+            if seen[0] == nth:
+                _signal_self(signum)
+    _count_writes(on_write)
+
+
+def signal_when_paused(signum):
+    """Send this process `signum` when a kernel call first ends inside an event (the work budget
+    spent) after the transient: the stop then checkpoints while an event is paused."""
+    from ensemble import runner
+    advance = runner.Trajectory.advance
+    sent = [False]
+
+    def patched(self, n, *args, **kwargs):
+        out = advance(self, n, *args, **kwargs)
+        if not sent[0] and len(out[0]) < n and self.done > self.cfg.run.transient:
+            sent[0] = True
+            _signal_self(signum)
+        return out
+    runner.Trajectory.advance = patched
+
+
+def hold(ready, go, rank=0, seconds=300):
+    """Hold the run at its first kernel call (on MPI rank `rank`; the lock is taken, the catalog
+    open) until the file `go` exists, after creating `ready`; a RuntimeError after `seconds`."""
+    from ensemble import runner
+    advance = runner.Trajectory.advance
+    held = [False]
+
+    def patched(self, *args, **kwargs):
+        if not held[0]:
+            held[0] = True
+            from mpi4py import MPI
+            if MPI.COMM_WORLD.Get_rank() == rank:
+                open(ready, "w").close()
+                deadline = time.monotonic() + seconds
+                while not os.path.exists(go):
+                    if time.monotonic() > deadline:
+                        raise RuntimeError(f"held for {seconds} s: {go} never appeared")
+                    time.sleep(0.05)
+        return advance(self, *args, **kwargs)
+    runner.Trajectory.advance = patched
+
+
 def signal_after_rename(signum):
     """Send this process `signum` right after the run renames its finished catalog."""
-    import signal
-
     from ensemble import runner
     replace = os.replace
 
     def patched(src, dst):
         replace(src, dst)
-        os.kill(os.getpid(), signum)
-        signal.getsignal(signum)   # the handler runs between bytecodes: before the run returns
+        _signal_self(signum)
     runner.os.replace = patched
 
 

@@ -13,7 +13,8 @@ here the slow and obvious way, from the raw events:
 - a task of n events is cut into k stretches; event i belongs to stretch floor(i k / n) and a
   recurrence to the stretch of its starting event;
 - the mode is the centre of the highest bin of the T nu histogram (the lowest such bin on a tie);
-- Aki's b = log10(e) / (mean(mu >= cut) - cut), NaN with fewer than two magnitudes;
+- GR b (Aki) = log10(e) / (mean(mu >= cut) - cut), NaN with fewer than two magnitudes; its
+  standard error (Shi & Bolt) ln(10) b^2 sqrt(sum (mu - mean)^2 / (n (n - 1)));
 - the KS distance compares, at the upper edge of each bin lying at or above the cut, the share
   of the binned magnitudes (from the first such bin to the top edge) below that edge with the
   fitted law 1 - 10^(-b (edge - cut));
@@ -26,11 +27,14 @@ here the slow and obvious way, from the raw events:
   task; bootstrap resamples drawn as rng.integers(0, units, (bootstrap, units)) from
   default_rng(SeedSequence(seed, spawn_key=(N, bits(l), bits(nu), bits(a), bits(b), bits(c))))
   with bits(x) the binary64 pattern of x as an unsigned integer, first for the numbers and
-  curves, then (if there is a peak and >= 2 units) for the peaks; intervals are the
+  curves, then (with >= 2 units and recurrences) for the peaks; intervals are the
   (1 - level) / 2 and (1 + level) / 2 quantiles of the resampled values, NaNs left out (linear
   interpolation between order statistics);
-- peaks: PEAK_RULE below, a plain transcription of the rule documented in stats.find_peaks;
-  each peak's interval from the nearest peak of every resample within PEAK_RULE["match_bins"];
+- peaks: PEAK_RULE below, a plain transcription of the rule documented in stats.find_peaks, with
+  the noise of each smoothed bin the larger of its Poisson value and the sample standard deviation
+  of the smoothed bootstrap resamples (drawn after those of the numbers, when there are >= 2 units
+  and recurrences); each peak's interval from the nearest peak of every resample within
+  PEAK_RULE["match_bins"];
 - a reduction is partial if a catalog's name ends in .partial or one of its tasks is not
   finished (status 1) or holds fewer than events_per_task events; the summary then states the
   events reduced of those expected and names those catalogs.
@@ -47,66 +51,71 @@ import numpy as np
 
 LOG10_E = math.log10(math.e)
 NUMBERS = ("n_events", "n_large", "fraction_large", "n_recurrences", "mean_tnu", "mode_tnu",
-           "mean_tnu_interior", "b_value", "ks_gr")
+           "mean_tnu_interior", "gr_b", "gr_b_se", "ks_gr")
 # columns of /per_task/numbers, in the order analysis/stats.py documents
 PER_TASK_COLUMNS = ("n_events", "n_large", "n_rec", "sum_tnu", "n_rec_int", "sum_tnu_int",
-                    "n_gr", "sum_mu_gr")
+                    "n_gr", "sum_mu_gr", "sum_mu2_gr")
 PARAMS = ("N", "l", "nu", "a", "b", "c")
 
 # -- the documented peak rule, in one place (replace this block when the finder changes) -----
 
 PEAK_RULE = {
     "kernel": (1, 4, 6, 4, 1),   # smoothing weights (/ 16), the histogram padded with its edge values
-    "rel_height": 0.3,           # a peak reaches this share of the highest smoothed value
-    "min_separation": 4,         # bins from any higher peak already chosen (of equal heights the
-                                 # lower bin counts as the higher)
+    "z": 3.0,                    # prominence > z * sqrt(noise(peak)^2 + noise(base)^2)
     "match_bins": 5,             # a resample's nearest peak counts for a base peak within this many bins
 }
 
 
-def _candidates(counts):
-    """(smoothed histogram, candidate bins highest first) by PEAK_RULE; None for an empty one."""
+def smoothed(counts):
     c = [float(x) for x in counts]
-    n = len(c)
-    if sum(c) <= 0:
-        return None
     w = PEAK_RULE["kernel"]
     padded = [c[0], c[0]] + c + [c[-1], c[-1]]
-    s = [sum(w[k] * padded[i + k] for k in range(5)) / sum(w) for i in range(n)]
-    candidates = []
-    for i in range(n):
-        if i == 0:
-            is_max = s[0] > s[1]
-        elif i == n - 1:
-            is_max = s[i] > s[i - 1]
-        else:   # the right end of a plateau is its maximum
-            is_max = s[i] >= s[i - 1] and s[i] > s[i + 1]
-        if is_max and s[i] >= PEAK_RULE["rel_height"] * max(s):
-            candidates.append(i)
-    candidates.sort(key=lambda i: (-s[i], i))
-    return s, candidates
+    return [sum(w[k] * padded[i + k] for k in range(5)) / sum(w) for i in range(len(c))]
 
 
-def plain_peaks(counts, edges):
-    """Peak positions (bin centres) of a histogram, highest first, by PEAK_RULE."""
-    found = _candidates(counts)
-    if found is None:
+def poisson_sd(counts):
+    """sd of each smoothed bin for independent Poisson counts: sqrt(sum w_k^2 c_k) / 16."""
+    c = [float(x) for x in counts]
+    w = PEAK_RULE["kernel"]
+    padded = [c[0], c[0]] + c + [c[-1], c[-1]]
+    return [math.sqrt(sum(w[k] ** 2 * padded[i + k] for k in range(5))) / sum(w) for i in range(len(c))]
+
+
+def plain_peaks(counts, edges, noise):
+    """Peak positions (bin centres), highest first (lower bin first on a tie), by PEAK_RULE: local
+    maxima (right end of a plateau) of the smoothed histogram padded with a zero on each side whose
+    prominence (height above the higher of the lowest points on each side before a higher value)
+    exceeds z times the combined noise of the peak and that lowest point."""
+    if sum(float(x) for x in counts) <= 0:
         return []
+    s = [0.0] + smoothed(counts) + [0.0]
+    sd = [0.0] + list(noise) + [0.0]
     chosen = []
-    for i in found[1]:
-        if all(abs(i - j) >= PEAK_RULE["min_separation"] for j in chosen):
+    for i in range(1, len(s) - 1):
+        if not (s[i] >= s[i - 1] and s[i] > s[i + 1]):
+            continue
+        sides = []
+        for step in (-1, 1):
+            j, low = i + step, None
+            while 0 <= j < len(s) and s[j] <= s[i]:
+                if low is None or s[j] < s[low]:
+                    low = j
+                j += step
+            if low is not None:
+                sides.append(low)
+        base = max(sides, key=lambda j: s[j])
+        if s[i] - s[base] > PEAK_RULE["z"] * math.sqrt(sd[i] ** 2 + sd[base] ** 2):
             chosen.append(i)
-    return [0.5 * (edges[i] + edges[i + 1]) for i in chosen]
+    chosen.sort(key=lambda i: (-s[i], i))
+    return [0.5 * (edges[i - 1] + edges[i]) for i in chosen]
 
 
 def tied_peaks(counts):
-    """True if two candidates within min_separation have the same height (the tie rule decides)."""
-    found = _candidates(counts)
-    if found is None:
+    """True if the smoothed histogram has two equal neighbouring values (a plateau: the rule decides)."""
+    if sum(float(x) for x in counts) <= 0:
         return False
-    s, cand = found
-    return any(s[i] == s[j] and abs(i - j) < PEAK_RULE["min_separation"]
-               for a, i in enumerate(cand) for j in cand[a + 1:])
+    s = smoothed(counts)
+    return any(s[i] == s[i + 1] and s[i] > 0 for i in range(len(s) - 1))
 
 
 # -- plain statistics ---------------------------------------------------------------------
@@ -150,12 +159,22 @@ def recurrences(t, epi, mu, boundary, mu_c, window):
     return out
 
 
-def b_value(mu, cut):
+def gr_b(mu, cut):
     m = [x for x in mu if x >= cut]
     if len(m) < 2:
         return math.nan
     excess = sum(m) / len(m) - cut
     return LOG10_E / excess if excess > 0 else math.nan
+
+
+def gr_b_se(mu, cut):
+    """Shi & Bolt: ln(10) b^2 sqrt(sum (m - mean)^2 / (n (n - 1)))."""
+    b = gr_b(mu, cut)
+    if not math.isfinite(b):
+        return math.nan
+    m = [x for x in mu if x >= cut]
+    mean = sum(m) / len(m)
+    return math.log(10.0) * b * b * math.sqrt(sum((x - mean) ** 2 for x in m) / (len(m) * (len(m) - 1)))
 
 
 def ks_distance(mu, edges, cut, b):
@@ -191,13 +210,13 @@ def statistics(mu, tnu, interior, opt):
                 best = k
         mode = 0.5 * (te[best] + te[best + 1])
     n, n_large = len(mu), int(np.count_nonzero(mu >= opt["mu_c"]))
-    b = b_value(mu, opt["b_cut"])
+    b = gr_b(mu, opt["b_cut"])
     numbers = {
         "n_events": n, "n_large": n_large, "fraction_large": n_large / n if n else math.nan,
         "n_recurrences": len(tnu), "mean_tnu": tnu.sum() / len(tnu) if len(tnu) else math.nan,
         "mode_tnu": mode,
         "mean_tnu_interior": tnu[interior].sum() / interior.sum() if interior.any() else math.nan,
-        "b_value": b, "ks_gr": ks_distance(mu, me, opt["b_cut"], b),
+        "gr_b": b, "gr_b_se": gr_b_se(mu, opt["b_cut"]), "ks_gr": ks_distance(mu, me, opt["b_cut"], b),
     }
     curves = {"mu": density(histogram(mu, me), me, n),
               "tnu": density(h_t, te, len(tnu)),
@@ -241,7 +260,7 @@ class Task:
             mu_h[s], t_h[s], ti_h[s] = histogram(mu, me), histogram(tnu, te), histogram(tnu[interior], te)
             gr = mu[mu >= opt["b_cut"]]
             numbers[s] = [len(mu), np.count_nonzero(mu >= opt["mu_c"]), len(tnu), tnu.sum(),
-                          interior.sum(), tnu[interior].sum(), len(gr), gr.sum()]
+                          interior.sum(), tnu[interior].sum(), len(gr), gr.sum(), (gr ** 2).sum()]
         return mu_h, t_h, ti_h, numbers
 
 
@@ -290,16 +309,26 @@ def point(tasks, params, opt):
 def _peaks(units, m, opt, rng, q):
     te = opt["tnu_edges"]
     hist = [histogram(u[1], te) for u in units]
-    base = plain_peaks(sum(hist), te)
-    tied = tied_peaks(sum(hist))
-    if not base or m < 2:
+    total = sum(hist)
+    noise = poisson_sd(total)
+    resamples = []
+    if m >= 2 and total.sum() > 0:
+        resamples = [sum(hist[p] for p in pick) for pick in rng.integers(0, m, size=(opt["bootstrap"], m))]
+        sm = [smoothed(c) for c in resamples]
+        for k in range(len(noise)):
+            values = [r[k] for r in sm]      # sample standard deviation over the resamples
+            mean = sum(values) / len(values)
+            spread = math.sqrt(sum((v - mean) ** 2 for v in values) / (len(values) - 1))
+            noise[k] = max(noise[k], spread)
+    base = plain_peaks(total, te, noise)
+    tied = tied_peaks(total)
+    if not base or not resamples:
         return [(b, math.nan, math.nan) for b in base], tied
     width = te[1] - te[0]
     found = [[] for _ in base]
-    for pick in rng.integers(0, m, size=(opt["bootstrap"], m)):
-        counts = sum(hist[p] for p in pick)
+    for counts in resamples:
         tied = tied or tied_peaks(counts)
-        resampled = plain_peaks(counts, te)
+        resampled = plain_peaks(counts, te, noise)
         for i, b in enumerate(base):
             if not resampled:
                 continue
@@ -428,7 +457,7 @@ def read_summary(path):
 # numpy's): the largest relative differences measured (tests/test_reduction.py's summaries and the
 # real catalog's of tests/test_analysis.py) were 1.5e-14 for
 # ks_gr (a small difference of nearly equal CDFs, inheriting b's ulps through 10 ** (-b x)),
-# 2.5e-15 for b_value, 3.7e-15 for interval ends and 4e-16 for the per-task sums. 1e-12 leaves
+# 2.5e-15 for gr_b, 3.7e-15 for interval ends and 4e-16 for the per-task sums. 1e-12 leaves
 # room for other data and still tells any real change apart.
 RTOL = 1e-12
 

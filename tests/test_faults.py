@@ -1,8 +1,9 @@
 """Faults, serially: crashes at every write of a batch, corrupt files, concurrent runs, stale locks,
 a full disk, bad output paths, late signals, and what `status` says in each case.
 
-Every subprocess runs under a timeout, and waits are on conditions (a committed batch, a held
-lock), not on sleeps of a guessed length.
+Every command runs under a timeout (tests/processes.py), waits are on conditions (a committed
+batch, a progress line), not on sleeps of a guessed length, and an interruption that must come
+before the run ends is injected at a known point (tests/inject.py), not sent at a guessed time.
 """
 import os
 import shutil
@@ -10,7 +11,6 @@ import signal
 import socket
 import subprocess
 import sys
-import threading
 import time
 
 import h5py
@@ -20,26 +20,21 @@ import pytest
 from ensemble import catalog, lock
 from ensemble.integrity import commit_crc
 
-from .conftest import ROOT, run_cli, write_config
+from .conftest import committed, write_config
 from .inject import CRASH_CODE
+from .processes import ROOT, Started, child_env, run_bounded, wait_for
 
-TIMEOUT = 120
-
-
-def env(**extra):
-    return dict(os.environ, NUMBA_CACHE_DIR=os.environ.get("NUMBA_CACHE_DIR", str(ROOT / ".numba_cache")),
-                OMP_NUM_THREADS="1", NUMBA_NUM_THREADS="1", **extra)
+TIMEOUT = 120     # seconds for any one command or wait: what they take is a few
 
 
 def injected(setup, *argv, timeout=TIMEOUT):
     """Run `python -m ensemble argv` in a subprocess after `setup` (code using tests.inject)."""
     code = f"import sys; sys.path.insert(0, {str(ROOT)!r}); from tests import inject; {setup}; inject.main({list(map(str, argv))!r})"
-    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env(), timeout=timeout)
+    return run_bounded([sys.executable, "-c", code], timeout, env=child_env())
 
 
 def cli(*args, timeout=TIMEOUT):
-    return subprocess.run([sys.executable, "-m", "ensemble", *map(str, args)], capture_output=True, text=True,
-                          env=env(), timeout=timeout)
+    return run_bounded([sys.executable, "-m", "ensemble", *args], timeout, env=child_env())
 
 
 def same_events(path_a, path_b):
@@ -147,27 +142,9 @@ def test_an_out_of_range_commit_row_with_a_valid_checksum_is_refused(interrupted
     assert res.returncode == 1 and "task 0" in res.stderr and "out of range" in res.stderr
 
 
-def start(cfg, out, *extra):
-    return subprocess.Popen([sys.executable, "-m", "ensemble", "run", cfg, "-o", out, *extra],
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env())
-
-
-def wait_until(condition, proc, timeout=TIMEOUT):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if condition():
-            return
-        assert proc.poll() is None, proc.communicate()[0]
-        time.sleep(0.05)
-    raise AssertionError("condition not met in time")
-
-
-def committed(out):
-    try:
-        _, tasks, _ = catalog.read_tasks(catalog.partial_path(out))
-    except catalog.CatalogError:
-        return False
-    return tasks["events_written"].sum() > 0
+def start(cfg, out, *extra, **kwargs):
+    """`run` in the background (a Started: use it in a `with` block)."""
+    return Started([sys.executable, "-m", "ensemble", "run", cfg, "-o", out, *extra], env=child_env(), **kwargs)
 
 
 @pytest.fixture(scope="module")
@@ -178,23 +155,21 @@ def long_cfg(tmp_path_factory):
 
 
 def stop(proc):
+    """SIGTERM to a started run; (exit code, output) once it has ended."""
     proc.send_signal(signal.SIGTERM)
-    out, _ = proc.communicate(timeout=60)
-    return proc.returncode, out
+    return proc.wait(TIMEOUT, "the run after SIGTERM"), proc.output
 
 
 def test_a_second_run_on_a_live_output_is_refused_and_the_first_one_is_intact(long_cfg, tmp_path):
     out = tmp_path / "live.h5"
-    first = start(long_cfg, out)
-    try:
-        wait_until(lambda: committed(out), first)
+    with start(long_cfg, out) as first:        # 200000 events: live until stopped
+        wait_for(lambda: committed(out), TIMEOUT, "a committed batch", first)
         for extra in (["--force"], ["--resume"], []):
             res = cli("run", long_cfg, "-o", out, *extra)
             assert res.returncode == 2 and "in use by another run" in res.stderr, res.stderr
             assert f"pid {first.pid}" in res.stderr
         status = cli("status", out)
         assert status.returncode == 0 and "running" in status.stdout and "progress:" in status.stdout
-    finally:
         code, log = stop(first)
     assert code == 75, log
     assert not os.path.exists(lock.lock_path(out))          # released on the way out
@@ -205,22 +180,21 @@ def test_a_second_run_on_a_live_output_is_refused_and_the_first_one_is_intact(lo
 def test_status_shows_progress_within_seconds_of_the_start(long_cfg, tmp_path):
     """Before any flush (flush_seconds = 1000 here) the lock carries the live progress line."""
     out = tmp_path / "early.h5"
-    proc = start(long_cfg, out, "--set", "output.flush_seconds=1000")
-    try:
-        wait_until(lambda: "events 0/" not in lock.read_info(out).get("progress", "events 0/"), proc)
+    with start(long_cfg, out, "--set", "output.flush_seconds=1000") as proc:
+        wait_for(lambda: "events 0/" not in lock.read_info(out).get("progress", "events 0/"), TIMEOUT,
+                 "a progress line in the lock", proc)
         status = cli("status", out)
         assert "running" in status.stdout and "events/s" in status.stdout, status.stdout
         assert "open" in status.stdout         # per task, from the catalog being written
-    finally:
-        code, _ = stop(proc)
-    assert code == 75
+        code, log = stop(proc)
+    assert code == 75, log
 
 
 def test_a_stale_lock_of_a_dead_run_is_taken_over(small, tmp_path):
     d, cfg = small
     out = tmp_path / "stale.h5"
-    dead = subprocess.Popen(["sleep", "0"])
-    dead.wait()
+    dead = subprocess.Popen(["true"])
+    dead.wait(timeout=TIMEOUT)
     with open(lock.lock_path(out), "w") as fh:
         fh.write(f"host: {socket.gethostname()}\npid: {dead.pid}\nstarted: x\nheartbeat: {time.time():.1f}\n")
     res = cli("run", cfg, "-o", out)
@@ -233,8 +207,10 @@ def test_a_lock_from_another_host_with_a_fresh_heartbeat_is_refused_with_how_to_
     d, cfg = small
     out = tmp_path / "foreign.h5"
     path = lock.lock_path(out)
+    # an hour ahead (that host's clock may be): fresh however long the run below takes to start,
+    # where `now` would turn stale after lock.STALE_SECONDS
     with open(path, "w") as fh:
-        fh.write(f"host: node-elsewhere\npid: 4242\nstarted: x\nheartbeat: {time.time():.1f}\n")
+        fh.write(f"host: node-elsewhere\npid: 4242\nstarted: x\nheartbeat: {time.time() + 3600:.1f}\n")
     res = cli("run", cfg, "-o", out)
     assert res.returncode == 2 and "node-elsewhere" in res.stderr and f"rm {path}" in res.stderr
     assert not os.path.exists(catalog.partial_path(out))
@@ -269,16 +245,16 @@ def test_a_signal_just_after_the_rename_leaves_exit_0(small, tmp_path):
 
 def test_resume_continues_from_the_stored_config_without_retyping_overrides(long_cfg, tmp_path):
     """A run started with --set options, interrupted, is continued by `resume CATALOG` alone."""
-    sets = ["--set", "run.events=1500", "--set", "model.b=30", "--set", "integrator.dt=5e-4",
+    sets = ["--set", "run.events=200", "--set", "model.b=30", "--set", "integrator.dt=5e-4",
             "--set", "output.flush_seconds=0.2"]
     ref = tmp_path / "ref.h5"
     assert cli("run", long_cfg, "-o", ref, *sets).returncode == 0
     out = tmp_path / "cut.h5"
-    proc = start(long_cfg, out, *sets)
-    wait_until(lambda: committed(out), proc)
-    code, _ = stop(proc)
-    if code == 0:
-        pytest.skip("the run finished before it could be interrupted (an idle machine is too fast)")
+    # SIGTERM at the first batch of events: it is committed, the rest of the run is not done
+    res = injected("inject.signal_at_write(15)", "run", long_cfg, "-o", out, *sets)
+    assert res.returncode == 75, res.stdout + res.stderr
+    _, tasks, _ = catalog.read(catalog.partial_path(out))
+    assert 0 < tasks["events_written"].sum() < 400
     res = cli("resume", out)
     assert res.returncode == 0, res.stderr
     same_events(ref, out)
@@ -325,11 +301,11 @@ def small_disk(tmp_path):
     """A tmpfs of 300 KiB (needs root, as in CI; elsewhere the test cannot make a full disk)."""
     mount = tmp_path / "disk"
     mount.mkdir()
-    res = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=300k", "tmpfs", str(mount)], capture_output=True)
+    res = run_bounded(["mount", "-t", "tmpfs", "-o", "size=300k", "tmpfs", mount], TIMEOUT)
     if res.returncode != 0:
-        pytest.skip(f"cannot mount a small tmpfs here ({res.stderr.decode().strip()})")
+        pytest.skip(f"cannot mount a small tmpfs here ({res.stderr.strip()})")
     yield mount
-    subprocess.run(["umount", "-l", str(mount)], capture_output=True)
+    run_bounded(["umount", "-l", mount], TIMEOUT)
 
 
 def test_a_full_disk_stops_the_run_with_one_line_and_nothing_lost(small, small_disk):
@@ -347,7 +323,7 @@ def test_a_full_disk_stops_the_run_with_one_line_and_nothing_lost(small, small_d
     status = cli("status", small_disk / "b.h5")
     assert status.returncode == 0 and "interrupted" in status.stdout
     # space freed: the same catalog, resumed, completes (the small config fits)
-    subprocess.run(["mount", "-o", "remount,size=8m", str(small_disk)], check=True)
+    assert run_bounded(["mount", "-o", "remount,size=8m", small_disk], TIMEOUT).returncode == 0
     res = cli("resume", small_disk / "b.h5")
     assert res.returncode == 0, res.stderr
 
@@ -355,20 +331,13 @@ def test_a_full_disk_stops_the_run_with_one_line_and_nothing_lost(small, small_d
 def test_signal_during_kernel_compilation_is_acknowledged_at_once(small, tmp_path):
     """An empty numba cache: rank 0 says it compiles; SIGINT is acknowledged within seconds, exit 75."""
     d, cfg = small
-    proc = subprocess.Popen([sys.executable, "-m", "ensemble", "run", cfg, "-o", tmp_path / "c.h5"],
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                            env=dict(env(), NUMBA_CACHE_DIR=str(tmp_path / "cache")))
-    watchdog = threading.Timer(300, proc.kill)     # the reads below cannot block for longer
-    watchdog.start()
-    try:
-        lines = [proc.stdout.readline(), proc.stdout.readline()]      # "writing ...", "compiling ..."
-        assert lines[1].startswith("compiling kernels"), lines
+    with Started([sys.executable, "-m", "ensemble", "run", cfg, "-o", tmp_path / "c.h5"],
+                 env=child_env(NUMBA_CACHE_DIR=str(tmp_path / "cache"))) as proc:
+        wait_for(lambda: len(proc.lines) >= 2, TIMEOUT, "two lines of output", proc)
+        assert proc.lines[1].startswith("compiling kernels"), proc.lines   # after "writing ..."
         proc.send_signal(signal.SIGINT)
-        out, _ = proc.communicate()
-    finally:
-        watchdog.cancel()
-        proc.kill()
-    assert proc.returncode == 75, out
+        code, out = proc.wait(300, "the run after SIGINT while compiling"), proc.output
+    assert code == 75, out
     # acknowledged while compiling: before the kernels were ready, not after
     assert "SIGINT received while compiling kernels" in out.split("kernels ready")[0], out
     assert "interrupted (SIGINT)" in out
@@ -386,14 +355,11 @@ def test_kernel_calls_paused_in_the_middle_of_events_give_the_same_catalog(small
     res = cli("run", cfg, "-o", out, *slow, "--set", "run.poll_seconds=0.001")
     assert res.returncode == 0, res.stderr
     same_events(ref, out)
-    # and a checkpoint taken while an event is paused resumes to the same catalog
+    # and a checkpoint taken while an event is paused resumes to the same catalog (SIGTERM comes
+    # when a kernel call first ends inside an event; the stop request is served right after it)
     cut = tmp_path / "cut.h5"
-    proc = start(cfg, cut, *slow, "--set", "run.poll_seconds=0.001", "--set", "output.flush_seconds=0.05")
-    wait_until(lambda: committed(cut), proc)
-    code, _ = stop(proc)
-    if code == 0:
-        pytest.skip("the run finished before it could be interrupted")
-    assert code == 75
+    res = injected("inject.signal_when_paused(15)", "run", cfg, "-o", cut, *slow, "--set", "run.poll_seconds=0.001")
+    assert res.returncode == 75, res.stdout + res.stderr
     assert cli("resume", cut).returncode == 0
     same_events(ref, cut)
 
@@ -403,14 +369,11 @@ def test_a_signal_during_one_very_long_event_is_served_within_a_kernel_call(tmp_
     cfg = write_config(tmp_path / "slow.toml", model={"N": 200, "b": 20.0},
                        run={"seeds": 1, "events": 10, "transient": 0}, integrator={"method": "rk4", "dt": 1e-8})
     out = tmp_path / "slow.h5"
-    proc = start(cfg, out)
-    try:
+    with start(cfg, out) as proc:
         # the work loop has started (it refreshes the lock's progress line between kernel calls)
-        wait_until(lambda: lock.read_info(out).get("progress", "starting") != "starting", proc)
+        wait_for(lambda: lock.read_info(out).get("progress", "starting") != "starting", TIMEOUT,
+                 "the work loop", proc)
         code, log = stop(proc)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
     assert code == 75, log
     _, tasks, _ = catalog.read(catalog.partial_path(out))
     assert tasks["events_written"][0] == 0 and tasks["events_done"][0] == 0   # the event was in progress
@@ -430,19 +393,11 @@ def test_status_of_the_partial_name_and_of_a_damaged_catalog(interrupted, tmp_pa
 def test_a_closed_stdout_does_not_stop_the_run(small, tmp_path):
     """`run ... | head -1`: the log's reader goes away, the run goes on to a complete catalog."""
     d, cfg = small
-    proc = subprocess.Popen([sys.executable, "-m", "ensemble", "run", cfg, "-o", tmp_path / "p.h5",
-                             "--set", "output.progress_seconds=0.01"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env())
-    watchdog = threading.Timer(TIMEOUT, proc.kill)
-    watchdog.start()
-    try:
-        proc.stdout.readline()
-        proc.stdout.close()                   # as head does after its line
-        err = proc.stderr.read().decode()
-        proc.wait()
-    finally:
-        watchdog.cancel()
-    assert proc.returncode == 0, err
+    # the reader closes stdout after the first line, as head does
+    with start(cfg, tmp_path / "p.h5", "--set", "output.progress_seconds=0.01", separate_stderr=True,
+               stdout_lines=1) as proc:
+        code = proc.wait(TIMEOUT)
+    assert code == 0, proc.errors
     same_events(d / "full.h5", tmp_path / "p.h5")
 
 

@@ -1,27 +1,26 @@
-"""The runner under real `mpiexec`: rank-count invariance, writers, resume, failures."""
+"""The runner under real `mpiexec`: rank-count invariance, writers, resume, failures.
+
+Every job runs under a timeout that kills mpiexec and its ranks (tests/processes.py); waits are
+on conditions (a committed batch), not on sleeps.
+"""
 import os
 import shutil
 import signal
-import subprocess
 import sys
-import time
 
 import numpy as np
 import pytest
 
 from ensemble import catalog
 
-from .conftest import ROOT, run_cli, write_config
+from .conftest import committed, run_cli, write_config
+from .processes import ROOT, Started, child_env, descendants, run_bounded, wait_for
 
 pytestmark = pytest.mark.mpi
 MPIEXEC = shutil.which("mpiexec")
 if MPIEXEC is None:
     pytest.skip("mpiexec not found (make setup installs MPICH)", allow_module_level=True)
-
-
-def env():
-    return dict(os.environ, NUMBA_CACHE_DIR=os.environ.get("NUMBA_CACHE_DIR", str(ROOT / ".numba_cache")),
-                OMP_NUM_THREADS="1", NUMBA_NUM_THREADS="1")
+TIMEOUT = 120     # seconds for a wait or a short job
 
 
 def mpi_cmd(n, *args):
@@ -29,8 +28,15 @@ def mpi_cmd(n, *args):
 
 
 def mpirun(n, *args, timeout=300):
-    # a hung job fails the test with TimeoutExpired instead of hanging the suite
-    return subprocess.run(mpi_cmd(n, *args), capture_output=True, text=True, env=env(), timeout=timeout)
+    # a hung job fails the test (showing its output) instead of hanging the suite
+    return run_bounded(mpi_cmd(n, *args), timeout, env=child_env())
+
+
+def injected_cmd(n, setup, *argv):
+    """mpiexec -n n running `python -m ensemble argv` after `setup` (code using tests.inject)."""
+    code = (f"import sys; sys.path.insert(0, {str(ROOT)!r}); from tests import inject; {setup}; "
+            f"inject.main({list(map(str, argv))!r})")
+    return [MPIEXEC, "-n", str(n), sys.executable, "-c", code]
 
 
 def assert_same_events(path_a, path_b):
@@ -91,64 +97,39 @@ def resume_equals_uninterrupted(d, cfg, out):
 
 def rank_pids(root):
     """PIDs of the ranks started by mpiexec `root` (hydra puts each in its own session)."""
-    table = subprocess.run(["ps", "-eo", "pid=,ppid=,args="], capture_output=True, text=True).stdout
-    children = {}
-    for line in table.splitlines():
-        pid, ppid, args = line.split(None, 2)
-        children.setdefault(int(ppid), []).append((int(pid), args))
-    found, todo = [], [root]
-    while todo:
-        for pid, args in children.get(todo.pop(), []):
-            todo.append(pid)
-            if "-m ensemble run" in args and "hydra" not in args and "mpiexec" not in args:
-                found.append(pid)
+    found = []
+    for pid in descendants(root):
+        try:
+            with open(f"/proc/{pid}/cmdline", "rb") as fh:
+                args = fh.read().replace(b"\0", b" ").decode(errors="replace")
+        except OSError:
+            continue
+        if "-m ensemble run" in args and "hydra" not in args and "mpiexec" not in args:
+            found.append(pid)
     return sorted(found)
 
 
-def wait_for_commit(proc, out, timeout=120):
-    """Wait (polling, no sleep of a guessed length) until the run has committed a batch of events."""
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        assert proc.poll() is None, "the run ended before it was interrupted"
-        try:
-            _, tasks, _ = catalog.read_tasks(catalog.partial_path(out))
-            if tasks["events_written"].sum() > 0:
-                return
-        except catalog.CatalogError:
-            pass     # not created yet
-        time.sleep(0.1)
-    raise AssertionError(f"no batch committed within {timeout} s")
-
-
 def start_and_interrupt(cfg, out, how, writer="auto"):
-    """Start a 2-rank run, wait for a committed batch, interrupt it; returns (exit code, output)."""
-    proc = subprocess.Popen(mpi_cmd(2, "run", cfg, "-o", out, "--set", f'output.writer="{writer}"'),
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env(),
-                            start_new_session=True)
-    try:
-        wait_for_commit(proc, out)
-    except BaseException:
-        os.killpg(proc.pid, signal.SIGKILL)
-        raise
-    ranks = rank_pids(proc.pid)
-    assert len(ranks) == 2, ranks
-    if how == "kill":
-        for pid in ranks + [proc.pid]:
-            os.kill(pid, signal.SIGKILL)
-    else:
-        # Signal the ranks themselves, as Slurm does (hydra's mpiexec, when signalled, forwards
-        # the signal but then exits 0 whatever the ranks return). `one`/`other`: only the
-        # first/second rank by pid (rank order unknown), `all`: both.
-        sig, which = how
-        for pid in {"one": ranks[:1], "other": ranks[1:], "all": ranks}[which]:
-            os.kill(pid, sig)
-    try:
-        output, _ = proc.communicate(timeout=60)
-    except subprocess.TimeoutExpired:
-        os.killpg(proc.pid, signal.SIGKILL)
-        output, _ = proc.communicate()
-        raise AssertionError(f"the run hung after {how}:\n{output}") from None
-    return proc.returncode, output
+    """Start a 2-rank run, wait for a committed batch, interrupt it; returns (exit code, output).
+
+    The run lasts ~10 s on 2 ranks; the first batch is committed after ~1/8 of it, and the
+    signals follow within milliseconds (polling every 50 ms).
+    """
+    with Started(mpi_cmd(2, "run", cfg, "-o", out, "--set", f'output.writer="{writer}"'), env=child_env()) as proc:
+        wait_for(lambda: committed(out), TIMEOUT, "a committed batch", proc)
+        ranks = rank_pids(proc.pid)
+        assert len(ranks) == 2, ranks
+        if how == "kill":
+            for pid in ranks + [proc.pid]:
+                os.kill(pid, signal.SIGKILL)
+        else:
+            # Signal the ranks themselves, as Slurm does (hydra's mpiexec, when signalled, forwards
+            # the signal but then exits 0 whatever the ranks return). `one`/`other`: only the
+            # first/second rank by pid (rank order unknown), `all`: both.
+            sig, which = how
+            for pid in {"one": ranks[:1], "other": ranks[1:], "all": ranks}[which]:
+                os.kill(pid, sig)
+        return proc.wait(TIMEOUT, f"the run after {how}"), proc.output
 
 
 @pytest.mark.parametrize("sig,which,writer", [
@@ -198,11 +179,8 @@ def test_a_genuine_error_on_one_rank_aborts_the_job(tmp_path):
     cfg = write_config(tmp_path / "cfg.toml", sweep={"b": [20.0, 30.0]},
                        run={"seeds": 2, "events": 20000, "transient": 10},
                        output={"batch": 20, "flush_seconds": 0.2})
-    code = (f"import sys; sys.path.insert(0, {str(ROOT)!r}); from tests import inject; "
-            f"inject.fail_on_rank(1, after_calls=20); inject.main(['run', {str(cfg)!r}, '-o', "
-            f"{str(tmp_path / 'x.h5')!r}])")
-    res = subprocess.run([MPIEXEC, "-n", "2", sys.executable, "-c", code], capture_output=True, text=True,
-                         env=env(), timeout=120)    # task 0 alone would run for minutes more
+    res = run_bounded(injected_cmd(2, "inject.fail_on_rank(1, after_calls=20)", "run", cfg, "-o", tmp_path / "x.h5"),
+                      TIMEOUT, env=child_env())    # task 0 alone would run for minutes more: a hang fails
     assert res.returncode != 0
     assert "rank 1" in res.stderr and "injected failure" in res.stderr
     catalog.read(catalog.partial_path(tmp_path / "x.h5"))   # what was committed stays readable
@@ -214,30 +192,32 @@ def test_a_failing_task_does_not_stop_the_others_under_mpi(tmp_path):
                        run={"seeds": 1, "events": 100, "transient": 20}, integrator={"dt": 1e-3},
                        output={"batch": 50, "flush_seconds": 0.5})
     out = tmp_path / "x.h5"
-    res = mpirun(2, "run", cfg, "-o", out, timeout=120)
+    res = mpirun(2, "run", cfg, "-o", out, timeout=TIMEOUT)
     assert res.returncode == 1, res.stderr
     assert "task 1" in res.stderr and "stability" in res.stderr
     _, tasks, _ = catalog.read(catalog.partial_path(out))
     assert list(tasks["status"]) == [catalog.FINISHED, catalog.FAILED, catalog.FINISHED]
-    res = mpirun(2, "resume", out, "--set", "integrator.dt=2e-4", timeout=120)
+    res = mpirun(2, "resume", out, "--set", "integrator.dt=2e-4", timeout=TIMEOUT)
     assert res.returncode == 0, res.stderr
     _, tasks, _ = catalog.read(out)
     assert list(tasks["events_written"]) == [100] * 3
 
 
 def test_a_second_run_cannot_open_a_live_parallel_catalog(four_tasks, tmp_path):
-    """Two mpio runs on one output: the second is refused, the first ends with the right catalog."""
+    """Two mpio runs on one output: the second is refused, the first ends with the right catalog.
+
+    The first is held at its first kernel call (lock taken, catalog open) until the second has
+    been refused: it is live then, however fast it would have finished.
+    """
     d, cfg = four_tasks
     out = tmp_path / "two.h5"
-    first = subprocess.Popen(mpi_cmd(2, "run", cfg, "-o", out), stdout=subprocess.PIPE,
-                             stderr=subprocess.STDOUT, text=True, env=env(), start_new_session=True)
-    try:
-        wait_for_commit(first, out)
-        second = mpirun(2, "run", cfg, "-o", out, "--force", "--set", "model.b=30", timeout=120)
-        assert second.returncode == 2 and "in use by another run" in second.stderr
-        output, _ = first.communicate(timeout=120)
-    finally:
-        if first.poll() is None:
-            os.killpg(first.pid, signal.SIGKILL)
-    assert first.returncode == 0, output
+    ready, go = tmp_path / "held", tmp_path / "go"
+    with Started(injected_cmd(2, f"inject.hold({str(ready)!r}, {str(go)!r})", "run", cfg, "-o", out),
+                 env=child_env()) as first:
+        wait_for(ready.exists, TIMEOUT, "the first run held", first)
+        second = mpirun(2, "run", cfg, "-o", out, "--force", "--set", "model.b=30", timeout=TIMEOUT)
+        assert second.returncode == 2 and "in use by another run" in second.stderr, second.stderr
+        go.touch()
+        code = first.wait(300, "the first run")
+    assert code == 0, first.output
     assert_same_events(d / "full.h5", out)

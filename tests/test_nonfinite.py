@@ -11,7 +11,6 @@ No tolerances: statuses and block indices are exact.
 import json
 import math
 import os
-import subprocess
 import sys
 
 import numpy as np
@@ -23,7 +22,7 @@ from ensemble.model.onset import onset_delay
 from ensemble.model.schedule import tree_min, tree_set
 from ensemble.model.workspace import NDIAG, NONFINITE, OK, UNLIMITED, Workspace, tree_size
 
-from .conftest import ROOT
+from .processes import ROOT, run_bounded
 
 
 def test_tree_min_returns_a_block_whatever_the_keys():
@@ -131,8 +130,7 @@ def test_bounds_checked_hard_cases_and_bad_inputs(tmp_path):
     """
     env = dict(os.environ, NUMBA_BOUNDSCHECK="1", NUMBA_CACHE_DIR=str(tmp_path / "numba"),
                PYTHONPATH=str(ROOT), OMP_NUM_THREADS="1", NUMBA_NUM_THREADS="1")
-    res = subprocess.run([sys.executable, "-c", BOUNDSCHECK_SCRIPT], cwd=ROOT, env=env, capture_output=True,
-                         text=True, timeout=600)
+    res = run_bounded([sys.executable, "-c", BOUNDSCHECK_SCRIPT], 600, cwd=ROOT, env=env)
     assert res.returncode == 0, res.stderr
     outcome = json.loads(res.stdout.strip().splitlines()[-1])
     for kind in ("hard", "bad"):
