@@ -1,4 +1,4 @@
-"""python -m analysis reduce|plot|report ...
+"""python -m analysis reduce|plot|report|export ...
 
 reduce streams one or more catalogs into per-task histograms (ranks split the tasks of all
 catalogs under mpirun and rank 0 merges them), pools the tasks of equal parameters (N, l, nu,
@@ -6,7 +6,7 @@ a, b, c) into one point whichever catalog holds them, computes per point the mer
 and summary numbers with bootstrap intervals and writes a summary. The same trajectory (random
 stream and parameters) in two catalogs is refused; so is an unfinished run (a *.partial
 catalog, unfinished tasks) unless --partial is given. plot overlays the points of one or more
-summaries.
+summaries; report prints a summary's numbers; export writes a catalog's or a summary's tables.
 
 Exit codes: 0 done, 1 file error (missing, damaged or of the wrong kind: a summary or a
 config given for a catalog, an unfinished run without --partial, ...), 2 bad options (and the
@@ -43,7 +43,7 @@ def _parser():
     r.add_argument("--tnu-bins", default="0:2000:80", help="T*nu bins lo:hi:n (default 0:2000:80)")
     r.add_argument("--mu-c", type=float, default=4.0, help="large-event magnitude (default 4)")
     r.add_argument("--window", type=int, default=10, help="epicenter window in blocks (default 10)")
-    r.add_argument("--b-cut", type=float, default=3.0, help="magnitude cut of the b-value fit (default 3)")
+    r.add_argument("--b-cut", type=float, default=3.0, help="magnitude cut of the GR b fit (default 3)")
     r.add_argument("--bootstrap", type=int, default=1000, help="bootstrap resamples (default 1000)")
     r.add_argument("--level", type=float, default=0.95, help="interval coverage (default 0.95)")
     r.add_argument("--blocks", type=int, default=20,

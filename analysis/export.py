@@ -326,6 +326,8 @@ def _tables(path, names, chunk=catalog.READ_CHUNK):
     a = s["attrs"]
     settings = (f"reduced from {a.get('catalog', '?')} with "
                 + ", ".join(f"{k} = {a[k]}" for k in SUMMARY_SETTINGS if k in a))
+    if str(a.get("partial", "")):   # an unfinished run's reduction says so (analysis/merge.py)
+        settings += "; " + _one_line(a["partial"])
     return {name: build[name]() for name in names}, settings
 
 

@@ -262,6 +262,16 @@ def test_csv_holds_what_the_api_returns(files, source, directory, tables):
         assert [line[2:].split(":", 1)[0] for line in lines[start:count]] == names, table   # one line each
 
 
+def test_tables_of_a_partial_reduction_say_so(files):
+    """The catalog holds unfinished tasks (reduced with --partial): each summary table's header
+    states it, as the report's first line does."""
+    partial = summary.read(files / "cat.summary.h5")["attrs"]["partial"]
+    assert partial.startswith("PARTIAL")
+    for table in ("curves", "numbers", "peaks"):
+        lines = (files / "sum_csv" / f"{table}.csv").read_text(encoding="utf-8").splitlines()
+        assert sum(line.startswith("# reduced from ") and line.endswith("; " + partial) for line in lines) == 1
+
+
 def test_export_refuses_to_overwrite(files, tmp_path):
     out = tmp_path / "out"
     out.mkdir()
