@@ -122,7 +122,7 @@ def _check_counts(inputs, per_task):
 def _reduce_on(comm, args):
     from ensemble.abort import abort_on_error, on_root
 
-    from .reduce import MIN_UNITS, point_statistics
+    from .reduce import point_statistics, unreliable
     rank, size = comm.Get_rank(), comm.Get_size()
     opt, out, inputs = on_root(comm, lambda: _prepare(args), tuple(COLLECTIVE))
     mine = [g for g in range(len(inputs.tasks["point"])) if g % size == rank]
@@ -141,10 +141,9 @@ def _reduce_on(comm, args):
     if inputs.partial:
         print(inputs.partial)
     for i, p in enumerate(points):
-        if p["units"] < MIN_UNITS:
+        if unreliable(p["units"], p["method"]):
             print(f"warning: point {i} ({', '.join(f'{k} = {v:g}' for k, v in p['params'].items())}): "
-                  f"intervals from {p['units']} {p['method']} are unreliable; at least {MIN_UNITS} are "
-                  f"needed", file=sys.stderr)
+                  f"{unreliable(p['units'], p['method'])}", file=sys.stderr)
     methods = sorted({p["method"] for p in points})
     print(f"wrote {out}: {len(points)} parameter points, {len(per_task)} tasks"
           + (f" from {len(inputs.paths)} catalogs" if len(inputs.paths) > 1 else "")

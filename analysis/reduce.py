@@ -117,6 +117,16 @@ NUMBERS = ("n_events", "n_large", "fraction_large", "n_recurrences", "mean_tnu",
 MIN_UNITS = 10
 
 
+def unreliable(units, method):
+    """Why a point's intervals are not to be trusted ('' if they are): fewer than MIN_UNITS units."""
+    if units >= MIN_UNITS:
+        return ""
+    what = ("seeds (run.seeds)" if method == "seeds"
+            else "stretches (reduce --blocks, with at least a few recurrences each)")
+    return (f"intervals unreliable: {units} resampling unit{'s' * (units != 1)} ({method}); "
+            f"at least {MIN_UNITS} {what} are needed")
+
+
 def _units(per_task, task_ids, seeds):
     """Resampling units of a point: whole tasks if there are >= 2 seeds, else stretches."""
     stack = [per_task[k] for k in task_ids]

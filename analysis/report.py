@@ -1,7 +1,8 @@
 """The summary numbers of every parameter point as a text table."""
 import numpy as np
 
-from .reduce import MIN_UNITS, NUMBERS, PARAMS
+from . import reduce
+from .reduce import NUMBERS, PARAMS
 
 LABELS = {
     "n_events": "events", "n_large": "large", "fraction_large": "frac(mu>=mu_c)",
@@ -28,13 +29,7 @@ def point_label(s, i, keys=None):
 
 def unreliable(s, i):
     """A warning if point i's intervals rest on fewer than MIN_UNITS resampling units, else ''."""
-    units, method = int(s["points/units"][i]), s["points/method"][i]
-    if units >= MIN_UNITS:
-        return ""
-    what = ("seeds (run.seeds)" if method == "seeds"
-            else "stretches (reduce --blocks, with at least a few recurrences each)")
-    return (f"intervals unreliable: {units} resampling unit{'s' * (units != 1)} ({method}); "
-            f"at least {MIN_UNITS} {what} are needed")
+    return reduce.unreliable(int(s["points/units"][i]), s["points/method"][i])
 
 
 def _fmt(est, lo, hi):

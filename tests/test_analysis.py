@@ -31,6 +31,10 @@ def reduced(tmp_path_factory):
     assert run_cli("run", cfg, "-o", d / "cat.h5").returncode == 0
     res = run_analysis("reduce", d / "cat.h5", "-o", d / "sum.h5", "--bootstrap", "200", "--mu-c", "3.5")
     assert res.returncode == 0, res.stderr
+    # two seeds per point: reduce warns that the intervals rest on too few units, per point
+    for point in (0, 1):
+        assert (f"warning: point {point} (" in res.stderr and
+                "intervals unreliable: 2 resampling units (seeds); at least 10 seeds" in res.stderr), res.stderr
     return d
 
 
