@@ -122,7 +122,7 @@ def _check_counts(inputs, per_task):
 def _reduce_on(comm, args):
     from ensemble.abort import abort_on_error, on_root
 
-    from .reduce import point_statistics, unreliable
+    from .reduce import MIN_UNITS, point_statistics, unreliable
     rank, size = comm.Get_rank(), comm.Get_size()
     opt, out, inputs = on_root(comm, lambda: _prepare(args), tuple(COLLECTIVE))
     mine = [g for g in range(len(inputs.tasks["point"])) if g % size == rank]
@@ -134,7 +134,7 @@ def _reduce_on(comm, args):
     _check_counts(inputs, per_task)
     points = []
     for params, ids in inputs.points:
-        result = point_statistics(per_task, ids, len(ids), opt, merge.bootstrap_rng(opt.seed, params))
+        result = point_statistics(per_task, ids, opt, merge.bootstrap_rng(opt.seed, params))
         result["params"] = params
         points.append(result)
     summary.write(out, inputs, per_task, points, opt, force=args.force)
@@ -149,7 +149,7 @@ def _reduce_on(comm, args):
           + (f" from {len(inputs.paths)} catalogs" if len(inputs.paths) > 1 else "")
           + "; intervals from "
           f"{opt.bootstrap} bootstrap resamples over {' / '.join(methods)}"
-          + (" (one seed per point: block bootstrap over stretches of the trajectory)"
+          + (f" (fewer than {MIN_UNITS} seeds per point: block bootstrap over stretches of each trajectory)"
              if "blocks" in methods else ""))
     return 0
 

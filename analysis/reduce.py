@@ -2,10 +2,11 @@
 
 Each task is cut into `blocks` stretches of consecutive events; histograms and
 sums are kept per (task, stretch). Error bars come from resampling
-independent realisations: the seeds of a parameter point when it has two or
-more, else (one long trajectory) the stretches of that trajectory, a block
-bootstrap, which the summary says. Events within a trajectory are correlated,
-so resampling single events would understate the errors.
+independent realisations: the seeds of a parameter point when it has at least
+MIN_UNITS of them, else the stretches of every one of its trajectories (a block
+bootstrap: a few long trajectories, as in the paper's one seed per point, give
+many stretches but only a few seeds), which the summary says. Events within a
+trajectory are correlated, so resampling single events would understate the errors.
 """
 from dataclasses import dataclass
 
@@ -121,25 +122,25 @@ def unreliable(units, method):
     """Why a point's intervals are not to be trusted ('' if they are): fewer than MIN_UNITS units."""
     if units >= MIN_UNITS:
         return ""
-    what = ("seeds (run.seeds)" if method == "seeds"
-            else "stretches (reduce --blocks, with at least a few recurrences each)")
     return (f"intervals unreliable: {units} resampling unit{'s' * (units != 1)} ({method}); "
-            f"at least {MIN_UNITS} {what} are needed")
+            f"at least {MIN_UNITS} are needed: {MIN_UNITS} seeds (run.seeds), or {MIN_UNITS} stretches over all "
+            "its tasks (reduce --blocks stretches per task, each holding a few recurrences)")
 
 
-def _units(per_task, task_ids, seeds):
-    """Resampling units of a point: whole tasks if there are >= 2 seeds, else stretches."""
+def _units(per_task, task_ids):
+    """Resampling units of a point: its tasks if it has at least MIN_UNITS, else the stretches
+    of all its tasks (task by task, in task order)."""
     stack = [per_task[k] for k in task_ids]
-    if seeds >= 2:
+    if len(stack) >= MIN_UNITS:
         pack = lambda name: np.stack([getattr(h, name).sum(axis=0) for h in stack])  # noqa: E731
         return pack, "seeds"
     pack = lambda name: np.concatenate([getattr(h, name) for h in stack])  # noqa: E731
     return pack, "blocks"
 
 
-def point_statistics(per_task, task_ids, seeds, opt, rng):
+def point_statistics(per_task, task_ids, opt, rng):
     """Merged densities and summary numbers of one parameter point, with bootstrap intervals."""
-    pack, method = _units(per_task, task_ids, seeds)
+    pack, method = _units(per_task, task_ids)
     units = {name: pack(name) for name in ("mu", "tnu", "tnu_interior", "numbers")}
     widths = (units["mu"].shape[1], units["tnu"].shape[1])
     flat = np.concatenate([units["mu"], units["tnu"], units["tnu_interior"], units["numbers"]], axis=1)

@@ -101,8 +101,8 @@ DATASETS = {
                          "sum_mu2_gr (analysis/stats.py) per task and stretch"),
     **{f"points/{name}": (unit, _POINTS, f"{meaning}, of the point's tasks")
        for name, (unit, _, meaning) in ((n, catalog.DATASETS[f"tasks/{n}"]) for n in PARAMS)},
-    "points/method": ("text", _POINTS, "resampling units of the intervals: 'seeds' (the point's tasks) or "
-                                       "'blocks' (stretches of its one task)"),
+    "points/method": ("text", _POINTS, "resampling units of the intervals: 'seeds' (the point's tasks, "
+                                       "when it has at least 10) or 'blocks' (the stretches of all its tasks)"),
     "points/units": ("count", _POINTS, "resampling units of the point"),
     **{f"points/{name}_{part}": (unit, _CURVE.format(variable), f"{what} of the {variable} of {whose}")
        for name, (_, variable, whose, unit) in CURVES.items()

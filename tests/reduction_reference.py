@@ -23,8 +23,8 @@ here the slow and obvious way, from the raw events:
   task's stream is its recorded (seed_entropy, spawn_key), or (run.seed of its catalog's config,
   its index) where nothing is recorded (-1: not finished); the tasks of a point are its
   resampling units in the order of their streams;
-- resampling units: the tasks of a point if it has two or more, else the stretches of its one
-  task; bootstrap resamples drawn as rng.integers(0, units, (bootstrap, units)) from
+- resampling units: the tasks of a point if it has at least MIN_SEEDS, else the stretches of
+  every task (task by task, in the order above); bootstrap resamples drawn as rng.integers(0, units, (bootstrap, units)) from
   default_rng(SeedSequence(seed, spawn_key=(N, bits(l), bits(nu), bits(a), bits(b), bits(c))))
   with bits(x) the binary64 pattern of x as an unsigned integer, first for the numbers and
   curves, then (with >= 2 units and recurrences) for the peaks; intervals are the
@@ -56,6 +56,7 @@ NUMBERS = ("n_events", "n_large", "fraction_large", "n_recurrences", "mean_tnu",
 PER_TASK_COLUMNS = ("n_events", "n_large", "n_rec", "sum_tnu", "n_rec_int", "sum_tnu_int",
                     "n_gr", "sum_mu_gr", "sum_mu2_gr")
 PARAMS = ("N", "l", "nu", "a", "b", "c")
+MIN_SEEDS = 10
 
 # -- the documented peak rule, in one place (replace this block when the finder changes) -----
 
@@ -275,10 +276,10 @@ def bits(x):
 
 def point(tasks, params, opt):
     """Estimates, intervals, peaks, method and unit count of one parameter point."""
-    if len(tasks) >= 2:
+    if len(tasks) >= MIN_SEEDS:
         units, method = [t.unit() for t in tasks], "seeds"
     else:
-        units, method = [tasks[0].unit(s) for s in range(opt["blocks"])], "blocks"
+        units, method = [t.unit(s) for t in tasks for s in range(opt["blocks"])], "blocks"
     m = len(units)
     curves, numbers = statistics(*_pool(units, range(m)), opt)
     key = (int(params["N"]),) + tuple(bits(params[name]) for name in PARAMS[1:])

@@ -127,7 +127,9 @@ seed = {seed}
 SEEDS_WRITTEN = [400, 400, 400, 400, 0, 250, 400, 400, 3, 400, 137, 400]
 # three points x one seed: block bootstrap over stretches, one task shorter than the stretches, one empty
 BLOCKS_WRITTEN = [400, 5, 0]
-# two points x two seeds (the fewest that resample seeds), one of them empty
+# two points x ten seeds (the fewest that resample seeds), one empty, one short
+TEN_WRITTEN = [400, 400, 0, 400, 400, 400, 400, 400, 400, 400, 400, 400, 400, 400, 60, 400, 400, 400, 400, 400]
+# two points x two seeds, one of them empty: the stretches of both are resampled
 PAIRS_WRITTEN = [400, 220, 0, 400]
 # merged with "seeds" (another root seed): point nu = 1 pools with the first point of "seeds"
 MORE_WRITTEN = [400, 90, 400, 400]
@@ -143,6 +145,7 @@ def catalogs(tmp_path_factory):
             ("seeds", "nu = [1.0, 0.5]\nb = [20.0, 30.0]", 3, 0, SEEDS_WRITTEN),
             ("blocks", "nu = [2.0, 1.0, 0.5]", 1, 0, BLOCKS_WRITTEN),
             ("pairs", "nu = [1.0, 2.0]", 2, 0, PAIRS_WRITTEN),
+            ("ten", "nu = [1.0, 0.5]", 10, 3, TEN_WRITTEN),
             ("more", "nu = [2.0, 1.0]", 2, 5, MORE_WRITTEN),
             ("whole", "nu = [3.0]", 2, 7, WHOLE_WRITTEN)):
         path = d / f"{name}.h5"
@@ -153,10 +156,11 @@ def catalogs(tmp_path_factory):
 
 
 # case: (catalog, level, stretches per task)
-CASES = {"seeds": ("seeds", 0.95, 4),      # 3 seeds per point: the tasks are the units
+CASES = {"seeds": ("seeds", 0.95, 4),      # 3 seeds per point: 4 stretches of each task
+         "ten_seeds": ("ten", 0.95, 4),    # 10 seeds per point: the tasks are the units
          "blocks": ("blocks", 0.9, 7),     # 1 seed per point: 7 stretches of its trajectory are
          "one_unit": ("blocks", 0.95, 1),  # ... or 1 stretch: a single unit, no intervals
-         "two_seeds": ("pairs", 0.8, 3)}   # 2 seeds per point: the tasks
+         "two_seeds": ("pairs", 0.8, 3)}   # 2 seeds per point: 3 stretches of each
 
 
 @pytest.fixture(scope="module")
@@ -219,10 +223,15 @@ def test_catalogs_exercise_the_edges(references):
     _, _, _, exp_1 = references["one_unit"]
     assert list(exp_1["points/units"]) == [1] * 3 and np.isnan(exp_1["points/numbers/gr_b"][:, 1:]).all()
     assert np.isfinite(exp_1["points/numbers/gr_b"][0, 0]) and np.isfinite(exp_1["points/peaks"][0, 0, 0])
-    # two seeds per point, one of them an empty task, still resample the seeds
+    # fewer than ten seeds: the stretches of every task, even of an empty one (2 x 3; 3 x 4)
     _, _, _, exp_2 = references["two_seeds"]
-    assert list(exp_2["points/method"]) == ["seeds"] * 2 and list(exp_2["points/units"]) == [2, 2]
+    assert list(exp_2["points/method"]) == ["blocks"] * 2 and list(exp_2["points/units"]) == [6, 6]
     assert np.all(exp_2["points/numbers/n_events"][:, 2] > exp_2["points/numbers/n_events"][:, 1])
+    assert list(exp["points/method"]) == ["blocks"] * 4 and list(exp["points/units"]) == [12] * 4
+    # ten seeds (one empty, one short): the tasks themselves
+    _, _, _, exp_10 = references["ten_seeds"]
+    assert list(exp_10["points/method"]) == ["seeds"] * 2 and list(exp_10["points/units"]) == [10, 10]
+    assert np.all(exp_10["points/numbers/n_events"][:, 2] > exp_10["points/numbers/n_events"][:, 1])
 
 
 @pytest.fixture(scope="module")
@@ -232,15 +241,20 @@ def summaries(catalogs, references):
 
     def summary_of(case, chunk):
         if (case, chunk) not in made:
-            path, _, opt, _ = references[case]
+            path, _, opt, exp = references[case]
             out = catalogs[0] / f"{case}_{chunk}.summary.h5"
-            run(reduce_command(chunk, path, out, opt["level"], opt["blocks"]))
+            res = run(reduce_command(chunk, path, out, opt["level"], opt["blocks"]))
+            # reduce warns on stderr for exactly the points with fewer than 10 units
+            warned = re.findall(r"^warning: point (\d+) \(.*: intervals unreliable: (\d+) resampling units?",
+                                res.stderr, re.M)
+            assert warned == [(str(i), str(u)) for i, u in enumerate(exp["points/units"]) if u < 10], res.stderr
             made[case, chunk] = out
         return made[case, chunk]
     return summary_of
 
 
-@pytest.mark.parametrize("case, chunk", [("seeds", 7), ("blocks", 3), ("one_unit", 1 << 16), ("two_seeds", 64)])
+@pytest.mark.parametrize("case, chunk", [("seeds", 7), ("blocks", 3), ("one_unit", 1 << 16), ("two_seeds", 64),
+                                         ("ten_seeds", 11)])
 def test_summary_equals_brute_force(references, summaries, case, chunk):
     """The whole summary, reduced with the catalog streamed in chunks of `chunk` rows."""
     path, tasks, opt, exp = references[case]
@@ -273,7 +287,7 @@ def test_report_states_every_number_and_the_level(references, summaries):
         assert "resampling blocks, 7 units" in lines[0]
         # 7 stretches < reduce.MIN_UNITS: the intervals are flagged, saying what is needed
         assert lines[1].strip().startswith("WARNING: intervals unreliable: 7 resampling units (blocks); "
-                                           "at least 10 stretches"), lines[1]
+                                           "at least 10 are needed: 10 seeds (run.seeds), or 10 stretches"), lines[1]
         lines = [lines[0]] + lines[2:]
         for name, line in zip(ref.NUMBERS, lines[1:]):
             est, lo, hi = exp[f"points/numbers/{name}"][i]
@@ -344,7 +358,8 @@ def test_merged_catalogs_equal_brute_force(merges, names):
     first appearance; every dataset against the reference, in both orders of the catalogs."""
     out, opt, exp = merges(names)
     pooled = [i for i in range(len(exp["points/nu"])) if exp["points/nu"][i] == 1.0 and exp["points/b"][i] == 20.0]
-    assert len(pooled) == 1 and exp["points/units"][pooled[0]] == 5 and len(exp["points/nu"]) == 5
+    # five tasks, fewer than ten: 5 stretches of each
+    assert len(pooled) == 1 and exp["points/units"][pooled[0]] == 25 and len(exp["points/nu"]) == 5
     ref.check_summary(ref.read_summary(out), exp, opt)
 
 
@@ -373,7 +388,7 @@ def test_mpi_merge_equals_brute_force(catalogs):
     """Two ranks split the tasks of three catalogs (each rank reads tasks of every catalog);
     points nu = 2 and nu = 1 pool a task of "blocks" with two of "more"."""
     paths, opt, exp = merged_reference(catalogs, ("blocks", "more", "whole"), level=0.95, blocks=3)
-    assert list(exp["points/units"]) == [3, 3, 3, 2]
+    assert list(exp["points/units"]) == [9, 9, 3, 6]     # 3 stretches of each of 3, 3, 1, 2 tasks
     out = catalogs[0] / "three_mpi.summary.h5"
     run(["mpiexec", "-n", "2", *reduce_command(29, paths, out, opt["level"], opt["blocks"])])
     ref.check_summary(ref.read_summary(out), exp, opt)
