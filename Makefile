@@ -5,7 +5,7 @@ export OMP_NUM_THREADS := 1
 export NUMBA_NUM_THREADS := 1
 export OPENBLAS_NUM_THREADS := 1
 
-.PHONY: setup run test test-all mutations
+.PHONY: setup run test test-all mutations loaded
 
 setup:
 	bash scripts/setup.sh
@@ -22,3 +22,7 @@ test-all: setup
 # plausible bugs applied one at a time to a copy of the repository; every one must be caught (tests/mutations.py)
 mutations: setup
 	$(PY) tests/mutations.py
+
+# the suite five times in a row beside two CPU-bound processes: no test may hang or flake under load
+loaded: setup
+	bash tests/loaded.sh 5 2

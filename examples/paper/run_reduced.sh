@@ -1,26 +1,27 @@
 #!/usr/bin/env bash
-# The reduced paper runs on this machine's ranks, reduced and plotted into docs/figures/.
-#   bash examples/paper/run_reduced.sh [RANKS]      (default 2; about 20 minutes on 2 cores)
-# Catalogs and summaries go to runs/ (git-ignored); figures and reports to docs/figures/.
+# The reduced paper runs (4 seeds x 2000-3000 events after 1000 per point) on this machine's ranks,
+# reduced, reported and plotted into runs/reduced/ (git-ignored): a quick look at every panel, about
+# 25 minutes on 2 cores. The full-size runs are run_full.sh and reduce_full.sh (docs/paper.md).
+#   bash examples/paper/run_reduced.sh [RANKS]      (default 2)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 RANKS=${1:-2}
 PY=.venv/bin/python
 export NUMBA_CACHE_DIR=${NUMBA_CACHE_DIR:-$PWD/.numba_cache} OMP_NUM_THREADS=1 NUMBA_NUM_THREADS=1
-mkdir -p runs docs/figures
+out=runs/reduced
+mkdir -p $out
 for name in fig1_b fig1_a fig1_c fig2; do
   cfg=examples/paper/${name}_reduced.toml
-  if [ ! -f runs/$name.h5 ]; then
-    mpiexec -n "$RANKS" $PY -m ensemble run "$cfg" -o runs/$name.h5 --set output.progress_seconds=60
+  if [ ! -f $out/$name.h5 ]; then
+    mpiexec -n "$RANKS" $PY -m ensemble run "$cfg" -o $out/$name.h5 --set output.progress_seconds=60
   fi
-  mpiexec -n "$RANKS" $PY -m analysis reduce runs/$name.h5 -o runs/$name.summary.h5 --force
-  $PY -m analysis report runs/$name.summary.h5 > docs/figures/$name.txt
+  mpiexec -n "$RANKS" $PY -m analysis reduce $out/$name.h5 -o $out/$name.summary.h5 --force
+  $PY -m analysis report $out/$name.summary.h5 > $out/$name.txt
 done
 for name in fig1_b fig1_a fig1_c; do
-  $PY -m analysis plot runs/$name.summary.h5 --figure magnitude -o docs/figures/$name.png \
-    --title "$name (reduced run): R(mu), 95% bootstrap bands over seeds"
+  $PY -m analysis plot $out/$name.summary.h5 --figure magnitude -o $out/$name.png \
+    --title "$name (reduced run): R(mu), 95% bootstrap bands"
 done
-$PY -m analysis plot runs/fig2.summary.h5 --figure recurrence -o docs/figures/fig2.png \
+$PY -m analysis plot $out/fig2.summary.h5 --figure recurrence -o $out/fig2.png \
   --title "fig2 (reduced run): local recurrence times of mu >= 4 events, window 10 blocks"
-$PY -m analysis plot runs/fig2.summary.h5 --figure magnitude -o docs/figures/fig2_magnitude.png \
-  --title "fig2 (reduced run): R(mu)"
+echo "wrote $out/: catalogs, summaries, reports (*.txt) and figures (*.png)"
