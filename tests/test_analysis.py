@@ -202,9 +202,8 @@ def test_serial_and_mpi_reduction_agree(reduced):
 # real run's events, each task with the stream (provenance) of the task it comes from: A from a
 # sweep b = [20, 30] with one seed (tasks 0 and 3 of cat.h5), B from b = [30, 20] (tasks 2 and 1).
 SPLIT = {"A": ((20.0, 30.0), (0, 3)), "B": ((30.0, 20.0), (2, 1))}
-# level 0.5: with two units per point a 95% interval spans the two units' values whatever the
-# resamples; quartiles depend on the resamples, so the comparisons see the order of the units
-# and the bootstrap's stream
+# level 0.5: quartiles of the resamples are less settled than 95% bounds, so the comparisons see
+# the order of the units (20 stretches of each of a point's two tasks) and the bootstrap's stream
 REDUCE_OPTIONS = ("--bootstrap", "200", "--mu-c", "3.5", "--level", "0.5")
 
 

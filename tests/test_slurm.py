@@ -448,7 +448,8 @@ def test_array_sweep_then_reduction_only_after_every_element_succeeded(cluster, 
     for suffix in (".summary.h5", "-magnitude.png", "-recurrence.png", ".report.txt"):
         assert (good / "results" / f"sweep{suffix}").exists(), suffix
     s = summary.read(good / "results" / "sweep.summary.h5")
-    assert list(s["points/b"]) == [20.0, 30.0] and list(s["points/units"]) == [2, 2]
+    # two seeds per point, fewer than ten: 20 stretches of each are the units
+    assert list(s["points/b"]) == [20.0, 30.0] and list(s["points/units"]) == [40, 40]
     assert list(s["tasks/catalog"]) == [0, 0, 1, 1] and s["attrs"]["partial"] == ""
     assert list(s["attrs"]["catalogs"]) == [str(good / "points" / f"point-{i:04d}.h5") for i in (0, 1)]
     # the failed element: the reduction never ran (Slurm cancelled it: --kill-on-invalid-dep)
