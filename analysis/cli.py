@@ -95,8 +95,7 @@ def _prepare(args):
     if not (0 < opt.level < 1) or opt.bootstrap < 1 or opt.blocks < 1 or opt.window < 0:
         raise ValueError("--level must be in (0, 1); --bootstrap, --blocks >= 1; --window >= 0")
     out = args.output or _default_output(args.catalogs)
-    for path in args.catalogs:
-        filekind.require(path, "catalog", CatalogError)
+    inputs = merge.read(args.catalogs, allow_partial=args.partial)   # checks each file's kind first
     if os.path.exists(out):
         # checked now, not after the work; and --force replaces a summary, never anything else
         if not args.force:
@@ -105,7 +104,7 @@ def _prepare(args):
                 or filekind.identify(out)[0] != "summary"):
             raise summary.SummaryError(f"{out} {filekind.describe(out)}; --force replaces only "
                                        "a reduction summary")
-    return opt, out, merge.read(args.catalogs, allow_partial=args.partial)
+    return opt, out, inputs
 
 
 def _check_counts(inputs, per_task):
@@ -141,9 +140,10 @@ def _reduce_on(comm, args):
     if inputs.partial:
         print(inputs.partial)
     for i, p in enumerate(points):
-        if unreliable(p["units"], p["method"]):
-            print(f"warning: point {i} ({', '.join(f'{k} = {v:g}' for k, v in p['params'].items())}): "
-                  f"{unreliable(p['units'], p['method'])}", file=sys.stderr)
+        why = unreliable(p["units"], p["method"])
+        if why:
+            print(f"warning: point {i} ({', '.join(f'{k} = {v:g}' for k, v in p['params'].items())}): {why}",
+                  file=sys.stderr)
     methods = sorted({p["method"] for p in points})
     print(f"wrote {out}: {len(points)} parameter points, {len(per_task)} tasks"
           + (f" from {len(inputs.paths)} catalogs" if len(inputs.paths) > 1 else "")

@@ -47,7 +47,7 @@ import numpy as np
 from ensemble import catalog, filekind
 
 from . import stats
-from .reduce import NUMBERS, PARAMS
+from .reduce import MIN_UNITS, NUMBERS, PARAMS
 
 FORMAT = filekind.SUMMARY_FORMAT_PREFIX + "2"   # 2: GR b and its standard error, 9 per-task sums, peaks by
 # prominence; several catalogs (catalogs, configs, partial, /tasks/catalog, catalog_task, catalog_point)
@@ -102,7 +102,7 @@ DATASETS = {
     **{f"points/{name}": (unit, _POINTS, f"{meaning}, of the point's tasks")
        for name, (unit, _, meaning) in ((n, catalog.DATASETS[f"tasks/{n}"]) for n in PARAMS)},
     "points/method": ("text", _POINTS, "resampling units of the intervals: 'seeds' (the point's tasks, "
-                                       "when it has at least 10) or 'blocks' (the stretches of all its tasks)"),
+                                       f"when it has at least {MIN_UNITS}) or 'blocks' (the stretches of all its tasks)"),
     "points/units": ("count", _POINTS, "resampling units of the point"),
     **{f"points/{name}_{part}": (unit, _CURVE.format(variable), f"{what} of the {variable} of {whose}")
        for name, (_, variable, whose, unit) in CURVES.items()

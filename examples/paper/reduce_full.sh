@@ -30,7 +30,7 @@ for name in $PANELS; do
   out=docs/paper/$name
   mpiexec -n "$RANKS" $PY -m analysis reduce "$cat" -o "$out.summary.h5" --force
   $PY -m analysis report "$out.summary.h5" > "$out.txt"
-  full=$'\n''full size: 2e5 events per point, 95% bootstrap bands over 20 stretches of each' 
+  full=$'\n''full size: 2e5 events per point, 95% bootstrap bands over 20 stretches of each'
   if [ "$name" = fig2 ]; then
     $PY -m analysis plot "$out.summary.h5" --figure recurrence -o "$out.png" --title "${TITLE[$name]}$full"
     $PY -m analysis plot "$out.summary.h5" --figure magnitude -o "${out}_magnitude.png" \

@@ -25,9 +25,13 @@ DIP_FROM = 2.5             # the dip: the minimum of R(mu) between DIP_FROM and 
 FLAT = (3.0, 5.5)          # a flat R(mu): max / min of R over this range (above the few-block events)
 
 
-def load(d, name):
-    path = Path(d) / f"{name}.summary.h5"
-    return summary.read(path) if path.exists() else None
+PANELS = ("fig1_b", "fig1_a", "fig1_c", "fig2", "large_b")
+
+
+def load(d):
+    """{panel: its summary, or None where it has not been reduced}, each read once."""
+    paths = {name: Path(d) / f"{name}.summary.h5" for name in PANELS}
+    return {name: summary.read(path) if path.exists() else None for name, path in paths.items()}
 
 
 def point_of(s, **params):
@@ -81,11 +85,10 @@ def peaks(s, i):
     return "; ".join(with_interval(r, 4) for r in sorted(rows, key=lambda r: r[0])) or "none"
 
 
-def runs_table(d):
+def runs_table(panels):
     out = ["| run | N | a | b | c | events | wall time [s] | events/s |", "|---|---|---|---|---|---|---|---|"]
     total_events = total_wall = 0.0
-    for name in ("fig1_b", "fig1_a", "fig1_c", "fig2", "large_b"):
-        s = load(d, name)
+    for name, s in panels.items():
         if s is None:
             out.append(f"| {name} | not run yet | | | | | | |")
             continue
@@ -111,9 +114,9 @@ def listing(s, rows, value, label):
             + ", ".join(f"{s[f'points/{label}'][i]:g}" for i in rows) + ")")
 
 
-def claims_table(d):
+def claims_table(panels):
     """One row per claim of the paper: the claim, and the full-size numbers that test it."""
-    b, a, c, f2, lb = (load(d, n) for n in ("fig1_b", "fig1_a", "fig1_c", "fig2", "large_b"))
+    b, a, c, f2, lb = (panels[n] for n in PANELS)
     out = ["| the paper (Ohmura & Kawamura 2007) | full size, this code (95% intervals) |", "|---|---|"]
     if b is not None:
         bs = [point_of(b, b=x) for x in (20.0, 30.0, 40.0, 50.0)]
@@ -156,11 +159,11 @@ SAME_MODEL = {"b = 20, a = 0, N = 800": [("fig1_b", {"b": 20.0}), ("fig1_c", {"c
               "b = 50, a = 0, N = 800": [("fig1_b", {"b": 50.0}), ("fig1_a", {"a": 0.0})]}
 
 
-def consistency_table(d):
+def consistency_table(panels):
     """Per model and number: the trajectories' values and chi^2 / dof of their spread."""
     out = ["| model | number | independent trajectories | chi^2 / dof |", "|---|---|---|---|"]
     for model, members in SAME_MODEL.items():
-        found = [(name, load(d, name), params) for name, params in members]
+        found = [(name, panels[name], params) for name, params in members]
         found = [(name, s, point_of(s, **params), params) for name, s, params in found if s is not None]
         if len(found) < 2:
             continue
@@ -177,16 +180,17 @@ def consistency_table(d):
 
 
 def main(d="docs/paper"):
+    panels = load(d)
     print("<!-- written by `python examples/paper/tables.py` from docs/paper/*.summary.h5 -->")
     print("## Runs\n")
-    print(runs_table(d))
+    print(runs_table(panels))
     print("\n## The paper's claims at full size\n")
-    print(claims_table(d))
+    print(claims_table(panels))
     print("\n## One model, independent trajectories\n")
     print("c drops out of the equations exactly, so every b = 20, a = 0, N = 800 point of the panels is one "
           "model; each panel ran it from its own seed. chi^2 / dof of the values about their weighted mean, "
           "sigma = 95% half-width / 1.96: about 1 if the intervals are right, much more if too narrow.\n")
-    print(consistency_table(d))
+    print(consistency_table(panels))
 
 
 if __name__ == "__main__":
