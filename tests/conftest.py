@@ -24,10 +24,27 @@ from .processes import ROOT, child_env, run_bounded  # noqa: F401 (ROOT: test mo
 BACKSTOP_SECONDS = 120
 _STDERR = pytest.StashKey[int]()
 
+# As in an activated .venv: the wheel stack's mpiexec (the mpich wheel) is the one beside python.
+os.environ["PATH"] = os.path.dirname(sys.executable) + os.pathsep + os.environ.get("PATH", "")
+
 
 def pytest_configure(config):
     # stderr itself, kept for the watchdog: during a test fd 2 is pytest's capture file
     config.stash[_STDERR] = os.dup(sys.stderr.fileno())
+    # `make test` sets up the parallel stack and says so: then no test may skip for want of MPI-IO
+    if os.environ.get("ENSEMBLE_TEST_STACK") == "parallel" and not catalog.has_parallel_hdf5():
+        raise pytest.UsageError("ENSEMBLE_TEST_STACK=parallel, but this h5py has no MPI support "
+                                "(rerun `make test`, or `make test STACK=wheels` to skip the MPI-IO tests)")
+
+
+def pytest_collection_modifyitems(config, items):
+    if catalog.has_parallel_hdf5():
+        return
+    skip = pytest.mark.skip(reason="h5py without MPI (the wheel stack): the parallel writer is not "
+                                   "tested here; `make test` sets up the parallel stack and tests it")
+    for item in items:
+        if item.get_closest_marker("parallel_hdf5"):
+            item.add_marker(skip)
 
 
 def pytest_unconfigure(config):

@@ -398,8 +398,8 @@ writer.close()
 
 
 @pytest.mark.mpi
-@pytest.mark.skipif(shutil.which("mpiexec") is None or not catalog.has_parallel_hdf5(),
-                    reason="needs mpiexec and h5py with MPI")
+@pytest.mark.parallel_hdf5
+@pytest.mark.skipif(shutil.which("mpiexec") is None, reason="needs mpiexec")
 def test_the_parallel_writer_describes_every_dataset(tmp_path):
     """A catalog created collectively by 2 ranks through mpio carries the same descriptions."""
     path = tmp_path / "mpio.h5"

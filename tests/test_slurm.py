@@ -15,7 +15,6 @@ import subprocess
 import sys
 import time
 
-import numpy as np
 import pytest
 
 from analysis import summary
@@ -26,6 +25,7 @@ from ensemble.slurm import (KINDS, PLACEHOLDER, PLACEHOLDERS, TEMPLATES, JobOpti
 
 from .conftest import write_config
 from .processes import child_env, poll_until, run_bounded
+from .same_catalogs import assert_same_events
 
 PACKAGES = ["slurmctld", "slurmd", "slurm-client", "munge"]
 DAEMONS = ["munged", "slurmctld", "slurmd", "sbatch", "srun", "scontrol", "sinfo"]
@@ -43,17 +43,6 @@ def tiny_config(path, **sections):
     for name, values in sections.items():
         base.setdefault(name, {}).update(values)
     return write_config(path, **base)
-
-
-def assert_same_events(path_a, path_b):
-    a, ta, _ = catalog.read(path_a)
-    b, tb, _ = catalog.read(path_b)
-    assert len(a["t"]) == len(b["t"]) > 0
-    order_a, order_b = np.lexsort((a["t"], a["task"])), np.lexsort((b["t"], b["task"]))
-    for name in catalog.EVENT_FIELDS:
-        np.testing.assert_array_equal(a[name][order_a], b[name][order_b], err_msg=name)
-    for name in catalog.TASK_FIELDS:
-        np.testing.assert_array_equal(ta[name], tb[name], err_msg=name)
 
 
 # ---------------------------------------------------------------- rendering (no Slurm needed)
