@@ -73,14 +73,6 @@ if [ -n "$current" ] && { [ "$STACK" = auto ] || [ "$STACK" = "$current" ]; } &&
   exit 0
 fi
 
-if [ ! -x $VPY ]; then
-  say "creating .venv with $PY ($("$PY" -V 2>&1))"
-  "$PY" -m venv .venv || die "$PY -m venv failed (Debian and Ubuntu: apt install python3-venv)"
-fi
-rm -f "$STATE"   # from here until the final check, .venv is being changed
-: >"$LOG"
-quietly $VPY -m pip install --upgrade pip setuptools wheel
-
 build_parallel() {   # against $STACK_MPICC and $STACK_H5PY_ENV; output in $LOG
   say "building mpi4py against $STACK_MPICC and h5py against $STACK_HDF5 (a few minutes; log: $LOG)"
   {
@@ -116,6 +108,7 @@ install_wheels() {
   quietly $VPY -m pip install --only-binary=:all: "mpi4py>=4.1" mpich h5py
 }
 
+# -- which stack: decided before .venv is touched, so that a refusal changes nothing ---------------
 kind=wheels
 if [ "$STACK" != wheels ]; then
   eval "$("$PY" scripts/stack.py)"
@@ -128,19 +121,27 @@ if [ "$STACK" != wheels ]; then
     eval "$("$PY" scripts/stack.py)"
   fi
   if [ "$STACK_FOUND" = 1 ]; then
-    if build_parallel; then
-      kind=parallel
-    elif [ "$STACK" = parallel ]; then
-      die "STACK=parallel: building against $STACK_MPICC and $STACK_HDF5 failed (see above and $LOG)"
-    else
-      say "falling back to the wheel stack"
-    fi
+    kind=parallel
   else
     why="no parallel HDF5 stack: missing $STACK_MISSING (python3 scripts/stack.py --explain shows where setup looked)"
     [ "$STACK" = parallel ] && die "STACK=parallel: $why. Load an MPI and a parallel HDF5 (module load ..., spack load ...; docs/install.md), or set STACK=wheels"
     say "$why"
     say "falling back to the wheel stack: runs work on any number of ranks, rank 0 writing the catalog"
   fi
+fi
+
+if [ ! -x $VPY ]; then
+  say "creating .venv with $PY ($("$PY" -V 2>&1))"
+  "$PY" -m venv .venv || die "$PY -m venv failed (Debian and Ubuntu: apt install python3-venv)"
+fi
+rm -f "$STATE"   # from here until the final check, .venv is being changed
+: >"$LOG"
+quietly $VPY -m pip install --upgrade pip setuptools wheel
+
+if [ "$kind" = parallel ] && ! build_parallel; then
+  [ "$STACK" = parallel ] && die "STACK=parallel: building against $STACK_MPICC and $STACK_HDF5 failed (see above and $LOG)"
+  say "falling back to the wheel stack"
+  kind=wheels
 fi
 [ "$kind" = wheels ] && install_wheels
 install_project
