@@ -5,7 +5,7 @@ The machine's own stack is not used: each case builds the places a module system
 virtual environment would (executables, include/H5pubconf.h, .pc files) in a temporary directory,
 and runs the detection with a PATH of only those and the few programs it needs. The installs
 themselves (the wheel stack as a non-root user, the parallel stack from Debian) are run by
-tests/install_wheels.sh and `make test` in CI.
+tests/install_paths.sh (wheels, modules) and `make test` in CI.
 """
 import os
 import shutil
