@@ -42,6 +42,7 @@ import h5py
 import numpy as np
 
 from . import __version__
+from .config import ConfigError
 from .integrity import EventCrc, commit_crc, crc, event_problems
 
 FORMAT = "bk-catalog-3"
@@ -170,6 +171,7 @@ def partial_path(path):
 
 
 def has_parallel_hdf5():
+    """True if h5py is built with MPI (the parallel stack): the one place that asks."""
     return bool(h5py.get_config().mpi)
 
 
@@ -532,6 +534,11 @@ def _open_file(path, open_file):
 class _Writer:
     """Common API of the writers: record, commit, finish, fail, start, poll, close."""
 
+    @classmethod
+    def label(cls, n_ranks):
+        """What the run log calls this writer on n_ranks."""
+        return cls.name
+
     def record(self, task, restart=False):
         """TaskRecord of a task in this catalog (verified; restart: taken up from its start)."""
         return self.layout.record(task, restart)
@@ -596,6 +603,10 @@ class Rank0Writer(_Writer):
 
     name = "serial HDF5 on rank 0, rows sent by message"
     TAG = 17
+
+    @classmethod
+    def label(cls, n_ranks):
+        return cls.name if n_ranks > 1 else "serial HDF5"
 
     def __init__(self, path, comm, cfg=None, tasks=None, integrator_text=""):
         self.comm = comm
@@ -710,13 +721,23 @@ class Rank0Writer(_Writer):
 WRITERS = {"parallel": ParallelWriter, "rank0": Rank0Writer}
 
 
-def choose_writer(name, comm):
-    """'auto' -> parallel HDF5 when h5py has MPI support and there is more than one rank."""
+def writer_key(name, n_ranks, parallel_hdf5):
+    """output.writer -> the key of WRITERS a run on n_ranks uses; parallel_hdf5: has_parallel_hdf5().
+
+    The only statement of the rule: runs (choose_writer) and validate (environment.py) both use it.
+    'auto' -> parallel HDF5 when h5py has MPI support and there is more than one rank.
+    """
+    if name == "parallel" and not parallel_hdf5:
+        raise ConfigError("output.writer = 'parallel' needs h5py built with MPI support, and this h5py has "
+                          "none (use 'auto' or 'rank0', or install the parallel stack)")
     if name == "auto":
-        name = "parallel" if comm.Get_size() > 1 and has_parallel_hdf5() else "rank0"
-    if name == "parallel" and not has_parallel_hdf5():
-        raise CatalogError("output.writer = 'parallel' needs h5py built with MPI support")
-    return WRITERS[name]
+        return "parallel" if n_ranks > 1 and parallel_hdf5 else "rank0"
+    return name
+
+
+def choose_writer(name, comm):
+    """The writer class for output.writer = name on the ranks of comm."""
+    return WRITERS[writer_key(name, comm.Get_size(), has_parallel_hdf5())]
 
 
 # -- reading --------------------------------------------------------------------------------

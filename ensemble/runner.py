@@ -393,8 +393,7 @@ def _run_locked(cfg, path, comm, mode, log, say, rerun, lock):
     tasks = task_list(cfg)
     Writer = catalog.choose_writer(cfg.output.writer, comm)
     partial = catalog.partial_path(path)
-    say(f"writing {partial} with {comm.Get_size()} rank(s): "
-        f"{Writer.name if comm.Get_size() > 1 else 'serial HDF5'}")
+    say(f"writing {partial} with {comm.Get_size()} rank(s): {Writer.label(comm.Get_size())}")
     t_start = time.perf_counter()
     if mode == "new":
         writer = Writer(partial, comm, cfg, tasks, integrator_text(cfg.integrator))

@@ -1,4 +1,6 @@
 """Command line, config validation and the catalog written by a serial run."""
+import sys
+
 import h5py
 import numpy as np
 import pytest
@@ -7,6 +9,7 @@ from ensemble import catalog
 from ensemble.config import loads
 
 from .conftest import run_cli, write_config
+from .processes import ROOT, child_env, run_bounded
 
 
 @pytest.fixture(scope="module")
@@ -78,6 +81,18 @@ def test_validate_prints_resolved_config_and_tasks(small_run):
     assert res.returncode == 0, res.stderr
     assert loads(res.stdout.split("# ")[0]).run.seeds == 3
     assert "# 6 tasks" in res.stdout and "task 5: point 1 seed 2" in res.stdout
+
+
+def test_run_refuses_the_parallel_writer_without_parallel_hdf5(tmp_path):
+    """The run itself refuses, as a config error (exit 2, one line), before creating anything."""
+    cfg = write_config(tmp_path / "c.toml")
+    code = ("import sys; from ensemble import catalog, cli; catalog.has_parallel_hdf5 = lambda: False; "
+            f"sys.exit(cli.main(['run', {str(cfg)!r}, '--set', 'output.writer=\"parallel\"']))")
+    res = run_bounded([sys.executable, "-c", code], 600, cwd=ROOT, env=child_env())
+    assert res.returncode == 2, res.stderr
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: output.writer = 'parallel' needs h5py")
+    assert not (tmp_path / "c.h5").exists() and not (tmp_path / "c.h5.partial").exists()
 
 
 @pytest.mark.parametrize("sections,key", [
