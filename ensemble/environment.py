@@ -3,8 +3,11 @@
 Two stacks are common: the wheel stack (MPICH from its PyPI wheel, h5py without MPI: with more
 than one rank, rank 0 writes for all) and the parallel stack (mpi4py and h5py built against the
 machine's MPI and parallel HDF5: all ranks write one file through mpio). `validate` prints
-describe().
+describe(), a run's log starts with stack(), and each catalog stores software() as its
+`software` attribute.
 """
+import sys
+
 import h5py
 import mpi4py
 
@@ -49,3 +52,11 @@ def describe(name):
     """validate's lines: the stack and what output.writer = name resolves to."""
     return [*stack(), writer_line(name)]
 
+
+def software(writer, n_ranks):
+    """The text stored in a catalog: the stack, python, numpy, numba, and the writer class used on n_ranks."""
+    import numba
+    import numpy
+    python = ".".join(map(str, sys.version_info[:3]))
+    return "\n".join([*stack(), f"python {python}, numpy {numpy.__version__}, numba {numba.__version__}",
+                      f"writer ({n_ranks} rank{'s' if n_ranks > 1 else ''}): {writer.label(n_ranks)}"])

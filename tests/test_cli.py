@@ -3,6 +3,7 @@ import sys
 
 import h5py
 import mpi4py
+import numba
 import numpy as np
 import pytest
 
@@ -20,6 +21,7 @@ def small_run(tmp_path_factory):
                        integrator={"dt": 5e-4}, output={"batch": 8})   # several commits per task
     res = run_cli("run", cfg)
     assert res.returncode == 0, res.stderr
+    (d / "run.log").write_text(res.stdout)
     return d, cfg
 
 
@@ -128,6 +130,19 @@ def test_run_refuses_the_parallel_writer_without_parallel_hdf5(tmp_path):
     lines = res.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: output.writer = 'parallel' needs h5py")
     assert not (tmp_path / "c.h5").exists() and not (tmp_path / "c.h5.partial").exists()
+
+
+def test_run_log_and_catalog_name_the_stack(small_run):
+    d, cfg = small_run
+    log = (d / "run.log").read_text().splitlines()
+    start = log.index(f"writing {d / 'cfg.h5.partial'} with 1 rank(s): serial HDF5")
+    assert log[start - 2:start] == expected_stack()
+    assert sum(line.startswith(("mpi: ", "hdf5: ")) for line in log) == 2
+    _, _, attrs = catalog.read_tasks(d / "cfg.h5")
+    python = ".".join(map(str, sys.version_info[:3]))
+    assert attrs["software"].splitlines() == [
+        *expected_stack(), f"python {python}, numpy {np.__version__}, numba {numba.__version__}",
+        "writer (1 rank): serial HDF5"]
 
 
 @pytest.mark.parametrize("sections,key", [
