@@ -12,7 +12,8 @@ killed at any moment leaves a file whose metadata is intact.
     /events/*       one row per event; task k owns rows [k * E, (k + 1) * E), E = events_per_task
     /tasks/*        one row per task: its parameters, committed count, provenance, status
     /checkpoint/*   per task two slots of its state and a commit row for each
-    attributes of /: config (resolved TOML text), version, format, events_per_task, transient
+    attributes of /: config (resolved TOML text), version, format, events_per_task, transient,
+                    software (MPI, HDF5, versions and writer of the run that created it)
 
 Every dataset is a line of the table DATASETS below (unit, shape, meaning; printed at the end of
 this docstring); each dataset carries that line as its `description` attribute, written once
@@ -42,6 +43,7 @@ import h5py
 import numpy as np
 
 from . import __version__
+from .config import ConfigError
 from .integrity import EventCrc, commit_crc, crc, event_problems
 
 FORMAT = "bk-catalog-3"
@@ -170,6 +172,7 @@ def partial_path(path):
 
 
 def has_parallel_hdf5():
+    """True if h5py is built with MPI (the parallel stack): the one place that asks."""
     return bool(h5py.get_config().mpi)
 
 
@@ -254,14 +257,19 @@ class _Layout:
         self._head = {}   # task -> Head in use (on the writing process)
 
     @staticmethod
-    def create(h5, cfg, tasks, integrator_text):
-        """Every dataset and attribute of the catalog (call on every rank with the same values)."""
+    def create(h5, cfg, tasks, integrator_text, software=""):
+        """Every dataset and attribute of the catalog (call on every rank with the same values).
+
+        software: environment.software() of the creating run, stored as it is (never updated on resume:
+        the metadata does not change after creation, which lets readers read while a run writes).
+        """
         rows = len(tasks) * cfg.run.events
         h5.attrs["config"] = cfg.to_toml()
         h5.attrs["version"] = __version__
         h5.attrs["format"] = FORMAT
         h5.attrs["events_per_task"] = cfg.run.events
         h5.attrs["transient"] = cfg.run.transient
+        h5.attrs["software"] = software
         ev = h5.create_group("events")
         for name, dtype in EVENT_FIELDS.items():
             # never fill: a full run would otherwise write the whole catalog twice; rows past
@@ -494,7 +502,7 @@ def _reserve_space(path):
         os.close(fd)
 
 
-def _create_file(path, open_file, cfg, tasks, integrator_text, reserve=True):
+def _create_file(path, open_file, cfg, tasks, integrator_text, software, reserve=True):
     """Create a catalog; on failure remove what was made (we hold the run's lock) and raise CatalogError.
 
     reserve: this process reserves the disk space (one rank of a parallel create).
@@ -502,7 +510,7 @@ def _create_file(path, open_file, cfg, tasks, integrator_text, reserve=True):
     h5 = None
     try:
         h5 = open_file(path, "w")
-        _Layout.create(h5, cfg, tasks, integrator_text)
+        _Layout.create(h5, cfg, tasks, integrator_text, software)
         h5.flush()
         if reserve:
             _reserve_space(path)
@@ -532,6 +540,11 @@ def _open_file(path, open_file):
 class _Writer:
     """Common API of the writers: record, commit, finish, fail, start, poll, close."""
 
+    @classmethod
+    def label(cls, n_ranks):
+        """What the run log (and the catalog's `software`) call this writer on n_ranks."""
+        return cls.name
+
     def record(self, task, restart=False):
         """TaskRecord of a task in this catalog (verified; restart: taken up from its start)."""
         return self.layout.record(task, restart)
@@ -542,7 +555,7 @@ class ParallelWriter(_Writer):
 
     name = "parallel HDF5 (mpio), independent writes"
 
-    def __init__(self, path, comm, cfg=None, tasks=None, integrator_text=""):
+    def __init__(self, path, comm, cfg=None, tasks=None, integrator_text="", software=""):
         self.comm = comm
 
         def open_file(p, mode):
@@ -550,7 +563,7 @@ class ParallelWriter(_Writer):
         error = None
         try:
             if cfg is not None:
-                self.h5 = _create_file(path, open_file, cfg, tasks, integrator_text,
+                self.h5 = _create_file(path, open_file, cfg, tasks, integrator_text, software,
                                        reserve=comm.Get_rank() == 0)
             else:
                 self.h5 = _open_file(path, open_file)
@@ -597,7 +610,11 @@ class Rank0Writer(_Writer):
     name = "serial HDF5 on rank 0, rows sent by message"
     TAG = 17
 
-    def __init__(self, path, comm, cfg=None, tasks=None, integrator_text=""):
+    @classmethod
+    def label(cls, n_ranks):
+        return cls.name if n_ranks > 1 else "serial HDF5"
+
+    def __init__(self, path, comm, cfg=None, tasks=None, integrator_text="", software=""):
         self.comm = comm
         self.rank = comm.Get_rank()
         self.layout = None
@@ -606,7 +623,7 @@ class Rank0Writer(_Writer):
         if self.rank == 0:
             try:
                 if cfg is not None:
-                    self.h5 = _create_file(path, h5py.File, cfg, tasks, integrator_text)
+                    self.h5 = _create_file(path, h5py.File, cfg, tasks, integrator_text, software)
                 else:
                     self.h5 = _open_file(path, h5py.File)
                 self.layout = _Layout(self.h5, barrier=self._flush)
@@ -710,13 +727,23 @@ class Rank0Writer(_Writer):
 WRITERS = {"parallel": ParallelWriter, "rank0": Rank0Writer}
 
 
-def choose_writer(name, comm):
-    """'auto' -> parallel HDF5 when h5py has MPI support and there is more than one rank."""
+def writer_key(name, n_ranks, parallel_hdf5):
+    """output.writer -> the key of WRITERS a run on n_ranks uses; parallel_hdf5: has_parallel_hdf5().
+
+    The only statement of the rule: runs (choose_writer) and validate (environment.py) both use it.
+    'auto' -> parallel HDF5 when h5py has MPI support and there is more than one rank.
+    """
+    if name == "parallel" and not parallel_hdf5:
+        raise ConfigError("output.writer = 'parallel' needs h5py built with MPI support, and this h5py has "
+                          "none (use 'auto' or 'rank0', or install the parallel stack)")
     if name == "auto":
-        name = "parallel" if comm.Get_size() > 1 and has_parallel_hdf5() else "rank0"
-    if name == "parallel" and not has_parallel_hdf5():
-        raise CatalogError("output.writer = 'parallel' needs h5py built with MPI support")
-    return WRITERS[name]
+        return "parallel" if n_ranks > 1 and parallel_hdf5 else "rank0"
+    return name
+
+
+def choose_writer(name, comm):
+    """The writer class for output.writer = name on the ranks of comm."""
+    return WRITERS[writer_key(name, comm.Get_size(), has_parallel_hdf5())]
 
 
 # -- reading --------------------------------------------------------------------------------

@@ -52,12 +52,15 @@ def _config(args):
 
 
 def _validate(args):
+    from . import environment
     from .tasks import describe, task_list
     cfg = _config(args)
+    # before any output: a writer this stack cannot provide fails here, before a job is submitted
+    stack = environment.describe(cfg.output.writer)
     print(cfg.to_toml())
     tasks = task_list(cfg)
     print(f"# {len(tasks)} tasks")
-    print("\n".join("# " + line for line in describe(tasks)))
+    print("\n".join("# " + line for line in [*describe(tasks), *stack]))
     return 0
 
 

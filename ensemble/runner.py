@@ -12,7 +12,7 @@ import tomllib
 
 import numpy as np
 
-from . import catalog
+from . import catalog, environment
 from .catalog import FAILED, FINISHED, Checkpoint, CatalogError
 from .config import ConfigError, from_dict, loads, section_lines
 from .integrators import kernel_args
@@ -391,13 +391,17 @@ def run(cfg, path, comm, resume=False, force=False, log=print, rerun=None, comma
 
 def _run_locked(cfg, path, comm, mode, log, say, rerun, lock):
     tasks = task_list(cfg)
+    n_ranks = comm.Get_size()
     Writer = catalog.choose_writer(cfg.output.writer, comm)
     partial = catalog.partial_path(path)
-    say(f"writing {partial} with {comm.Get_size()} rank(s): "
-        f"{Writer.name if comm.Get_size() > 1 else 'serial HDF5'}")
+    for line in environment.stack():
+        say(line)
+    say(f"writing {partial} with {n_ranks} rank(s): {Writer.label(n_ranks)}")
     t_start = time.perf_counter()
     if mode == "new":
-        writer = Writer(partial, comm, cfg, tasks, integrator_text(cfg.integrator))
+        # rank 0's text on every rank: under mpio the catalog's attributes are written collectively
+        software = comm.bcast(environment.software(Writer, n_ranks) if comm.Get_rank() == 0 else None, root=0)
+        writer = Writer(partial, comm, cfg, tasks, integrator_text(cfg.integrator), software)
     else:
         writer = Writer(partial, comm)
     # event counts reach rank 0 as messages: about 100 per second in all, however many ranks

@@ -1,12 +1,17 @@
 """Command line, config validation and the catalog written by a serial run."""
+import sys
+
 import h5py
+import mpi4py
+import numba
 import numpy as np
 import pytest
 
-from ensemble import catalog
+from ensemble import catalog, cli
 from ensemble.config import loads
 
 from .conftest import run_cli, write_config
+from .processes import ROOT, child_env, run_bounded
 
 
 @pytest.fixture(scope="module")
@@ -16,6 +21,7 @@ def small_run(tmp_path_factory):
                        integrator={"dt": 5e-4}, output={"batch": 8})   # several commits per task
     res = run_cli("run", cfg)
     assert res.returncode == 0, res.stderr
+    (d / "run.log").write_text(res.stdout)
     return d, cfg
 
 
@@ -78,6 +84,65 @@ def test_validate_prints_resolved_config_and_tasks(small_run):
     assert res.returncode == 0, res.stderr
     assert loads(res.stdout.split("# ")[0]).run.seeds == 3
     assert "# 6 tasks" in res.stdout and "task 5: point 1 seed 2" in res.stdout
+
+
+def expected_stack():
+    """The mpi and hdf5 lines validate, the run log and the catalog give in this environment."""
+    from mpi4py import MPI
+    library = " ".join(MPI.Get_library_version().splitlines()[0].split())
+    mpi = "with" if catalog.has_parallel_hdf5() else "without"
+    return [f"mpi: {library} (MPI {'.'.join(map(str, MPI.Get_version()))}, mpi4py {mpi4py.__version__})",
+            f"hdf5: {h5py.version.hdf5_version} {mpi} MPI (h5py {h5py.__version__})"]
+
+
+def test_validate_names_the_mpi_the_hdf5_and_the_writer(small_run):
+    d, cfg = small_run
+    res = run_cli("validate", cfg)
+    assert res.returncode == 0, res.stderr
+    more = ("parallel HDF5 (mpio), independent writes" if catalog.has_parallel_hdf5() else
+            "serial HDF5 on rank 0, rows sent by message (h5py has no MPI)")
+    assert res.stdout.strip().splitlines()[-3:] == [
+        *("# " + line for line in expected_stack()), f"# writer: auto -> 1 rank: serial HDF5; more ranks: {more}"]
+
+
+def test_validate_without_parallel_hdf5(small_run, monkeypatch, capsys):
+    """As on the wheel stack: 'auto' says why more ranks use rank0, 'parallel' fails naming the key."""
+    d, cfg = small_run
+    monkeypatch.setattr(catalog, "has_parallel_hdf5", lambda: False)
+    assert cli.main(["validate", str(cfg)]) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert lines[-2].startswith("# hdf5: ") and lines[-2].endswith(f" without MPI (h5py {h5py.__version__})")
+    assert lines[-1] == ("# writer: auto -> 1 rank: serial HDF5; "
+                         "more ranks: serial HDF5 on rank 0, rows sent by message (h5py has no MPI)")
+    assert cli.main(["validate", str(cfg), "--set", 'output.writer="parallel"']) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and len(err.strip().splitlines()) == 1
+    assert err.startswith("error: output.writer = 'parallel' needs h5py built with MPI support")
+
+
+def test_run_refuses_the_parallel_writer_without_parallel_hdf5(tmp_path):
+    """The run itself refuses, as a config error (exit 2, one line), before creating anything."""
+    cfg = write_config(tmp_path / "c.toml")
+    code = ("import sys; from ensemble import catalog, cli; catalog.has_parallel_hdf5 = lambda: False; "
+            f"sys.exit(cli.main(['run', {str(cfg)!r}, '--set', 'output.writer=\"parallel\"']))")
+    res = run_bounded([sys.executable, "-c", code], 600, cwd=ROOT, env=child_env())
+    assert res.returncode == 2, res.stderr
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: output.writer = 'parallel' needs h5py")
+    assert not (tmp_path / "c.h5").exists() and not (tmp_path / "c.h5.partial").exists()
+
+
+def test_run_log_and_catalog_name_the_stack(small_run):
+    d, cfg = small_run
+    log = (d / "run.log").read_text().splitlines()
+    start = log.index(f"writing {d / 'cfg.h5.partial'} with 1 rank(s): serial HDF5")
+    assert log[start - 2:start] == expected_stack()
+    assert sum(line.startswith(("mpi: ", "hdf5: ")) for line in log) == 2
+    _, _, attrs = catalog.read_tasks(d / "cfg.h5")
+    python = ".".join(map(str, sys.version_info[:3]))
+    assert attrs["software"].splitlines() == [
+        *expected_stack(), f"python {python}, numpy {np.__version__}, numba {numba.__version__}",
+        "writer (1 rank): serial HDF5"]
 
 
 @pytest.mark.parametrize("sections,key", [

@@ -52,6 +52,8 @@ def two_tasks(tmp_path_factory):
 
 
 MPIO = pytest.mark.parallel_hdf5
+WRITER_LABELS = {"parallel": "parallel HDF5 (mpio), independent writes",
+                 "rank0": "serial HDF5 on rank 0, rows sent by message"}
 
 
 @pytest.mark.parametrize("ranks,writer", [(1, "auto"), pytest.param(2, "parallel", marks=MPIO), (2, "rank0"),
@@ -62,9 +64,12 @@ def test_catalog_independent_of_ranks_and_writer(two_tasks, ranks, writer):
     res = mpirun(ranks, "run", cfg, "-o", out, "--set", f'output.writer="{writer}"')
     assert res.returncode == 0, res.stderr
     assert_same_events(d / "serial.h5", out)
-    _, tasks, _ = catalog.read(out)
+    _, tasks, attrs = catalog.read(out)
     assert set(tasks["rank"]) <= set(range(ranks)) and np.all(tasks["rank"] >= 0)
     assert np.all(tasks["events_per_second"] > 0)
+    # each records the writer that made it (assert_same_events compares events and task rows only)
+    used = WRITER_LABELS[writer] if ranks > 1 else "serial HDF5"
+    assert attrs["software"].splitlines()[-1] == f"writer ({ranks} rank{'s' if ranks > 1 else ''}): {used}"
 
 
 @pytest.fixture(scope="module")
