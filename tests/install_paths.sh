@@ -38,6 +38,7 @@ for f in /usr/bin/*; do
   ln -s "$f" "$bin/"
 done
 path=$bin
+module=""
 extra=()
 case $CASE in
   wheels)
