@@ -65,7 +65,10 @@ esac
 git clone -q "$ROOT" "$work/repo"
 chown -R "$USER_NAME": "$work"
 
-runuser -u "$USER_NAME" -- env -i HOME="$home" PATH="$path" LANG=C.UTF-8 "${extra[@]}" bash -c "
+# a pip cache of its own: every run downloads (and builds) as on a new account, so the times it prints
+# are those of a fresh machine however often it runs here
+runuser -u "$USER_NAME" -- env -i HOME="$home" PATH="$path" LANG=C.UTF-8 PIP_CACHE_DIR="$work/pip-cache" \
+  "${extra[@]}" bash -c "
   set -euo pipefail
   cd '$work/repo'
   say() { echo 'install_paths $CASE:' \"\$@\"; }
