@@ -84,7 +84,7 @@ def run_event(force, psi, epicenter, model, integrator, v_start=0.0, trace=None)
     build_schedule(ws.W, ws.since, ws.tree, p.nu, p.b)     # (simulate does this itself)
     clock = np.zeros(2)
     start = time.perf_counter()
-    status = integrate_event(*ws.arrays[:7], clock, n, epicenter, v_start, p, ws.diag, profile,
+    status = integrate_event(ws.arrays, clock, n, epicenter, v_start, p, profile,
                              np.zeros((0, NTRACE)) if trace is None else trace)
     seconds = time.perf_counter() - start
     force, psi = ws.state((ws.diag[D_DURATION], 0.0), p.nu)     # every block at the end

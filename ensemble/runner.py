@@ -78,7 +78,7 @@ class Trajectory:
         epicenter = np.empty(n, dtype=np.int64)
         diag = np.empty((n, NDIAG))
         ws = self.ws
-        status, k = simulate(*ws.arrays, self.clock, self.params, n, budget, t, epicenter, diag)
+        status, k = simulate(ws.arrays, self.clock, self.params, n, budget, t, epicenter, diag)
         if status not in (OK, PAUSED):
             where = self.done + k
             phase = "transient " if where < self.cfg.run.transient else ""

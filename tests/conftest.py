@@ -88,7 +88,7 @@ def developed_state(model, events, seed=1, dt=1e-3):
     epi = np.empty(events, dtype=np.int64)
     diag = np.empty((events, NDIAG))
     params = kernel_params(model, Integrator(method="rk4", dt=dt))
-    status, k = simulate(*ws.arrays, clock, params, events, UNLIMITED, t, epi, diag)
+    status, k = simulate(ws.arrays, clock, params, events, UNLIMITED, t, epi, diag)
     assert status == 0
     return ws.state(clock, model.nu)
 

@@ -41,7 +41,7 @@ def run_with_budget(ws, clock, params, n, budget):
     out = outputs(n)
     done = paused = 0
     while done < n:
-        status, k = simulate(*ws.arrays, clock, params, n - done, budget, *(a[done:] for a in out))
+        status, k = simulate(ws.arrays, clock, params, n - done, budget, *(a[done:] for a in out))
         assert status in (OK, PAUSED)
         paused += status == PAUSED
         done += k
@@ -78,7 +78,7 @@ def test_between_events_state_of_a_paused_event(name, method):
     ref = outputs(n)
     for k in range(n):
         after.append((ws.force.copy(), ws.psi.copy(), ws.since.copy(), clock.copy()))
-        assert simulate(*ws.arrays, clock, params, 1, UNLIMITED, *(a[k:k + 1] for a in ref)) == (OK, 1)
+        assert simulate(ws.arrays, clock, params, 1, UNLIMITED, *(a[k:k + 1] for a in ref)) == (OK, 1)
     after.append((ws.force.copy(), ws.psi.copy(), ws.since.copy(), clock.copy()))
 
     ws, clock = fresh(model)
@@ -87,7 +87,7 @@ def test_between_events_state_of_a_paused_event(name, method):
     done = pauses = resumed = 0
     paused_in = set()     # events paused in the middle of
     while done < n:
-        status, k = simulate(*ws.arrays, clock, params, n - done, int(10 ** rng.uniform(0, 4)),
+        status, k = simulate(ws.arrays, clock, params, n - done, int(10 ** rng.uniform(0, 4)),
                              *(a[done:] for a in got))
         done += k
         if status != PAUSED:
@@ -104,7 +104,7 @@ def test_between_events_state_of_a_paused_event(name, method):
             other = Workspace(model.N)
             other.load(force, psi, since)
             rest = outputs(n - done)
-            assert simulate(*other.arrays, c, params, n - done, UNLIMITED, *rest) == (OK, n - done)
+            assert simulate(other.arrays, c, params, n - done, UNLIMITED, *rest) == (OK, n - done)
             for a, b in zip(rest, ref):
                 np.testing.assert_array_equal(a, b[done:])
             for a, b in zip(other.between_events(c), after[n]):

@@ -48,7 +48,7 @@ def test_clock_offset_does_not_change_events():
         epi = np.empty(20, dtype=np.int64)
         diag = np.empty((20, NDIAG))
         params = kernel_params(model, Integrator(method="rk4"))
-        status, _ = simulate(*ws.arrays, clock, params, 20, UNLIMITED, t, epi, diag)
+        status, _ = simulate(ws.arrays, clock, params, 20, UNLIMITED, t, epi, diag)
         assert status == 0
         out.append((t - start, epi, diag))
     np.testing.assert_array_equal(out[0][2], out[1][2])

@@ -47,7 +47,7 @@ def run_simulate(model, force, psi, events=5, method="rk4"):
     ws.load(force, psi)
     t, epi, diag = np.empty(events), np.empty(events, dtype=np.int64), np.empty((events, NDIAG))
     params = kernel_params(model, Integrator(method=method))
-    return simulate(*ws.arrays, np.zeros(2), params, events, UNLIMITED, t, epi, diag)
+    return simulate(ws.arrays, np.zeros(2), params, events, UNLIMITED, t, epi, diag)
 
 
 def test_nonfinite_parameters_are_named():
@@ -60,12 +60,12 @@ def test_nonfinite_parameters_are_named():
                 {"max_duration": math.nan}):
         ws.load(force, psi)
         out = np.empty(3), np.empty(3, dtype=np.int64), np.empty((3, NDIAG))
-        assert simulate(*ws.arrays, np.zeros(2), params._replace(**bad), 3, UNLIMITED, *out) == (NONFINITE, 0), bad
+        assert simulate(ws.arrays, np.zeros(2), params._replace(**bad), 3, UNLIMITED, *out) == (NONFINITE, 0), bad
     # the two bounds may be inf: none
     ws.load(force, psi)
     out = np.empty(3), np.empty(3, dtype=np.int64), np.empty((3, NDIAG))
     unbounded = params._replace(max_step=math.inf, max_duration=math.inf)
-    assert simulate(*ws.arrays, np.zeros(2), unbounded, 3, UNLIMITED, *out) == (OK, 3)
+    assert simulate(ws.arrays, np.zeros(2), unbounded, 3, UNLIMITED, *out) == (OK, 3)
 
 
 # Runs in a subprocess compiled with NUMBA_BOUNDSCHECK=1; prints one JSON line

@@ -33,7 +33,7 @@ def run_lazy(model, force, psi, events):
     clock = np.zeros(2)
     t, epi, diag = np.empty(events), np.empty(events, dtype=np.int64), np.empty((events, NDIAG))
     params = kernel_params(model, Integrator(method="rk4"))
-    status, _ = simulate(*ws.arrays, clock, params, events, UNLIMITED, t, epi, diag)
+    status, _ = simulate(ws.arrays, clock, params, events, UNLIMITED, t, epi, diag)
     assert status == 0
     return ws, clock, t, epi, diag
 
@@ -90,7 +90,7 @@ def test_an_event_updates_only_the_blocks_it_touched():
     small = 0
     for _ in range(60):
         before = ws.W.copy(), ws.since.copy()
-        assert simulate(*ws.arrays, clock, params, 1, UNLIMITED, t, epi, diag)[0] == 0
+        assert simulate(ws.arrays, clock, params, 1, UNLIMITED, t, epi, diag)[0] == 0
         changed = np.flatnonzero((ws.W != before[0]).any(axis=1) | (ws.since != before[1]).any(axis=1))
         lo, hi = int(diag[0, D_FIRST]), int(diag[0, D_LAST])
         if hi - lo < 20:

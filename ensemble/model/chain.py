@@ -33,10 +33,9 @@ EVENT_WORK = 32
 
 
 @nb.njit(cache=True)
-def simulate(W, act, flag, touched, stuck, since, tree, diag, event, undo, clock, p, n_events, budget, out_t,
-             out_epicenter, out_diag):
-    """Run up to n_events events from the time `clock`, within `budget` work units, with the
-    parameters `p` (params.KernelParams).
+def simulate(arrays, clock, p, n_events, budget, out_t, out_epicenter, out_diag):
+    """Run up to n_events events from the time `clock`, within `budget` work units, on the work
+    arrays `arrays` (workspace.WorkArrays) with the parameters `p` (params.KernelParams).
 
     Returns (status, k), k the number of events completed in this call:
     OK and k = n_events, or OK and k < n_events when the budget ran out between two events;
@@ -56,6 +55,7 @@ def simulate(W, act, flag, touched, stuck, since, tree, diag, event, undo, clock
     NONFINITE also stands for a NaN or inf among the parameters (p.max_step and p.max_duration
     may be inf: no bound) or the loaded state.
     """
+    W, since, tree, diag, event, undo = arrays.W, arrays.since, arrays.tree, arrays.diag, arrays.event, arrays.undo
     n = W.shape[0]
     no_profile = np.empty(0)
     no_trace = np.empty((0, NTRACE))
@@ -93,10 +93,9 @@ def simulate(W, act, flag, touched, stuck, since, tree, diag, event, undo, clock
             # event starts without a false stick (a force above it stays as it is).
             if W[epicenter, F0] < p.b * W[epicenter, P]:
                 W[epicenter, F0] = p.b * W[epicenter, P]
-            begin_event(W, act, flag, touched, since, tree, clock, n, epicenter, 0.0, p, event, undo)
+            begin_event(arrays, clock, n, epicenter, 0.0, p)
             spent += EVENT_WORK
-        status, used = continue_event(W, act, flag, touched, stuck, since, tree, clock, n, p, diag, no_profile,
-                                      no_trace, event, undo, budget - spent)
+        status, used = continue_event(arrays, clock, n, p, no_profile, no_trace, budget - spent)
         spent += used
         if status == PAUSED:
             return PAUSED, k

@@ -10,7 +10,7 @@ static threshold) is cut at that instant, located on the cubic Hermite
 interpolant of the step, and redone with the shorter step. Clamping v to zero at
 the end of a step instead would make the slip only second-order accurate.
 
-Work arrays (see `workspace.py`): columns of the float array `W` hold per-block
+Work arrays (one record, `workspace.WorkArrays`): columns of the float array `W` hold per-block
 quantities, `act` the active list, `flag` 0 (never slid in this event), 1
 (sliding), 2 (slid and now at rest), `touched` the blocks that slid.
 
@@ -36,7 +36,7 @@ from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D
                         D_LAST, D_LOAD_WORK, D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK,
                         EV_BLOCK_STEPS, EV_CUTS, EV_EPICENTER, EV_ERR_PREV, EV_FAR, EV_H_NEXT, EV_NA, EV_NT,
                         EV_PHASE, EV_REJECTED, EV_SLIP_TIME, EV_STEPS, EV_T_FAR, EV_TAU, EV_TRACED, EV_VMAX,
-                        EV_WORK, EV_YREST, F0, HD0, HD1, IN_EVENT, K1V, NEVENT, NONFINITE, NUNDO, OK,
+                        EV_WORK, EV_YREST, F0, HD0, HD1, IN_EVENT, K1V, NONFINITE, OK,
                         P, P0, PAUSED, T_AGE, T_BLOCK, T_ERROR, T_H, T_OWN, T_PART, T_PSI, T_SLIDING,
                         T_TAU, T_V, TOO_LONG, TR, TS, UNLIMITED, UNSTABLE, V, V0, Y, Y0, YS)
 
@@ -219,14 +219,13 @@ def _record(trace, row, p, W, act, na, tau, h, err, expo):
 
 
 @nb.njit(cache=True)
-def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter, v_start, p, diag, profile,
-                    trace):
+def integrate_event(arrays, t0, n, epicenter, v_start, p, profile, trace):
     """Integrate one event from the onset of `epicenter` at time t0 until every block is at rest.
 
-    On entry every block is at rest, block i with force W[i, F0] and state psi W[i, P]
-    at time since[i] (c-free frame; see schedule.py), `tree` holds every block's
-    onset key, the epicenter is on its threshold at t0 (two-float time), the
-    other columns and `flag` are zero. `v_start` is the epicenter's initial
+    On entry (work arrays `arrays`, workspace.WorkArrays) every block is at rest, block i with
+    force W[i, F0] and state psi W[i, P] at time since[i] (c-free frame; see schedule.py), `tree`
+    holds every block's onset key, the epicenter is on its threshold at t0 (two-float time), the
+    other columns and `flag` are zero, `event` is BETWEEN with an empty undo log. `v_start` is the epicenter's initial
     velocity (0 for a natural onset). `p` holds the parameters (params.KernelParams):
     p.method RK4 steps by p.dt; ARK3, ARK4 and ARK5 start with p.dt and control the step (at most
     p.max_step) so that the embedded error estimate stays below p.rtol, p.atol. On return the
@@ -238,22 +237,21 @@ def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter,
 
     This is begin_event and continue_event without a budget, in one call.
     """
-    event = np.zeros(NEVENT)
-    undo = np.empty((n, NUNDO))
-    begin_event(W, act, flag, touched, since, tree, t0, n, epicenter, v_start, p, event, undo)
-    status, _ = continue_event(W, act, flag, touched, stuck, since, tree, t0, n, p, diag, profile, trace, event,
-                               undo, UNLIMITED)
+    begin_event(arrays, t0, n, epicenter, v_start, p)
+    status, _ = continue_event(arrays, t0, n, p, profile, trace, UNLIMITED)
     return status
 
 
 @nb.njit(cache=True)
-def begin_event(W, act, flag, touched, since, tree, t0, n, epicenter, v_start, p, event, undo):
+def begin_event(arrays, t0, n, epicenter, v_start, p):
     """Start an event at the onset of `epicenter` at time t0 (as integrate_event's entry).
 
     The epicenter and its neighbours are watched (their between-events values logged in `undo`),
     and the event's loop variables go into `event` (EV_*, EV_PHASE = IN_EVENT) for
     continue_event. EV_NUNDO and the clock entries are the caller's (chain.simulate).
     """
+    W, act, flag, touched, since, tree = arrays.W, arrays.act, arrays.flag, arrays.touched, arrays.since, arrays.tree
+    event, undo = arrays.event, arrays.undo
     na, nt, yrest = _start(W, act, 0, flag, touched, 0, since, tree, t0, p.nu, epicenter, 0.0, 0.0, event,
                            undo)
     t_far, far = _far_onset(W, flag, n, since, tree, t0, 0.0, p)
@@ -286,7 +284,7 @@ def _keep(event, na, nt, yrest, t_far, far, tau, work, slip_time, steps, block_s
 
 
 @nb.njit(cache=True)
-def continue_event(W, act, flag, touched, stuck, since, tree, t0, n, p, diag, profile, trace, event, undo, budget):
+def continue_event(arrays, t0, n, p, profile, trace, budget):
     """Integrate the event in progress (begin_event) until every block is at rest, or pause.
 
     Before each step the work spent in this call (block-steps, see above) is compared with
@@ -295,6 +293,8 @@ def continue_event(W, act, flag, touched, stuck, since, tree, t0, n, p, diag, pr
     integrate_event (which see); when the event has finished, `event` is BETWEEN and its undo
     log empty. Returns (status, work units spent in this call).
     """
+    W, act, flag, touched, stuck = arrays.W, arrays.act, arrays.flag, arrays.touched, arrays.stuck
+    since, tree, diag, event, undo = arrays.since, arrays.tree, arrays.diag, arrays.event, arrays.undo
     na = int(event[EV_NA])
     nt = int(event[EV_NT])
     yrest = event[EV_YREST]
