@@ -26,7 +26,7 @@ import numpy as np
 
 from ensemble.config import Model
 from ensemble.events import check, run_event
-from ensemble.integrators import kernel_args
+from ensemble.integrators import kernel_params
 from ensemble.model.event import take_step
 from ensemble.model.workspace import F0, NCOLS, P, P0, V, V0, Y, Y0, YS
 
@@ -39,17 +39,17 @@ SLIDING = 4     # blocks sliding in the step-alone timing
 
 
 @nb.njit(cache=True)
-def _repeat_step(method, W, act, na, h, l2, nu, a, b, rtol, atol, reps):
+def _repeat_step(W, act, na, h, p, reps):
     total = 0.0
     for _ in range(reps):
-        total += take_step(method, W, act, na, W.shape[0], 0.0, h, l2, nu, a, b, 0.0, rtol, atol)[2]
+        total += take_step(W, act, na, W.shape[0], 0.0, h, p, 0.0)[2]
     return total
 
 
 def step_alone_ns(setting, model, reps=200_000):
     """Nanoseconds per block-step of one step of `setting`'s method, 4 blocks sliding (best of 3)."""
     integ = setting.integrator()
-    l2, nu, a, b, method, dt, rtol, atol, *_ = kernel_args(model, integ)
+    p = kernel_params(model, integ)
     n = 16
     W = np.zeros((n, NCOLS))
     act = np.arange(6, 6 + SLIDING).astype(np.int64)
@@ -57,18 +57,18 @@ def step_alone_ns(setting, model, reps=200_000):
         W[i, Y0] = W[i, Y] = W[i, YS] = 100.0 + 10.0 * k
         W[i, V0] = W[i, V] = 300.0 - 50.0 * k
         W[i, P0] = W[i, P] = -5.5 - 0.1 * k
-        W[i, F0] = b * 26.0
-    h = dt
+        W[i, F0] = p.b * 26.0
+    h = p.dt
     if integ.method != "rk4":     # a step the error control would accept
         h = 0.01
-        while _repeat_step(method, W.copy(), act, SLIDING, h, l2, nu, a, b, rtol, atol, 1) > 1.0:
+        while _repeat_step(W.copy(), act, SLIDING, h, p, 1) > 1.0:
             h /= 2
-    _repeat_step(method, W.copy(), act, SLIDING, h, l2, nu, a, b, rtol, atol, 10)
+    _repeat_step(W.copy(), act, SLIDING, h, p, 10)
     best = np.inf
     for _ in range(3):
         work = W.copy()
         start = time.perf_counter()
-        _repeat_step(method, work, act, SLIDING, h, l2, nu, a, b, rtol, atol, reps)
+        _repeat_step(work, act, SLIDING, h, p, reps)
         best = min(best, time.perf_counter() - start)
     return best / (reps * SLIDING) * 1e9
 

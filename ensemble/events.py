@@ -4,7 +4,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .integrators import kernel_args
+from .integrators import kernel_params
 from .model.event import integrate_event
 from .model.onset import onset_delay
 from .model.schedule import build_schedule, tree_min
@@ -80,15 +80,14 @@ def run_event(force, psi, epicenter, model, integrator, v_start=0.0, trace=None)
     ws = Workspace(n)
     ws.load(force, psi)
     profile = np.zeros(n)
-    l2, nu, a, b, method, dt, rtol, atol, h_max, max_duration, max_steps = kernel_args(model, integrator)
-    build_schedule(ws.W, ws.since, ws.tree, nu, b)     # (simulate does this itself)
+    p = kernel_params(model, integrator)
+    build_schedule(ws.W, ws.since, ws.tree, p.nu, p.b)     # (simulate does this itself)
     clock = np.zeros(2)
     start = time.perf_counter()
-    status = integrate_event(*ws.arrays[:7], clock, n, epicenter, v_start, l2, nu, a, b, method, dt,
-                             rtol, atol, h_max, max_duration, max_steps, ws.diag, profile,
+    status = integrate_event(ws.arrays, clock, n, epicenter, v_start, p, profile,
                              np.zeros((0, NTRACE)) if trace is None else trace)
     seconds = time.perf_counter() - start
-    force, psi = ws.state((ws.diag[D_DURATION], 0.0), nu)     # every block at the end
+    force, psi = ws.state((ws.diag[D_DURATION], 0.0), p.nu)     # every block at the end
     d = ws.diag
     return EventResult(status, d[D_SLIP], d[D_DURATION], int(d[D_STEPS]), int(d[D_BLOCK_STEPS]),
                        int(d[D_REJECTED]), int(d[D_CUTS]), d[D_VMAX], d[D_WORK],

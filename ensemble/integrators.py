@@ -6,6 +6,7 @@ which locates sticks and onsets inside a step the same way for each.
 from dataclasses import dataclass
 
 from .model.event import ARK3, ARK4, ARK5, RK4
+from .model.params import KernelParams
 
 
 @dataclass(frozen=True)
@@ -29,12 +30,11 @@ INTEGRATORS = {
 }
 
 
-def kernel_args(model, integrator):
-    """The kernels' scalar arguments from [model] and [integrator] (config dataclasses).
-
-    Order: l^2, nu, a, b, method, dt, rtol, atol, max_step, max_duration, max_steps.
-    """
+def kernel_params(model, integrator):
+    """The kernels' parameter record (model.params.KernelParams) from [model] and [integrator]
+    (config dataclasses)."""
     max_steps = int(min(2 * integrator.max_duration / integrator.dt + 1e6, 2**62))
-    return (model.l ** 2, model.nu, model.a, model.b, INTEGRATORS[integrator.method].code,
-            integrator.dt, integrator.rtol, integrator.atol, integrator.max_step,
-            integrator.max_duration, max_steps)
+    return KernelParams(l2=model.l ** 2, nu=model.nu, a=model.a, b=model.b,
+                        method=INTEGRATORS[integrator.method].code, dt=integrator.dt, rtol=integrator.rtol,
+                        atol=integrator.atol, max_step=integrator.max_step,
+                        max_duration=integrator.max_duration, max_steps=max_steps)

@@ -15,7 +15,7 @@ import numpy as np
 from . import catalog, environment
 from .catalog import FAILED, FINISHED, Checkpoint, CatalogError
 from .config import ConfigError, from_dict, loads, section_lines
-from .integrators import kernel_args
+from .integrators import kernel_params
 from .lock import RunLock
 from .model.chain import simulate
 from .model.workspace import (D_DURATION, D_FIRST, D_LAST, D_NSLIP, D_SLIP, NDIAG, OK, PAUSED,
@@ -57,7 +57,7 @@ class Trajectory:
             self.ws.load(checkpoint.force, checkpoint.psi, checkpoint.since)
             self.clock = checkpoint.clock.copy()
             self.done = checkpoint.done
-        self.args = kernel_args(task.model, self.integrator)
+        self.params = kernel_params(task.model, self.integrator)
 
     def checkpoint(self):
         """The state after the last completed event (also while an event is paused)."""
@@ -78,7 +78,7 @@ class Trajectory:
         epicenter = np.empty(n, dtype=np.int64)
         diag = np.empty((n, NDIAG))
         ws = self.ws
-        status, k = simulate(*ws.arrays, self.clock, *self.args, n, budget, t, epicenter, diag)
+        status, k = simulate(ws.arrays, self.clock, self.params, n, budget, t, epicenter, diag)
         if status not in (OK, PAUSED):
             where = self.done + k
             phase = "transient " if where < self.cfg.run.transient else ""

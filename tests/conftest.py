@@ -8,7 +8,7 @@ import pytest
 from ensemble import catalog
 from ensemble.config import Integrator, Model
 from ensemble.events import advance_to_onset, check, run_event
-from ensemble.integrators import kernel_args
+from ensemble.integrators import kernel_params
 from ensemble.model.chain import simulate
 from ensemble.model.workspace import NDIAG, UNLIMITED, Workspace
 
@@ -87,7 +87,8 @@ def developed_state(model, events, seed=1, dt=1e-3):
     t = np.empty(events)
     epi = np.empty(events, dtype=np.int64)
     diag = np.empty((events, NDIAG))
-    status, k = simulate(*ws.arrays, clock, *kernel_args(model, Integrator(method="rk4", dt=dt)), events, UNLIMITED, t, epi, diag)
+    params = kernel_params(model, Integrator(method="rk4", dt=dt))
+    status, k = simulate(ws.arrays, clock, params, events, UNLIMITED, t, epi, diag)
     assert status == 0
     return ws.state(clock, model.nu)
 

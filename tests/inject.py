@@ -101,6 +101,32 @@ def signal_when_paused(signum):
     runner.Trajectory.advance = patched
 
 
+def count_pauses(path, first_budget=None):
+    """Write to `path`, at exit, how many kernel calls ended inside an event (the work budget spent).
+
+    first_budget replaces runner.FIRST_BUDGET, the budget of a task's first call, so that a run
+    whose events are all cheaper than the default (250k block-steps) pauses as well.
+    """
+    import atexit
+
+    from ensemble import runner
+    if first_budget is not None:
+        runner.FIRST_BUDGET = first_budget
+    advance = runner.Trajectory.advance
+    paused = [0]
+
+    def patched(self, n, *args, **kwargs):
+        out = advance(self, n, *args, **kwargs)
+        paused[0] += self.ws.paused
+        return out
+    runner.Trajectory.advance = patched
+
+    def write():
+        with open(path, "w") as fh:
+            fh.write(f"{paused[0]}\n")
+    atexit.register(write)
+
+
 def hold(ready, go, rank=0, seconds=300):
     """Hold the run at its first kernel call (on MPI rank `rank`; the lock is taken, the catalog
     open) until the file `go` exists, after creating `ready`; a RuntimeError after `seconds`."""

@@ -56,7 +56,7 @@ MUTATIONS = (
              ("tests/test_physics.py", "tests/test_sequences.py"),
              "a mirror neighbour (u_{N} = u_{N-2}) at the right end instead of a free end"),
     Mutation("kernel-energy-no-loading-work", "ensemble/model/event.py",
-             "e_change += -nu * tau * slip + nu * slip_time", "e_change += -nu * tau * slip",
+             "e_change += -p.nu * tau * slip + p.nu * slip_time", "e_change += -p.nu * tau * slip",
              ("tests/test_physics.py::test_energy_balance_per_event",),
              "the loading work dropped from the energy balance"),
     Mutation("kernel-no-healing-at-rest-in-event", "ensemble/model/event.py",

@@ -4,8 +4,9 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from ensemble.config import Integrator
+from ensemble.config import Integrator, Model
 from ensemble.events import check, run_event
+from ensemble.integrators import kernel_params
 from ensemble.model.steppers import ark3_step, ark4_step, ark5_step
 from ensemble.model.tableaux import ARK324, ARK436, ARK548
 from ensemble.model.workspace import (NTRACE, P, P0, T_BLOCK, T_ERROR, T_H, T_OWN, T_PART, T_SLIDING, T_TAU, V,
@@ -179,7 +180,8 @@ def test_zero_step_keeps_the_state(step):
     W[:, Y0] = W[:, Y] = W[:, YS] = rng.random(8)
     W[:, V0] = rng.random(8) * 100
     W[:, P0] = W[:, P]
-    _, _, err = step(W, act, 3, 8, 0.5, 0.0, 9.0, 1e-8, 0.0, 20.0, 0.0, 1e-6, 1e-12)
+    params = kernel_params(Model(l=3.0, nu=1e-8, a=0.0, b=20.0), Integrator(rtol=1e-6, atol=1e-12))
+    _, _, err = step(W, act, 3, 8, 0.5, 0.0, params, 0.0)
     assert err == 0.0
     for new, old in ((Y, Y0), (V, V0), (P, P0)):
         np.testing.assert_array_equal(W[act[:3], new], W[act[:3], old])
@@ -194,9 +196,10 @@ def _slide(step, steps, duration=0.5):
     act = np.array([1, 0, 0])
     W[1, V] = 5.0
     h = duration / steps
+    params = kernel_params(Model(l=3.0, nu=1e-8, a=2.0, b=20.0), Integrator(rtol=1e-6, atol=1e-12))
     for k in range(steps):
         W[1, Y0], W[1, V0], W[1, P0] = W[1, Y], W[1, V], W[1, P]
-        step(W, act, 1, n, k * h, h, 9.0, 1e-8, 2.0, 20.0, 0.0, 1e-6, 1e-12)
+        step(W, act, 1, n, k * h, h, params, 0.0)
     return np.array([W[1, Y], W[1, V], W[1, P]])
 
 

@@ -14,7 +14,7 @@ import pytest
 
 from ensemble.catalog import Checkpoint
 from ensemble.config import Config, Integrator, Model, Run
-from ensemble.integrators import kernel_args
+from ensemble.integrators import kernel_params
 from ensemble.model.chain import simulate
 from ensemble.model.workspace import F0, NDIAG, OK, P, PAUSED, UNLIMITED, Workspace
 from ensemble.runner import Trajectory
@@ -36,12 +36,12 @@ def outputs(n):
     return np.empty(n), np.empty(n, dtype=np.int64), np.empty((n, NDIAG))
 
 
-def run_with_budget(ws, clock, args, n, budget):
+def run_with_budget(ws, clock, params, n, budget):
     """n events in calls of `budget` work units; (onsets, epicenters, diagnostics, calls that paused)."""
     out = outputs(n)
     done = paused = 0
     while done < n:
-        status, k = simulate(*ws.arrays, clock, *args, n - done, budget, *(a[done:] for a in out))
+        status, k = simulate(ws.arrays, clock, params, n - done, budget, *(a[done:] for a in out))
         assert status in (OK, PAUSED)
         paused += status == PAUSED
         done += k
@@ -52,12 +52,12 @@ def run_with_budget(ws, clock, args, n, budget):
 @pytest.mark.parametrize("name", MODELS)
 def test_any_budget_gives_the_same_events_and_state(name, method):
     model, n = MODELS[name], 20
-    args = kernel_args(model, Integrator(method=method))
+    params = kernel_params(model, Integrator(method=method))
     ws_ref, clock_ref = fresh(model)
-    *ref, _ = run_with_budget(ws_ref, clock_ref, args, n, UNLIMITED)
+    *ref, _ = run_with_budget(ws_ref, clock_ref, params, n, UNLIMITED)
     for budget in (1, 7, 100, 10**9):
         ws, clock = fresh(model)
-        *got, paused = run_with_budget(ws, clock, args, n, budget)
+        *got, paused = run_with_budget(ws, clock, params, n, budget)
         for a, b in zip(got, ref):
             np.testing.assert_array_equal(a, b)
         np.testing.assert_array_equal(clock, clock_ref)
@@ -72,13 +72,13 @@ def test_between_events_state_of_a_paused_event(name, method):
     """Paused anywhere, the state handed out is exactly the one after the last completed event,
     the workspace is left alone, and a fresh workspace loaded with it continues bit for bit."""
     model, n = MODELS[name], 16
-    args = kernel_args(model, Integrator(method=method))
+    params = kernel_params(model, Integrator(method=method))
     ws, clock = fresh(model)
     after = []      # exact between-events state after k events, k = 0..n
     ref = outputs(n)
     for k in range(n):
         after.append((ws.force.copy(), ws.psi.copy(), ws.since.copy(), clock.copy()))
-        assert simulate(*ws.arrays, clock, *args, 1, UNLIMITED, *(a[k:k + 1] for a in ref)) == (OK, 1)
+        assert simulate(ws.arrays, clock, params, 1, UNLIMITED, *(a[k:k + 1] for a in ref)) == (OK, 1)
     after.append((ws.force.copy(), ws.psi.copy(), ws.since.copy(), clock.copy()))
 
     ws, clock = fresh(model)
@@ -87,7 +87,7 @@ def test_between_events_state_of_a_paused_event(name, method):
     done = pauses = resumed = 0
     paused_in = set()     # events paused in the middle of
     while done < n:
-        status, k = simulate(*ws.arrays, clock, *args, n - done, int(10 ** rng.uniform(0, 4)),
+        status, k = simulate(ws.arrays, clock, params, n - done, int(10 ** rng.uniform(0, 4)),
                              *(a[done:] for a in got))
         done += k
         if status != PAUSED:
@@ -104,7 +104,7 @@ def test_between_events_state_of_a_paused_event(name, method):
             other = Workspace(model.N)
             other.load(force, psi, since)
             rest = outputs(n - done)
-            assert simulate(*other.arrays, c, *args, n - done, UNLIMITED, *rest) == (OK, n - done)
+            assert simulate(other.arrays, c, params, n - done, UNLIMITED, *rest) == (OK, n - done)
             for a, b in zip(rest, ref):
                 np.testing.assert_array_equal(a, b[done:])
             for a, b in zip(other.between_events(c), after[n]):

@@ -2,7 +2,7 @@
 import numpy as np
 
 from ensemble.config import Integrator, Model
-from ensemble.integrators import kernel_args
+from ensemble.integrators import kernel_params
 from ensemble.model.chain import simulate
 from ensemble.model.workspace import NDIAG, UNLIMITED, Workspace
 
@@ -47,7 +47,8 @@ def test_clock_offset_does_not_change_events():
         t = np.empty(20)
         epi = np.empty(20, dtype=np.int64)
         diag = np.empty((20, NDIAG))
-        status, _ = simulate(*ws.arrays, clock, *kernel_args(model, Integrator(method="rk4")), 20, UNLIMITED, t, epi, diag)
+        params = kernel_params(model, Integrator(method="rk4"))
+        status, _ = simulate(ws.arrays, clock, params, 20, UNLIMITED, t, epi, diag)
         assert status == 0
         out.append((t - start, epi, diag))
     np.testing.assert_array_equal(out[0][2], out[1][2])

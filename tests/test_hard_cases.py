@@ -6,7 +6,7 @@ runs at dt = 2e-4) and with each adaptive method at its default tolerances and n
 tuning. The full sizes (N = 800, 6400) are benchmarks/hard_cases.py.
 
 The two c cases cannot fail for a kernel bug that the other cases would not show: c never
-reaches the kernels (the c-free frame removes it exactly; kernel_args does not pass it, and the
+reaches the kernels (the c-free frame removes it exactly; kernel_params does not pass it, and the
 initial state does not depend on it), so "c = 1e2" and "c = 1e6" run bit-identical events (as
 the printed numbers show). They stay as a guard that c keeps out of the kernels; the kernel's
 physics with c is checked against references that keep c (test_physics.py, test_sequences.py).

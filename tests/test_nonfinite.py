@@ -16,7 +16,7 @@ import sys
 import numpy as np
 
 from ensemble.config import Integrator, Model
-from ensemble.integrators import kernel_args
+from ensemble.integrators import kernel_params
 from ensemble.model.chain import simulate
 from ensemble.model.onset import onset_delay
 from ensemble.model.schedule import tree_min, tree_set
@@ -46,8 +46,8 @@ def run_simulate(model, force, psi, events=5, method="rk4"):
     ws = Workspace(model.N)
     ws.load(force, psi)
     t, epi, diag = np.empty(events), np.empty(events, dtype=np.int64), np.empty((events, NDIAG))
-    args = kernel_args(model, Integrator(method=method))
-    return simulate(*ws.arrays, np.zeros(2), *args, events, UNLIMITED, t, epi, diag)
+    params = kernel_params(model, Integrator(method=method))
+    return simulate(ws.arrays, np.zeros(2), params, events, UNLIMITED, t, epi, diag)
 
 
 def test_nonfinite_parameters_are_named():
@@ -55,20 +55,17 @@ def test_nonfinite_parameters_are_named():
     model = Model(N=30)
     force, psi = -np.linspace(0.0, 1.0, model.N), np.zeros(model.N)
     ws = Workspace(model.N)
-    # l2, nu, b, atol, max_step, max_duration in the order of kernel_args
-    for which, value in ((0, math.nan), (1, math.inf), (3, math.nan), (7, math.inf), (8, math.nan),
-                         (9, math.nan)):
-        args = list(kernel_args(model, Integrator()))
-        args[which] = value
+    params = kernel_params(model, Integrator())
+    for bad in ({"l2": math.nan}, {"nu": math.inf}, {"b": math.nan}, {"atol": math.inf}, {"max_step": math.nan},
+                {"max_duration": math.nan}):
         ws.load(force, psi)
         out = np.empty(3), np.empty(3, dtype=np.int64), np.empty((3, NDIAG))
-        assert simulate(*ws.arrays, np.zeros(2), *args, 3, UNLIMITED, *out) == (NONFINITE, 0)
+        assert simulate(ws.arrays, np.zeros(2), params._replace(**bad), 3, UNLIMITED, *out) == (NONFINITE, 0), bad
     # the two bounds may be inf: none
-    args = list(kernel_args(model, Integrator()))
-    args[8] = args[9] = math.inf
     ws.load(force, psi)
     out = np.empty(3), np.empty(3, dtype=np.int64), np.empty((3, NDIAG))
-    assert simulate(*ws.arrays, np.zeros(2), *args, 3, UNLIMITED, *out) == (OK, 3)
+    unbounded = params._replace(max_step=math.inf, max_duration=math.inf)
+    assert simulate(ws.arrays, np.zeros(2), unbounded, 3, UNLIMITED, *out) == (OK, 3)
 
 
 # Runs in a subprocess compiled with NUMBA_BOUNDSCHECK=1; prints one JSON line

@@ -77,7 +77,7 @@ def test_energy_balance_per_event():
 def test_c_invariance_from_equivalent_physical_states():
     """c = 1e2 and c = 1e4 give the same events from states that differ by the uniform shift of u.
 
-    What this can and cannot see: c never reaches the kernels (kernel_args does not pass it; the
+    What this can and cannot see: c never reaches the kernels (kernel_params does not pass it; the
     c-free frame removes it exactly), so it only checks that `physical_state` removes c
     consistently; no bug in ensemble/model can make it fail. The kernel's handling of c is
     checked against a reference that keeps c: test_kernel_agrees_with_independent_full_chain_reference

@@ -4,7 +4,7 @@ import pytest
 
 from ensemble.config import Integrator, Model
 from ensemble.events import advance_to_onset, check, run_event
-from ensemble.integrators import kernel_args
+from ensemble.integrators import kernel_params
 from ensemble.model.chain import simulate
 from ensemble.model.schedule import tree_min, tree_set
 from ensemble.model.workspace import D_DURATION, D_FIRST, D_LAST, D_SLIP, NDIAG, UNLIMITED, Workspace, tree_size
@@ -32,7 +32,8 @@ def run_lazy(model, force, psi, events):
     ws.load(force, psi)
     clock = np.zeros(2)
     t, epi, diag = np.empty(events), np.empty(events, dtype=np.int64), np.empty((events, NDIAG))
-    status, _ = simulate(*ws.arrays, clock, *kernel_args(model, Integrator(method="rk4")), events, UNLIMITED, t, epi, diag)
+    params = kernel_params(model, Integrator(method="rk4"))
+    status, _ = simulate(ws.arrays, clock, params, events, UNLIMITED, t, epi, diag)
     assert status == 0
     return ws, clock, t, epi, diag
 
@@ -85,11 +86,11 @@ def test_an_event_updates_only_the_blocks_it_touched():
     ws.load(force, psi)
     clock = np.zeros(2)
     t, epi, diag = np.empty(1), np.empty(1, dtype=np.int64), np.empty((1, NDIAG))
-    args = kernel_args(model, Integrator(method="rk4"))
+    params = kernel_params(model, Integrator(method="rk4"))
     small = 0
     for _ in range(60):
         before = ws.W.copy(), ws.since.copy()
-        assert simulate(*ws.arrays, clock, *args, 1, UNLIMITED, t, epi, diag)[0] == 0
+        assert simulate(ws.arrays, clock, params, 1, UNLIMITED, t, epi, diag)[0] == 0
         changed = np.flatnonzero((ws.W != before[0]).any(axis=1) | (ws.since != before[1]).any(axis=1))
         lo, hi = int(diag[0, D_FIRST]), int(diag[0, D_LAST])
         if hi - lo < 20:

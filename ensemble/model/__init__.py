@@ -1,6 +1,6 @@
 """Numba kernels of the Burridge-Knopoff chain with rate- and state-dependent friction.
 
-Kernels are pure: arrays and scalars in, arrays out. Nothing here knows about
+Kernels are pure: arrays, scalars and the parameter record (params.py) in, arrays out. Nothing here knows about
 config objects, files, MPI or HDF5 (see ensemble.runner for the wrapper).
 
 Numba's on-disk cache only notices changes to the file of the cached function

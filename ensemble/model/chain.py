@@ -33,10 +33,9 @@ EVENT_WORK = 32
 
 
 @nb.njit(cache=True)
-def simulate(W, act, flag, touched, stuck, since, tree, diag, event, undo, clock, l2, nu, a, b, method,
-             dt, rtol, atol, h_max, max_duration, max_steps, n_events, budget, out_t, out_epicenter,
-             out_diag):
-    """Run up to n_events events from the time `clock`, within `budget` work units.
+def simulate(arrays, clock, p, n_events, budget, out_t, out_epicenter, out_diag):
+    """Run up to n_events events from the time `clock`, within `budget` work units, on the work
+    arrays `arrays` (workspace.WorkArrays) with the parameters `p` (params.KernelParams).
 
     Returns (status, k), k the number of events completed in this call:
     OK and k = n_events, or OK and k < n_events when the budget ran out between two events;
@@ -53,18 +52,19 @@ def simulate(W, act, flag, touched, stuck, since, tree, diag, event, undo, clock
     out_t[k] is the onset time of event k, out_epicenter[k] its epicenter,
     out_diag[k] the event's diagnostics vector (workspace.D_*). On a status
     other than OK and PAUSED the state is that after the failed event, which is not counted;
-    NONFINITE also stands for a NaN or inf among the parameters (h_max and max_duration may
-    be inf: no bound) or the loaded state.
+    NONFINITE also stands for a NaN or inf among the parameters (p.max_step and p.max_duration
+    may be inf: no bound) or the loaded state.
     """
+    W, since, tree, diag, event, undo = arrays.W, arrays.since, arrays.tree, arrays.diag, arrays.event, arrays.undo
     n = W.shape[0]
     no_profile = np.empty(0)
     no_trace = np.empty((0, NTRACE))
-    if not _finite_parameters(l2, nu, a, b, dt, rtol, atol, h_max, max_duration):
+    if not _finite_parameters(p):
         return NONFINITE, 0
     if math.isnan(tree[1]):      # a freshly loaded state (Workspace.load): schedule every block
         if not finite_state(W, since):
             return NONFINITE, 0
-        build_schedule(W, since, tree, nu, b)
+        build_schedule(W, since, tree, p.nu, p.b)
     onset = np.empty(2)
     k = 0
     spent = 0
@@ -75,7 +75,7 @@ def simulate(W, act, flag, touched, stuck, since, tree, diag, event, undo, clock
             _, epicenter = tree_min(tree)
             # The onset, exactly: the epicenter's own delay from its state (the tree
             # only orders the blocks), never before the end of the previous event.
-            delay = onset_delay(W[epicenter, F0], W[epicenter, P], nu, b)
+            delay = onset_delay(W[epicenter, F0], W[epicenter, P], p.nu, p.b)
             if not math.isfinite(delay):     # a NaN state, or inf: no block ever starts (b / nu > 1e308)
                 return NONFINITE, k
             onset[0] = since[epicenter, 0]
@@ -88,17 +88,14 @@ def simulate(W, act, flag, touched, stuck, since, tree, diag, event, undo, clock
             if (onset[0] - clock[0]) + (onset[1] - clock[1]) > 0.0:
                 clock[0] = onset[0]
                 clock[1] = onset[1]
-            materialize(W, since, epicenter, clock, nu)
+            materialize(W, since, epicenter, clock, p.nu)
             # Put the epicenter on its threshold, not a round-off below it, so the
             # event starts without a false stick (a force above it stays as it is).
-            if W[epicenter, F0] < b * W[epicenter, P]:
-                W[epicenter, F0] = b * W[epicenter, P]
-            begin_event(W, act, flag, touched, since, tree, clock, n, epicenter, 0.0, l2, nu, b, dt, event,
-                        undo)
+            if W[epicenter, F0] < p.b * W[epicenter, P]:
+                W[epicenter, F0] = p.b * W[epicenter, P]
+            begin_event(arrays, clock, n, epicenter, 0.0, p)
             spent += EVENT_WORK
-        status, used = continue_event(W, act, flag, touched, stuck, since, tree, clock, n, l2, nu, a, b,
-                                      method, dt, rtol, atol, h_max, max_duration, max_steps, diag,
-                                      no_profile, no_trace, event, undo, budget - spent)
+        status, used = continue_event(arrays, clock, n, p, no_profile, no_trace, budget - spent)
         spent += used
         if status == PAUSED:
             return PAUSED, k
@@ -116,10 +113,10 @@ def simulate(W, act, flag, touched, stuck, since, tree, diag, event, undo, clock
 
 
 @nb.njit(cache=True)
-def _finite_parameters(l2, nu, a, b, dt, rtol, atol, h_max, max_duration):
+def _finite_parameters(p):
     """No NaN or inf among the model and integrator parameters, but for the two bounds: the
     largest step and the longest event may be inf (no bound), though not NaN (which would
     silently disable them as well)."""
-    return (math.isfinite(l2) and math.isfinite(nu) and math.isfinite(a) and math.isfinite(b)
-            and math.isfinite(dt) and math.isfinite(rtol) and math.isfinite(atol)
-            and not math.isnan(h_max) and not math.isnan(max_duration))
+    return (math.isfinite(p.l2) and math.isfinite(p.nu) and math.isfinite(p.a) and math.isfinite(p.b)
+            and math.isfinite(p.dt) and math.isfinite(p.rtol) and math.isfinite(p.atol)
+            and not math.isnan(p.max_step) and not math.isnan(p.max_duration))

@@ -10,7 +10,7 @@ static threshold) is cut at that instant, located on the cubic Hermite
 interpolant of the step, and redone with the shorter step. Clamping v to zero at
 the end of a step instead would make the slip only second-order accurate.
 
-Work arrays (see `workspace.py`): columns of the float array `W` hold per-block
+Work arrays (one record, `workspace.WorkArrays`): columns of the float array `W` hold per-block
 quantities, `act` the active list, `flag` 0 (never slid in this event), 1
 (sliding), 2 (slid and now at rest), `touched` the blocks that slid.
 
@@ -36,7 +36,7 @@ from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D
                         D_LAST, D_LOAD_WORK, D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK,
                         EV_BLOCK_STEPS, EV_CUTS, EV_EPICENTER, EV_ERR_PREV, EV_FAR, EV_H_NEXT, EV_NA, EV_NT,
                         EV_PHASE, EV_REJECTED, EV_SLIP_TIME, EV_STEPS, EV_T_FAR, EV_TAU, EV_TRACED, EV_VMAX,
-                        EV_WORK, EV_YREST, F0, HD0, HD1, IN_EVENT, K1V, NEVENT, NONFINITE, NUNDO, OK,
+                        EV_WORK, EV_YREST, F0, HD0, HD1, IN_EVENT, K1V, NONFINITE, OK,
                         P, P0, PAUSED, T_AGE, T_BLOCK, T_ERROR, T_H, T_OWN, T_PART, T_PSI, T_SLIDING,
                         T_TAU, T_V, TOO_LONG, TR, TS, UNLIMITED, UNSTABLE, V, V0, Y, Y0, YS)
 
@@ -81,36 +81,36 @@ def _slip_at(W, flag, j, x):
 
 
 @nb.njit(cache=True)
-def _excess(W, flag, n, j, tau, h, x, l2, nu, b):
+def _excess(W, flag, n, j, tau, h, x, p):
     """Force above the static threshold of resting block j at fraction x of the step."""
     s = tau + x * h
     yl = _slip_at(W, flag, left(j), x)
     yr = _slip_at(W, flag, right(j, n), x)
-    return spring_force(W[j, F0], s, nu, l2, yl, W[j, Y], yr) - b * _rest_psi(W, j, s)
+    return spring_force(W[j, F0], s, p.nu, p.l2, yl, W[j, Y], yr) - p.b * _rest_psi(W, j, s)
 
 
 @nb.njit(cache=True)
-def _force_now(W, n, j, tau, l2, nu):
-    return spring_force(W[j, F0], tau, nu, l2, W[left(j), Y], W[j, Y], W[right(j, n), Y])
+def _force_now(W, n, j, tau, p):
+    return spring_force(W[j, F0], tau, p.nu, p.l2, W[left(j), Y], W[j, Y], W[right(j, n), Y])
 
 
 @nb.njit(cache=True)
-def _excess_now(W, n, j, tau, l2, nu, b):
+def _excess_now(W, n, j, tau, p):
     """Force above the static threshold of resting block j at the current time."""
-    return _force_now(W, n, j, tau, l2, nu) - b * _rest_psi(W, j, tau)
+    return _force_now(W, n, j, tau, p) - p.b * _rest_psi(W, j, tau)
 
 
 @nb.njit(cache=True)
-def _above_threshold(W, flag, n, j, tau, l2, nu, b):
+def _above_threshold(W, flag, n, j, tau, p):
     """Block j is at rest and its force exceeds the static threshold at local time tau."""
     # Cheap filter first: the threshold of a resting block only grows, so a
     # force below b * (psi when it came to rest) cannot start it.
-    return (flag[j] != 1 and _force_now(W, n, j, tau, l2, nu) > b * W[j, P]
-            and _excess_now(W, n, j, tau, l2, nu, b) > 0.0)
+    return (flag[j] != 1 and _force_now(W, n, j, tau, p) > p.b * W[j, P]
+            and _excess_now(W, n, j, tau, p) > 0.0)
 
 
 @nb.njit(cache=True)
-def _pressed(W, n, i, tau, l2, nu, b):
+def _pressed(W, n, i, tau, p):
     """Sliding block i has not moved in this step but is still at or above its threshold.
 
     A block that starts exactly on its threshold gains force at the rate
@@ -118,7 +118,7 @@ def _pressed(W, n, i, tau, l2, nu, b):
     rounding of the force for a step: it has not stopped, it has not started yet.
     """
     return (W[i, V0] == 0.0 and W[i, V] == 0.0
-            and _force_now(W, n, i, tau, l2, nu) - b * W[i, P] >= 0.0)
+            and _force_now(W, n, i, tau, p) - p.b * W[i, P] >= 0.0)
 
 
 @nb.njit(cache=True)
@@ -127,15 +127,15 @@ def _adjacent_to_active(flag, n, j):
 
 
 @nb.njit(cache=True)
-def _loading_onset(W, flag, n, j, tau, l2, nu, b):
+def _loading_onset(W, flag, n, j, tau, p):
     """Local time at which resting block j starts by loading alone (inf if it is watched)."""
     if flag[j] == 1 or _adjacent_to_active(flag, n, j):
         return np.inf
-    return tau + onset_delay(_force_now(W, n, j, tau, l2, nu), _rest_psi(W, j, tau), nu, b)
+    return tau + onset_delay(_force_now(W, n, j, tau, p), _rest_psi(W, j, tau), p.nu, p.b)
 
 
 @nb.njit(cache=True)
-def _far_onset(W, flag, n, since, tree, t0, tau, l2, nu, b):
+def _far_onset(W, flag, n, since, tree, t0, tau, p):
     """(local time, block) of the earliest onset by loading alone of a block nobody watches.
 
     The tree orders the candidates; the winner's onset is recomputed exactly:
@@ -146,8 +146,8 @@ def _far_onset(W, flag, n, since, tree, t0, tau, l2, nu, b):
     if key == np.inf:
         return np.inf, -1
     if since[j, 0] == t0[0] and since[j, 1] == t0[1]:
-        return _loading_onset(W, flag, n, j, tau, l2, nu, b), j
-    t = (since[j, 0] - t0[0]) + (since[j, 1] - t0[1]) + onset_delay(W[j, F0], W[j, P], nu, b)
+        return _loading_onset(W, flag, n, j, tau, p), j
+    t = (since[j, 0] - t0[0]) + (since[j, 1] - t0[1]) + onset_delay(W[j, F0], W[j, P], p.nu, p.b)
     return max(t, tau), j
 
 
@@ -178,26 +178,26 @@ def _start(W, act, na, flag, touched, nt, since, tree, t0, nu, j, tau, yrest, ev
 
 
 @nb.njit(cache=True)
-def take_step(method, W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol):
-    """One step of `method` (RK4, ARK3, ARK4, ARK5) of the active blocks; see steppers.py."""
-    if method == RK4:
-        return rk4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
-    if method == ARK3:
-        return ark3_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
-    if method == ARK4:
-        return ark4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
-    return ark5_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
+def take_step(W, act, na, n, tau, h, p, yrest):
+    """One step of the method p.method (RK4, ARK3, ARK4, ARK5) of the active blocks; see steppers.py."""
+    if p.method == RK4:
+        return rk4_step(W, act, na, n, tau, h, p, yrest)
+    if p.method == ARK3:
+        return ark3_step(W, act, na, n, tau, h, p, yrest)
+    if p.method == ARK4:
+        return ark4_step(W, act, na, n, tau, h, p, yrest)
+    return ark5_step(W, act, na, n, tau, h, p, yrest)
 
 
 @nb.njit(cache=True)
-def _record(trace, row, method, W, act, na, tau, h, err, rtol, atol, expo):
+def _record(trace, row, p, W, act, na, tau, h, err, expo):
     """Row `row` of the step trace (workspace.TRACE_COLUMNS) for the step just tried."""
     trace[row, T_TAU] = tau
     trace[row, T_H] = h
     trace[row, T_SLIDING] = na
     trace[row, T_ERROR] = err
     trace[row, T_BLOCK] = -1
-    if method == RK4:
+    if p.method == RK4:
         return
     # a block whose error is e could have taken a step (err / e)^(1/(q+1)) times longer (counted
     # as at most 10x: a block with a vanishing error estimate still has to step)
@@ -205,7 +205,7 @@ def _record(trace, row, method, W, act, na, tau, h, err, rtol, atol, expo):
     worst = -1.0
     for k in range(na):
         i = act[k]
-        parts = block_error(W, i, h, rtol, atol, ERROR_WEIGHTS[method])
+        parts = block_error(W, i, h, p.rtol, p.atol, ERROR_WEIGHTS[p.method])
         e = max(parts)
         own += 1.0 if err <= 0.0 else min(1.0, max(0.1, (e / err) ** -expo))
         if e > worst:
@@ -219,49 +219,46 @@ def _record(trace, row, method, W, act, na, tau, h, err, rtol, atol, expo):
 
 
 @nb.njit(cache=True)
-def integrate_event(W, act, flag, touched, stuck, since, tree, t0, n, epicenter, v_start, l2, nu, a,
-                    b, method, dt, rtol, atol, h_max, max_duration, max_steps, diag, profile, trace):
+def integrate_event(arrays, t0, n, epicenter, v_start, p, profile, trace):
     """Integrate one event from the onset of `epicenter` at time t0 until every block is at rest.
 
-    On entry every block is at rest, block i with force W[i, F0] and state psi W[i, P]
-    at time since[i] (c-free frame; see schedule.py), `tree` holds every block's
-    onset key, the epicenter is on its threshold at t0 (two-float time), the
-    other columns and `flag` are zero. `v_start` is the epicenter's initial
-    velocity (0 for a natural onset). method RK4 steps by dt; ARK3, ARK4 and ARK5
-    start with dt and control the step (at most h_max) so that the embedded
-    error estimate stays below rtol, atol. On return the blocks the event touched hold the
-    state at its end (the schedule updated), the other columns and `flag` are
-    zero, and `diag` holds the event summary (see workspace.D_*). If `profile`
+    On entry (work arrays `arrays`, workspace.WorkArrays) every block is at rest, block i with
+    force W[i, F0] and state psi W[i, P] at time since[i] (c-free frame; see schedule.py), `tree`
+    holds every block's onset key, the epicenter is on its threshold at t0 (two-float time), the
+    other columns and `flag` are zero, `event` is BETWEEN with an empty undo log. `v_start` is the epicenter's initial
+    velocity (0 for a natural onset). `p` holds the parameters (params.KernelParams):
+    p.method RK4 steps by p.dt; ARK3, ARK4 and ARK5 start with p.dt and control the step (at most
+    p.max_step) so that the embedded error estimate stays below p.rtol, p.atol. On return the
+    blocks the event touched hold the state at its end (the schedule updated), the other columns
+    and `flag` are zero, and `diag` holds the event summary (see workspace.D_*). If `profile`
     has n entries it receives the slip of every block (else pass an empty
     array). If `trace` has rows, each step tried fills one (workspace.TRACE_COLUMNS, until the
     rows run out; a step cut at a located transition appears once, as tried). Returns a status code.
 
     This is begin_event and continue_event without a budget, in one call.
     """
-    event = np.zeros(NEVENT)
-    undo = np.empty((n, NUNDO))
-    begin_event(W, act, flag, touched, since, tree, t0, n, epicenter, v_start, l2, nu, b, dt, event, undo)
-    status, _ = continue_event(W, act, flag, touched, stuck, since, tree, t0, n, l2, nu, a, b, method, dt,
-                               rtol, atol, h_max, max_duration, max_steps, diag, profile, trace, event,
-                               undo, UNLIMITED)
+    begin_event(arrays, t0, n, epicenter, v_start, p)
+    status, _ = continue_event(arrays, t0, n, p, profile, trace, UNLIMITED)
     return status
 
 
 @nb.njit(cache=True)
-def begin_event(W, act, flag, touched, since, tree, t0, n, epicenter, v_start, l2, nu, b, dt, event, undo):
+def begin_event(arrays, t0, n, epicenter, v_start, p):
     """Start an event at the onset of `epicenter` at time t0 (as integrate_event's entry).
 
     The epicenter and its neighbours are watched (their between-events values logged in `undo`),
     and the event's loop variables go into `event` (EV_*, EV_PHASE = IN_EVENT) for
     continue_event. EV_NUNDO and the clock entries are the caller's (chain.simulate).
     """
-    na, nt, yrest = _start(W, act, 0, flag, touched, 0, since, tree, t0, nu, epicenter, 0.0, 0.0, event,
+    W, act, flag, touched, since, tree = arrays.W, arrays.act, arrays.flag, arrays.touched, arrays.since, arrays.tree
+    event, undo = arrays.event, arrays.undo
+    na, nt, yrest = _start(W, act, 0, flag, touched, 0, since, tree, t0, p.nu, epicenter, 0.0, 0.0, event,
                            undo)
-    t_far, far = _far_onset(W, flag, n, since, tree, t0, 0.0, l2, nu, b)
+    t_far, far = _far_onset(W, flag, n, since, tree, t0, 0.0, p)
     W[epicenter, V] = v_start
     event[EV_PHASE] = IN_EVENT
     event[EV_EPICENTER] = epicenter
-    _keep(event, na, nt, yrest, t_far, far, 0.0, 0.0, 0.0, 0, 0, 0, 0, v_start, dt, 1.0, 0)
+    _keep(event, na, nt, yrest, t_far, far, 0.0, 0.0, 0.0, 0, 0, 0, 0, v_start, p.dt, 1.0, 0)
 
 
 @nb.njit(cache=True, inline="always")
@@ -287,8 +284,7 @@ def _keep(event, na, nt, yrest, t_far, far, tau, work, slip_time, steps, block_s
 
 
 @nb.njit(cache=True)
-def continue_event(W, act, flag, touched, stuck, since, tree, t0, n, l2, nu, a, b, method, dt, rtol, atol,
-                   h_max, max_duration, max_steps, diag, profile, trace, event, undo, budget):
+def continue_event(arrays, t0, n, p, profile, trace, budget):
     """Integrate the event in progress (begin_event) until every block is at rest, or pause.
 
     Before each step the work spent in this call (block-steps, see above) is compared with
@@ -297,6 +293,8 @@ def continue_event(W, act, flag, touched, stuck, since, tree, t0, n, l2, nu, a, 
     integrate_event (which see); when the event has finished, `event` is BETWEEN and its undo
     log empty. Returns (status, work units spent in this call).
     """
+    W, act, flag, touched, stuck = arrays.W, arrays.act, arrays.flag, arrays.touched, arrays.stuck
+    since, tree, diag, event, undo = arrays.since, arrays.tree, arrays.diag, arrays.event, arrays.undo
     na = int(event[EV_NA])
     nt = int(event[EV_NT])
     yrest = event[EV_YREST]
@@ -314,16 +312,16 @@ def continue_event(W, act, flag, touched, stuck, since, tree, t0, n, l2, nu, a, 
     err_prev = event[EV_ERR_PREV]
     traced = int(event[EV_TRACED])
     status = OK
-    v_limit = RK4_STABILITY / dt
+    v_limit = RK4_STABILITY / p.dt
     psi_limit = -math.log(v_limit)
-    expo = _CONTROL_EXPONENT[method]
+    expo = _CONTROL_EXPONENT[p.method]
     used = 0
     while na > 0:
         if used >= budget:
             _keep(event, na, nt, yrest, t_far, far, tau, work, slip_time, steps, block_steps, rejected,
                   cuts, vmax, h_next, err_prev, traced)
             return PAUSED, used
-        if steps >= max_steps or tau > max_duration:
+        if steps >= p.max_steps or tau > p.max_duration:
             status = TOO_LONG
             break
         for k in range(na):
@@ -334,18 +332,18 @@ def continue_event(W, act, flag, touched, stuck, since, tree, t0, n, l2, nu, a, 
         h = h_next
         retried = False
         while True:
-            dwork, dslip, err = take_step(method, W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
+            dwork, dslip, err = take_step(W, act, na, n, tau, h, p, yrest)
             used += na
             if traced < trace.shape[0]:
-                _record(trace, traced, method, W, act, na, tau, h, err, rtol, atol, expo)
+                _record(trace, traced, p, W, act, na, tau, h, err, expo)
                 traced += 1
-            if method == RK4 or err <= 1.0 or h < 1e-12:
+            if p.method == RK4 or err <= 1.0 or h < 1e-12:
                 break
             h *= max(0.2, 0.9 * err ** expo)    # rejected: retry from (Y0, V0, P0)
             steps += 1
             rejected += 1
             retried = True
-        if method != RK4:
+        if p.method != RK4:
             if err == 0.0:
                 grow = 5.0
             else:
@@ -355,7 +353,7 @@ def continue_event(W, act, flag, touched, stuck, since, tree, t0, n, l2, nu, a, 
                 # no growth right after a rejection (the step just failed at a larger h):
                 # 4% fewer steps, 20% fewer rejections for ark4 on large events (plain controller)
                 grow = min(grow, 1.0)
-            h_next = min(h_max, h * grow)
+            h_next = min(p.max_step, h * grow)
         # Earliest transition inside the step, as a fraction x of it; the slip
         # of a sliding block inside the step is the Hermite cubic with these slopes.
         for k in range(na):
@@ -368,8 +366,8 @@ def continue_event(W, act, flag, touched, stuck, since, tree, t0, n, l2, nu, a, 
         for k in range(na):
             i = act[k]
             if W[i, V] <= 0.0 and W[i, V0] > 0.0:
-                a_end = spring_force(W[i, F0], tau + h, nu, l2, W[left(i), Y], W[i, Y],
-                                     W[right(i, n), Y]) - friction(W[i, V], W[i, P], a, b)
+                a_end = spring_force(W[i, F0], tau + h, p.nu, p.l2, W[left(i), Y], W[i, Y],
+                                     W[right(i, n), Y]) - friction(W[i, V], W[i, P], p.a, p.b)
                 d0 = h * W[i, K1V]
                 d1 = h * a_end
                 lo = 0.0
@@ -387,16 +385,16 @@ def continue_event(W, act, flag, touched, stuck, since, tree, t0, n, l2, nu, a, 
         for k in range(na):
             i = act[k]
             for j in (left(i), right(i, n)):
-                if j != i and _above_threshold(W, flag, n, j, tau + h, l2, nu, b):
+                if j != i and _above_threshold(W, flag, n, j, tau + h, p):
                     lo = 0.0
                     hi = 1.0
-                    if _excess(W, flag, n, j, tau, h, 0.0, l2, nu, b) >= 0.0:
+                    if _excess(W, flag, n, j, tau, h, 0.0, p) >= 0.0:
                         hi = 0.0
                     for _ in range(_BISECT):
                         if hi == 0.0:
                             break
                         mid = 0.5 * (lo + hi)
-                        if _excess(W, flag, n, j, tau, h, mid, l2, nu, b) > 0.0:
+                        if _excess(W, flag, n, j, tau, h, mid, p) > 0.0:
                             hi = mid
                         else:
                             lo = mid
@@ -413,7 +411,7 @@ def continue_event(W, act, flag, touched, stuck, since, tree, t0, n, l2, nu, a, 
         if kind != 0 and x_cut < 1.0:
             h = x_cut * h
             cuts += 1
-            dwork, dslip, _ = take_step(method, W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol)
+            dwork, dslip, _ = take_step(W, act, na, n, tau, h, p, yrest)
             used += na
         tau += h
         steps += 1
@@ -429,13 +427,13 @@ def continue_event(W, act, flag, touched, stuck, since, tree, t0, n, l2, nu, a, 
                 status = NONFINITE
             if v > vmax:
                 vmax = v
-            if method == RK4 and (v > v_limit or W[i, P] < psi_limit) and status == OK:
+            if p.method == RK4 and (v > v_limit or W[i, P] < psi_limit) and status == OK:
                 status = UNSTABLE
         if status != OK:
             break
         # Transitions at tau: the located one, then anything that crossed with it.
         if kind == 2 or kind == 3:
-            na, nt, yrest = _start(W, act, na, flag, touched, nt, since, tree, t0, nu, who, tau, yrest,
+            na, nt, yrest = _start(W, act, na, flag, touched, nt, since, tree, t0, p.nu, who, tau, yrest,
                                    event, undo)
             W[who, V] = 0.0
         if kind == 1:
@@ -444,7 +442,7 @@ def continue_event(W, act, flag, touched, stuck, since, tree, t0, n, l2, nu, a, 
         nstuck = 0
         for k in range(na):
             i = act[k]
-            if W[i, V] <= 0.0 and not (i == who and kind >= 2) and not _pressed(W, n, i, tau, l2, nu, b):
+            if W[i, V] <= 0.0 and not (i == who and kind >= 2) and not _pressed(W, n, i, tau, p):
                 # Blocks never move backward: a block that started this step
                 # but could not move keeps its slip.
                 if W[i, Y] < W[i, Y0]:
@@ -466,22 +464,22 @@ def continue_event(W, act, flag, touched, stuck, since, tree, t0, n, l2, nu, a, 
         for k in range(m + nstuck):
             i = act[k] if k < m else stuck[k - m]
             for j in (left(i), right(i, n)):
-                if j != i and _above_threshold(W, flag, n, j, tau, l2, nu, b):
-                    na, nt, yrest = _start(W, act, na, flag, touched, nt, since, tree, t0, nu, j,
+                if j != i and _above_threshold(W, flag, n, j, tau, p):
+                    na, nt, yrest = _start(W, act, na, flag, touched, nt, since, tree, t0, p.nu, j,
                                            tau, yrest, event, undo)
         # Blocks no longer watched by a sliding neighbour may only start by
         # loading: back on the schedule with their analytic onset.
         for k in range(nstuck):
             i = stuck[k]
             for j in (left(i), i, right(i, n)):
-                tree_set(tree, j, t0[0] + (t0[1] + _loading_onset(W, flag, n, j, tau, l2, nu, b)))
+                tree_set(tree, j, t0[0] + (t0[1] + _loading_onset(W, flag, n, j, tau, p)))
         if kind != 0 or nstuck > 0 or na != m:
-            t_far, far = _far_onset(W, flag, n, since, tree, t0, tau, l2, nu, b)
+            t_far, far = _far_onset(W, flag, n, since, tree, t0, tau, p)
     if profile.shape[0] == n:
         profile[:] = 0.0
         for k in range(nt):
             profile[touched[k]] = W[touched[k], Y]
-    _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, l2, nu, b, work, slip_time, diag)
+    _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, p, work, slip_time, diag)
     diag[D_STEPS] = steps
     diag[D_VMAX] = vmax
     diag[D_BLOCK_STEPS] = block_steps
@@ -496,7 +494,7 @@ def continue_event(W, act, flag, touched, stuck, since, tree, t0, n, l2, nu, a, 
 
 
 @nb.njit(cache=True)
-def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, l2, nu, b, work, slip_time, diag):
+def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, p, work, slip_time, diag):
     """Summarise the event, bring the touched blocks to its end, reschedule them and their neighbours."""
     slip = 0.0
     first = n
@@ -517,14 +515,14 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, l2, nu, b, work
         # the non-negative terms (own and spring energies) count alike in both sums
         stored = 0.5 * y * y
         if i + 1 < n:
-            stored += 0.5 * l2 * (W[i + 1, Y] - y) ** 2
+            stored += 0.5 * p.l2 * (W[i + 1, Y] - y) ** 2
         if i - 1 >= 0 and flag[i - 1] == 0:
-            stored += 0.5 * l2 * (y - W[i - 1, Y]) ** 2
+            stored += 0.5 * p.l2 * (y - W[i - 1, Y]) ** 2
         e_change += stored - y * W[i, F0]
         gross += stored + abs(y * W[i, F0])
     elastic = e_change     # the terms apart (workspace.py): D_ELASTIC, D_LOAD_WORK
-    e_change += -nu * tau * slip + nu * slip_time
-    gross += nu * tau * slip + nu * slip_time
+    e_change += -p.nu * tau * slip + p.nu * slip_time
+    gross += p.nu * tau * slip + p.nu * slip_time
     diag[D_DURATION] = tau
     diag[D_SLIP] = slip
     diag[D_FIRST] = first
@@ -534,13 +532,13 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, l2, nu, b, work
     diag[D_RESIDUAL] = e_change + work
     diag[D_ENERGY_SCALE] = gross
     diag[D_ELASTIC] = elastic
-    diag[D_LOAD_WORK] = nu * tau * slip - nu * slip_time
+    diag[D_LOAD_WORK] = p.nu * tau * slip - p.nu * slip_time
     # The touched blocks move to the end time (loading, state grown since they
     # stopped); their untouched neighbours stay at t0, which is just as valid.
     # Then the slip changes the forces (free ends: an end block has one spring).
     for k in range(nt):
         i = touched[k]
-        W[i, F0] += nu * tau
+        W[i, F0] += p.nu * tau
         W[i, P] += math.log1p((tau - W[i, TR]) * math.exp(-W[i, P]))
         since[i, 0] = t0[0]
         since[i, 1] = t0[1]
@@ -549,11 +547,11 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, l2, nu, b, work
         i = touched[k]
         y = W[i, Y]
         deg = (1 if i > 0 else 0) + (1 if i < n - 1 else 0)
-        W[i, F0] -= (1.0 + l2 * deg) * y
+        W[i, F0] -= (1.0 + p.l2 * deg) * y
         if i > 0:
-            W[i - 1, F0] += l2 * y
+            W[i - 1, F0] += p.l2 * y
         if i < n - 1:
-            W[i + 1, F0] += l2 * y
+            W[i + 1, F0] += p.l2 * y
     for k in range(nt):
         i = touched[k]
         W[i, Y] = 0.0
@@ -564,4 +562,4 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, l2, nu, b, work
     for k in range(nt):
         i = touched[k]
         for j in (left(i), i, right(i, n)):
-            tree_set(tree, j, onset_key(W, since, j, nu, b))
+            tree_set(tree, j, onset_key(W, since, j, p.nu, p.b))

@@ -1,9 +1,10 @@
 """Steps of the event integrators on the active set (pure numba kernels).
 
 Every stepper advances the sliding blocks from the step-start values (columns
-Y0, V0, P0 of W) by h into (Y, V, P), leaves the derivative at the step start in
-K1V (for the Hermite interpolant), and returns (friction work, time integral of
-the total slip, error estimate relative to the tolerances; 0 for fixed steps).
+Y0, V0, P0 of W) by h into (Y, V, P) with the parameters p (params.KernelParams),
+leaves the derivative at the step start in K1V (for the Hermite interpolant), and
+returns (friction work, time integral of the total slip, error estimate relative
+to the tolerances; 0 for fixed steps).
 
 - rk4_step: classical RK4, the paper's method; stable only while h / theta < 2.785.
 - ark3_step, ark4_step, ark5_step: the additive (IMEX) Runge-Kutta pairs ARK3(2)4L[2]SA,
@@ -24,8 +25,8 @@ from .workspace import (ARK_A, ARK_G, ARK_V, F0, K1V, KP, KV, KY, P, P0, PS, SP,
 
 
 @nb.njit(cache=True, error_model="numpy")
-def stage_rates(W, act, na, n, tau, l2, nu, a, b, yrest, with_state=True):
-    """Derivatives of all active blocks at stage state (YS, VS, PS) into KY, KV, KP.
+def stage_rates(W, act, na, n, tau, p, yrest, with_state=True):
+    """Derivatives of all active blocks at stage state (YS, VS, PS) into KY, KV, KP (p: KernelParams).
 
     with_state=False leaves KP alone (an implicit stage already knows it).
 
@@ -38,9 +39,9 @@ def stage_rates(W, act, na, n, tau, l2, nu, a, b, yrest, with_state=True):
         i = act[k]
         v = W[i, VS]
         psi = W[i, PS]
-        phi = friction(v, psi, a, b)
+        phi = friction(v, psi, p.a, p.b)
         W[i, KY] = v
-        W[i, KV] = spring_force(W[i, F0], tau, nu, l2, W[left(i), YS], W[i, YS],
+        W[i, KV] = spring_force(W[i, F0], tau, p.nu, p.l2, W[left(i), YS], W[i, YS],
                                 W[right(i, n), YS]) - phi
         if with_state:
             W[i, KP] = state_rate(v, psi)
@@ -51,7 +52,7 @@ def stage_rates(W, act, na, n, tau, l2, nu, a, b, yrest, with_state=True):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def rk4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol):
+def rk4_step(W, act, na, n, tau, h, p, yrest):
     """Classical RK4: advance the active blocks from the step-start values (Y0, V0, P0) by h.
 
     Resting blocks keep YS == Y, so neighbour slips are read from YS throughout.
@@ -79,7 +80,7 @@ def rk4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol):
                 W[i, YS] = W[i, Y0]
                 W[i, VS] = W[i, V0]
                 W[i, PS] = W[i, P0]
-        power, ysum = stage_rates(W, act, na, n, tau + frac * h, l2, nu, a, b, yrest)
+        power, ysum = stage_rates(W, act, na, n, tau + frac * h, p, yrest)
         pw += weight * power
         ys += weight * ysum
         for k in range(na):
@@ -165,7 +166,7 @@ def _newton_state(psi, target, hg):
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
-def _ark_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol, c, ae, ai, bw, bd, gamma):
+def _ark_step(W, act, na, n, tau, h, p, yrest, c, ae, ai, bw, bd, gamma):
     """One step of the IMEX pair (c, ae, ai, gamma; weights bw, error weights bd = b - bhat).
 
     Stage s: slip and velocity explicit from the earlier stages' rates, psi
@@ -220,7 +221,7 @@ def _ark_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol, c, ae, ai,
                 # kernel may redo a step with h = 0)
                 psi = W[i, PS]
                 W[i, KP] = (psi - W[i, SV]) / hg if hg > 0.0 else state_rate(W[i, VS], psi)
-        power, ysum = stage_rates(W, act, na, n, tau + c[s] * h, l2, nu, a, b, yrest, s == 0)
+        power, ysum = stage_rates(W, act, na, n, tau + c[s] * h, p, yrest, s == 0)
         pw += bw[s] * power
         ys += bw[s] * ysum
         for k in range(na):
@@ -245,7 +246,7 @@ def _ark_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol, c, ae, ai,
         W[i, V] = W[i, V0] + h * dv
         W[i, P] = W[i, P0] + h * dp
         W[i, YS] = W[i, Y]
-        e1, e2, e3 = _error_norms(W, i, h * ey, h * ev, h * ep, rtol, atol)
+        e1, e2, e3 = _error_norms(W, i, h * ey, h * ev, h * ep, p.rtol, p.atol)
         err = max(err, e1, e2, e3)
     return pw * h, ys * h, err
 
@@ -283,21 +284,18 @@ ERROR_WEIGHTS = (_D3[:0], _D3, _D4, _D5)
 
 
 @nb.njit(cache=True, error_model="numpy")
-def ark3_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol):
+def ark3_step(W, act, na, n, tau, h, p, yrest):
     """ARK3(2)4L[2]SA step of the active blocks; see the module docstring."""
-    return _ark_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol,
-                     _C3, _AE3, _AI3, _B3, _D3, _G3)
+    return _ark_step(W, act, na, n, tau, h, p, yrest, _C3, _AE3, _AI3, _B3, _D3, _G3)
 
 
 @nb.njit(cache=True, error_model="numpy")
-def ark4_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol):
+def ark4_step(W, act, na, n, tau, h, p, yrest):
     """ARK4(3)6L[2]SA step of the active blocks; see the module docstring."""
-    return _ark_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol,
-                     _C4, _AE4, _AI4, _B4, _D4, _G4)
+    return _ark_step(W, act, na, n, tau, h, p, yrest, _C4, _AE4, _AI4, _B4, _D4, _G4)
 
 
 @nb.njit(cache=True, error_model="numpy")
-def ark5_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol):
+def ark5_step(W, act, na, n, tau, h, p, yrest):
     """ARK5(4)8L[2]SA step of the active blocks; see the module docstring."""
-    return _ark_step(W, act, na, n, tau, h, l2, nu, a, b, yrest, rtol, atol,
-                     _C5, _AE5, _AI5, _B5, _D5, _G5)
+    return _ark_step(W, act, na, n, tau, h, p, yrest, _C5, _AE5, _AI5, _B5, _D5, _G5)

@@ -32,6 +32,8 @@ D_LOAD_WORK = nu tau sum(y) - nu int_0^tau sum(y) dt = nu int_0^tau t sum(v) dt 
 driver's advance since the onset on the sliding blocks; the rest of the two energy changes
 (the driver alone pulling every block) cancels. residual = D_ELASTIC + D_WORK - D_LOAD_WORK.
 """
+from collections import namedtuple
+
 import numpy as np
 
 # columns of W
@@ -116,6 +118,22 @@ STATUS_TEXT = {
 }
 
 
+# The work arrays as the kernels receive them: one record (chain.simulate, event.begin_event,
+# continue_event, integrate_event), its fields read by name. n blocks; int is int64.
+WorkArrays = namedtuple("WorkArrays", [
+    "W",        # (n, NCOLS) float64: per-block quantities, the columns above
+    "act",      # (n,) int: the sliding blocks, act[:na] (event.py)
+    "flag",     # (n,) int8: 0 not slid in this event, 1 sliding, 2 slid and at rest again
+    "touched",  # (n,) int: the blocks that slid in this event, touched[:nt]
+    "stuck",    # (n,) int: scratch of one step, the blocks that stopped in it
+    "since",    # (n, 2) float64: two-float time at which a block's F0 and P hold between events (schedule.py)
+    "tree",     # (tree_size(n),) float64: min-tree of the onset keys (schedule.py); NaN at the root: rebuild it
+    "diag",     # (NDIAG,) float64: summary of the last event (D_*)
+    "event",    # (NEVENT,) float64: the event in progress (EV_*)
+    "undo",     # (n, NUNDO) float64: undo log of the event in progress (U_*, undo.py)
+])
+
+
 def tree_size(n):
     """Length of the onset tree (schedule.py) for n blocks: twice a power of two >= n."""
     m = 1
@@ -145,10 +163,9 @@ class Workspace:
 
     @property
     def arrays(self):
-        """The kernels' leading array arguments: W, act, flag, touched, stuck, since, tree, diag,
-        event, undo."""
-        return (self.W, self.act, self.flag, self.touched, self.stuck, self.since, self.tree, self.diag,
-                self.event, self.undo)
+        """The work arrays as the kernels take them (WorkArrays)."""
+        return WorkArrays(W=self.W, act=self.act, flag=self.flag, touched=self.touched, stuck=self.stuck,
+                          since=self.since, tree=self.tree, diag=self.diag, event=self.event, undo=self.undo)
 
     def load(self, force, psi, since=None):
         """Set the between-events state: force and psi of every block (at time since, default 0).

@@ -1,0 +1,43 @@
+"""The kernels' parameters as one record, passed as one argument from the runner to the innermost step.
+
+numba takes a namedtuple as a nopython argument (a struct of its fields, read by name: `p.l2`), so no
+kernel signature restates the order of the fields. The record is built by keyword only: exchanging two
+fields (rtol and atol, say) is a visible change of names, never a silent change of position.
+ensemble.integrators.kernel_params builds it from the config.
+"""
+from collections import namedtuple
+
+_Fields = namedtuple("KernelParams", "l2 nu a b method dt rtol atol max_step max_duration max_steps")
+_INTEGERS = ("method", "max_steps")     # the other fields are float64
+
+
+class KernelParams(_Fields):
+    """Model and integrator parameters of the event kernels (dimensionless, c-free frame).
+
+    l2            l^2, the stiffness of the springs between blocks relative to the driver spring
+    nu            loading velocity of the driver plate
+    a             velocity-strengthening coefficient of a ln(1 + v) in the friction
+    b             state coefficient of b psi, psi = ln(theta): also the static threshold b psi at rest
+    method        integrator code, event.RK4, ARK3, ARK4 or ARK5 (ensemble.integrators.INTEGRATORS)
+    dt            step of rk4; the first step of an event for the adaptive methods
+    rtol          adaptive methods: relative tolerance of the local error per step
+    atol          adaptive methods: absolute tolerance (slip, velocity)
+    max_step      adaptive methods: largest step (inf: no bound)
+    max_duration  an event lasting longer than this (local time since its onset) ends with TOO_LONG
+    max_steps     steps of one event, rejected ones included, after which it ends with TOO_LONG (a
+                  backstop behind max_duration for steps too small to reach it)
+    """
+    __slots__ = ()
+
+    def __new__(cls, **fields):
+        if set(fields) != set(cls._fields):
+            missing = [f for f in cls._fields if f not in fields]
+            unknown = [f for f in fields if f not in cls._fields]
+            raise TypeError(f"KernelParams: missing {missing}, unknown {unknown}")
+        # one type per field, so that every caller reaches the same compiled kernel
+        return super().__new__(cls, *(int(fields[f]) if f in _INTEGERS else float(fields[f])
+                                      for f in cls._fields))
+
+    def __getnewargs_ex__(self):
+        """For pickle and copy, which would otherwise call __new__ with the fields by position."""
+        return (), self._asdict()
