@@ -53,16 +53,9 @@ install_project() {
   fi
 }
 
-report() {
-  $VPY - "$1" <<'EOF'
-import sys, h5py, mpi4py
-from mpi4py import MPI
-mpi = " ".join(MPI.Get_library_version().split("\n")[0].split())
-writer = "parallel (MPI-IO)" if h5py.get_config().mpi else "rank0 (rank 0 writes for all)"
-print(f"setup: ok: stack {sys.argv[1]}: {mpi} (mpi4py {mpi4py.__version__}), HDF5 {h5py.version.hdf5_version}"
-      f" {'with' if h5py.get_config().mpi else 'without'} MPI (h5py {h5py.__version__}); runs with more "
-      f"than one rank write with the {writer} writer")
-EOF
+report() {   # in validate's words (ensemble/environment.py): the MPI, the HDF5, the writer runs take
+  echo "setup: ok: stack $1"
+  $VPY -c "from ensemble import environment; print('\n'.join('  ' + line for line in environment.describe('auto')))"
 }
 
 # -- a complete stack already there: check and leave -----------------------------------------------
@@ -123,7 +116,8 @@ if [ "$STACK" != wheels ]; then
   if [ "$STACK_FOUND" = 1 ]; then
     kind=parallel
   else
-    why="no parallel HDF5 stack: missing $STACK_MISSING (python3 scripts/stack.py --explain shows where setup looked)"
+    why="no parallel HDF5 stack: missing $STACK_MISSING"
+    why="$why (python3 scripts/stack.py --explain shows where setup looked)"
     [ "$STACK" = parallel ] && die "STACK=parallel: $why. Load an MPI and a parallel HDF5 (module load ..., spack load ...; docs/install.md), or set STACK=wheels"
     say "$why"
     say "falling back to the wheel stack: runs work on any number of ranks, rank 0 writing the catalog"
