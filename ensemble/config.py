@@ -13,6 +13,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field, fields
 
 from . import filekind
+from .model import laws
 
 
 class ConfigError(ValueError):
@@ -27,19 +28,39 @@ def _nonneg(x):
     return x >= 0
 
 
-def _finite(x):
-    return math.isfinite(x)
-
-
 @dataclass(frozen=True)
-class Model:
-    """Dimensionless Burridge-Knopoff chain with rate- and state-dependent friction."""
+class _Chain:
+    """Dimensionless Burridge-Knopoff chain; the friction law's own keys follow (model/laws/)."""
     N: int = 800         # number of blocks (free ends)
     l: float = 3.0       # stiffness of the springs between blocks (l^2 relative to the driver spring)
     nu: float = 1e-8     # loading velocity of the driver plate
-    a: float = 0.0       # velocity-strengthening coefficient of a ln(1 + v)
-    b: float = 20.0      # state coefficient of b ln(theta) (slip weakening of slope b)
-    c: float = 1000.0    # constant friction (removed exactly by a uniform shift of u)
+    law: str = laws.DEFAULT   # friction law: one of model/laws/ (aging: the paper's)
+
+    def __post_init__(self):
+        """Resolve the law's keys: a key left out takes the law's default; a key of another law
+        (not None) is an error naming it."""
+        if self.law not in laws.LAWS:
+            raise ConfigError(f"model.law must be one of {', '.join(sorted(laws.LAWS))}, got {self.law!r}")
+        own = laws.get(self.law).keys
+        for name in LAW_KEYS:
+            value = getattr(self, name)
+            if name in own and value is None:
+                object.__setattr__(self, name, own[name].default)
+            elif name not in own and value is not None:
+                raise ConfigError(f"model.{name} does not belong to model.law = {self.law!r} "
+                                  f"(its keys: {', '.join(own)})")
+
+    def law_keys(self):
+        """The [model] keys of this model's law, in order."""
+        return tuple(laws.get(self.law).keys)
+
+
+# every law's keys, in the order of the registry (a name two laws share has one meaning)
+LAW_KEYS = tuple(dict.fromkeys(k for law in laws.LAWS.values() for k in law.keys))
+Model = dataclasses.make_dataclass(
+    "Model", [(name, float, field(default=None)) for name in LAW_KEYS], bases=(_Chain,), frozen=True)
+Model.__doc__ = _Chain.__doc__
+Model.__module__ = __name__
 
 
 @dataclass(frozen=True)
@@ -75,9 +96,7 @@ _RULES = {
     ("model", "N"): (lambda x: x >= 2, "an integer >= 2"),
     ("model", "l"): (_positive, "> 0"),
     ("model", "nu"): (_positive, "> 0"),
-    ("model", "a"): (_nonneg, ">= 0"),
-    ("model", "b"): (_positive, "> 0"),
-    ("model", "c"): (_finite, "finite"),
+    **{("model", name): (key.check, key.rule) for law in laws.LAWS.values() for name, key in law.keys.items()},
     ("run", "seeds"): (lambda x: x >= 1, "an integer >= 1"),
     ("run", "events"): (lambda x: x >= 1, "an integer >= 1"),
     ("run", "transient"): (_nonneg, "an integer >= 0"),
@@ -123,8 +142,10 @@ class Config:
 
 
 def section_lines(section):
-    """`key = value` TOML lines of one section's dataclass, in field order."""
-    return [f"{f.name} = {_toml_value(getattr(section, f.name))}" for f in fields(section)]
+    """`key = value` TOML lines of one section's dataclass, in field order (a key of another
+    friction law, None, is left out)."""
+    return [f"{f.name} = {_toml_value(getattr(section, f.name))}" for f in fields(section)
+            if getattr(section, f.name) is not None]
 
 
 def _toml_value(v):
@@ -199,9 +220,9 @@ def _sweep(raw, overridden):
     out = []
     for key, values in raw.items():
         with _from_set(overridden, "sweep", key):
-            if key not in types:
+            if key not in types or key == "law":
                 raise ConfigError(f"unknown key sweep.{key} (only [model] keys can be swept: "
-                                  f"{', '.join(types)})")
+                                  f"{', '.join(k for k in types if k != 'law')})")
             if not isinstance(values, list) or not values:
                 raise ConfigError(f"sweep.{key} must be a non-empty list of values")
             out.append((key, tuple(_coerce("model", key, v, types[key], where=f"sweep.{key}")
@@ -248,6 +269,8 @@ _OVERFLOW_RULES = (
 def _check_overflow(cfg):
     for keys, number, meaning in _OVERFLOW_RULES:
         named = [_values(cfg, key) for key in keys]
+        if any(v is None for _, values in named for v in values):
+            continue    # a key of another friction law
         for corner in itertools.product(*[(min(v), max(v)) for _, v in named]):
             if not math.isfinite(number(*corner)):
                 given = ", ".join(f"{name} = {x!r}" for (name, _), x in zip(named, corner))
@@ -266,6 +289,10 @@ def from_dict(raw, overridden=None):
             raise ConfigError(f"unknown section [{name}] (known: {', '.join(sorted(allowed))})")
     parts = {name: _section(name, raw.get(name, {}), overridden) for name in SECTIONS}
     cfg = Config(sweep=_sweep(raw.get("sweep", {}), overridden), **parts)
+    for key, _ in cfg.sweep:
+        if key in LAW_KEYS and key not in cfg.model.law_keys():
+            raise ConfigError(f"sweep.{key} does not belong to model.law = {cfg.model.law!r} "
+                              f"(its keys: {', '.join(cfg.model.law_keys())})")
     if cfg.integrator.method not in _integrator_names():
         raise ConfigError(f"integrator.method must be one of {', '.join(_integrator_names())}, "
                           f"got {cfg.integrator.method!r}")

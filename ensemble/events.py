@@ -4,9 +4,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .config import Integrator
 from .integrators import kernel_params
+from .model import laws
 from .model.event import integrate_event
-from .model.onset import onset_delay
 from .model.schedule import build_schedule, tree_min
 from .model.workspace import (D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D_ENERGY_SCALE, D_LOAD_WORK,
                               D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK, NTRACE, OK, STATUS_TEXT,
@@ -57,7 +58,7 @@ def physical_state(u, theta, t, model):
     lap = np.zeros_like(u)
     lap[:-1] += u[1:] - u[:-1]
     lap[1:] += u[:-1] - u[1:]
-    force = (model.nu * t - u) + model.l ** 2 * lap - model.c
+    force = (model.nu * t - u) + model.l ** 2 * lap - (model.c if model.c is not None else 0.0)
     return force, np.log(np.asarray(theta, dtype=float))
 
 
@@ -65,10 +66,11 @@ def advance_to_onset(force, psi, model):
     """Load quietly until the next onset: (epicenter, delay, force, psi) at the onset."""
     ws = Workspace(len(force))
     ws.load(force, psi)
-    build_schedule(ws.W, ws.since, ws.tree, model.nu, model.b)
+    p = kernel_params(model, Integrator())
+    build_schedule(ws.W, ws.since, ws.tree, p)
     _, epicenter = tree_min(ws.tree)
-    delay = onset_delay(force[epicenter], psi[epicenter], model.nu, model.b)
-    return (epicenter, delay, *ws.state((delay, 0.0), model.nu))
+    delay = laws.get(model.law).onset_delay(p.law, force[epicenter], psi[epicenter], p.nu)
+    return (epicenter, delay, *ws.state((delay, 0.0), p))
 
 
 def run_event(force, psi, epicenter, model, integrator, v_start=0.0, trace=None):
@@ -81,13 +83,15 @@ def run_event(force, psi, epicenter, model, integrator, v_start=0.0, trace=None)
     ws.load(force, psi)
     profile = np.zeros(n)
     p = kernel_params(model, integrator)
-    build_schedule(ws.W, ws.since, ws.tree, p.nu, p.b)     # (simulate does this itself)
+    build_schedule(ws.W, ws.since, ws.tree, p)     # (simulate does this itself)
     clock = np.zeros(2)
     start = time.perf_counter()
     status = integrate_event(ws.arrays, clock, n, epicenter, v_start, p, profile,
                              np.zeros((0, NTRACE)) if trace is None else trace)
     seconds = time.perf_counter() - start
-    force, psi = ws.state((ws.diag[D_DURATION], 0.0), p.nu)     # every block at the end
+    # every block at the end (at the onset's time for a law whose loader stands still in events)
+    end = ws.diag[D_DURATION] if laws.get(model.law).loader_moves else 0.0
+    force, psi = ws.state((end, 0.0), p)
     d = ws.diag
     return EventResult(status, d[D_SLIP], d[D_DURATION], int(d[D_STEPS]), int(d[D_BLOCK_STEPS]),
                        int(d[D_REJECTED]), int(d[D_CUTS]), d[D_VMAX], d[D_WORK],

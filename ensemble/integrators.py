@@ -6,6 +6,7 @@ which locates sticks and onsets inside a step the same way for each.
 from dataclasses import dataclass
 
 from .model.event import ARK3, ARK4, ARK5, RK4
+from .model import laws
 from .model.params import KernelParams
 
 
@@ -34,7 +35,7 @@ def kernel_params(model, integrator):
     """The kernels' parameter record (model.params.KernelParams) from [model] and [integrator]
     (config dataclasses)."""
     max_steps = int(min(2 * integrator.max_duration / integrator.dt + 1e6, 2**62))
-    return KernelParams(l2=model.l ** 2, nu=model.nu, a=model.a, b=model.b,
+    return KernelParams(l2=model.l ** 2, nu=model.nu, law=laws.get(model.law).kernel_params(model),
                         method=INTEGRATORS[integrator.method].code, dt=integrator.dt, rtol=integrator.rtol,
                         atol=integrator.atol, max_step=integrator.max_step,
                         max_duration=integrator.max_duration, max_steps=max_steps)

@@ -66,7 +66,7 @@ class Trajectory:
 
     def state(self):
         """(force, psi) of every block now (between events), c-free frame."""
-        return self.ws.state(self.clock, self.task.model.nu)
+        return self.ws.state(self.clock, self.params)
 
     def advance(self, n, budget=UNLIMITED):
         """Run n events; returns (onset times, epicenters, diagnostics rows).

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .config import Model
+from .model import laws
 
 
 @dataclass(frozen=True)
@@ -36,13 +37,14 @@ def rng_for(cfg, task):
 def initial_state(cfg, task):
     """Forces and states of all blocks at t = 0 (all at rest), c-free frame.
 
-    Every block starts with theta = 1 (psi = 0, static threshold exactly c) and a
-    force uniformly distributed in (-init_stress, 0] below it: a small seeded
+    Every block starts with psi = 0 (theta = 1: the aging law's static threshold is exactly c)
+    and a force uniformly distributed in (-init_stress, 0] below its threshold: a small seeded
     perturbation of a uniform state. The transient events are discarded.
     """
     rng = rng_for(cfg, task)
-    force = -cfg.run.init_stress * rng.random(task.model.N)
+    law = laws.get(task.model.law)
     psi = np.zeros(task.model.N)
+    force = law.threshold(law.kernel_params(task.model), 0.0) - cfg.run.init_stress * rng.random(task.model.N)
     return force, psi
 
 

@@ -18,8 +18,9 @@ import numba
 
 def _cache_dir():
     digest = hashlib.sha256()
-    for src in sorted(Path(__file__).parent.glob("*.py")):
-        digest.update(src.name.encode())
+    here = Path(__file__).parent
+    for src in sorted(here.rglob("*.py")):
+        digest.update(str(src.relative_to(here)).encode())
         digest.update(src.read_bytes())
     base = os.environ.get("NUMBA_CACHE_DIR") or os.path.join(
         os.path.expanduser("~"), ".cache", "bk-ensemble", "numba")

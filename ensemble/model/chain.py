@@ -20,7 +20,7 @@ import numba as nb
 import numpy as np
 
 from .event import begin_event, continue_event
-from .onset import onset_delay
+from .laws import loader_moves, onset_delay, threshold
 from .schedule import advance_clock, build_schedule, finite_state, materialize, tree_min
 from .undo import log_block
 from .workspace import (BETWEEN, D_DURATION, D_SLIP, EV_CLOCK_HI, EV_CLOCK_LO, EV_EPICENTER, EV_PHASE,
@@ -64,7 +64,7 @@ def simulate(arrays, clock, p, n_events, budget, out_t, out_epicenter, out_diag)
     if math.isnan(tree[1]):      # a freshly loaded state (Workspace.load): schedule every block
         if not finite_state(W, since):
             return NONFINITE, 0
-        build_schedule(W, since, tree, p.nu, p.b)
+        build_schedule(W, since, tree, p)
     onset = np.empty(2)
     k = 0
     spent = 0
@@ -75,7 +75,7 @@ def simulate(arrays, clock, p, n_events, budget, out_t, out_epicenter, out_diag)
             _, epicenter = tree_min(tree)
             # The onset, exactly: the epicenter's own delay from its state (the tree
             # only orders the blocks), never before the end of the previous event.
-            delay = onset_delay(W[epicenter, F0], W[epicenter, P], p.nu, p.b)
+            delay = onset_delay(p.law, W[epicenter, F0], W[epicenter, P], p.nu)
             if not math.isfinite(delay):     # a NaN state, or inf: no block ever starts (b / nu > 1e308)
                 return NONFINITE, k
             onset[0] = since[epicenter, 0]
@@ -88,11 +88,11 @@ def simulate(arrays, clock, p, n_events, budget, out_t, out_epicenter, out_diag)
             if (onset[0] - clock[0]) + (onset[1] - clock[1]) > 0.0:
                 clock[0] = onset[0]
                 clock[1] = onset[1]
-            materialize(W, since, epicenter, clock, p.nu)
+            materialize(W, since, epicenter, clock, p)
             # Put the epicenter on its threshold, not a round-off below it, so the
             # event starts without a false stick (a force above it stays as it is).
-            if W[epicenter, F0] < p.b * W[epicenter, P]:
-                W[epicenter, F0] = p.b * W[epicenter, P]
+            if W[epicenter, F0] < threshold(p.law, W[epicenter, P]):
+                W[epicenter, F0] = threshold(p.law, W[epicenter, P])
             begin_event(arrays, clock, n, epicenter, 0.0, p)
             spent += EVENT_WORK
         status, used = continue_event(arrays, clock, n, p, no_profile, no_trace, budget - spent)
@@ -100,7 +100,8 @@ def simulate(arrays, clock, p, n_events, budget, out_t, out_epicenter, out_diag)
         if status == PAUSED:
             return PAUSED, k
         t_onset = clock[0] + clock[1]
-        advance_clock(clock, diag[D_DURATION])
+        if loader_moves(p.law):     # else the event took no loading time (laws/__init__.py)
+            advance_clock(clock, diag[D_DURATION])
         if status != OK:
             return status, k
         if diag[D_SLIP] == 0.0:
@@ -117,6 +118,15 @@ def _finite_parameters(p):
     """No NaN or inf among the model and integrator parameters, but for the two bounds: the
     largest step and the longest event may be inf (no bound), though not NaN (which would
     silently disable them as well)."""
-    return (math.isfinite(p.l2) and math.isfinite(p.nu) and math.isfinite(p.a) and math.isfinite(p.b)
+    return (math.isfinite(p.l2) and math.isfinite(p.nu) and _finite_law(p.law)
             and math.isfinite(p.dt) and math.isfinite(p.rtol) and math.isfinite(p.atol)
             and not math.isnan(p.max_step) and not math.isnan(p.max_duration))
+
+
+@nb.njit(cache=True)
+def _finite_law(law):
+    """Every parameter of the friction law is finite (they are all floats)."""
+    for x in law:
+        if not math.isfinite(x):
+            return False
+    return True

@@ -26,8 +26,8 @@ import math
 import numba as nb
 import numpy as np
 
-from .friction import friction, left, right, spring_force
-from .onset import onset_delay
+from .geometry import left, right, spring_force
+from .laws import friction, loader_moves, onset_delay, rest_state, rk4_unstable, stiff_limit, threshold
 from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
 from .steppers import ERROR_WEIGHTS, ark3_step, ark4_step, ark5_step, block_error, rk4_step
 from .tableaux import ARK324, ARK436, ARK548
@@ -37,8 +37,8 @@ from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D
                         EV_BLOCK_STEPS, EV_CUTS, EV_EPICENTER, EV_ERR_PREV, EV_FAR, EV_H_NEXT, EV_NA, EV_NT,
                         EV_PHASE, EV_REJECTED, EV_SLIP_TIME, EV_STEPS, EV_T_FAR, EV_TAU, EV_TRACED, EV_VMAX,
                         EV_WORK, EV_YREST, F0, HD0, HD1, IN_EVENT, K1V, NONFINITE, OK,
-                        P, P0, PAUSED, T_AGE, T_BLOCK, T_ERROR, T_H, T_OWN, T_PART, T_PSI, T_SLIDING,
-                        T_TAU, T_V, TOO_LONG, TR, TS, UNLIMITED, UNSTABLE, V, V0, Y, Y0, YS)
+                        P, P0, PAUSED, SLIDING, STOPPED, T_AGE, T_BLOCK, T_ERROR, T_H, T_OWN, T_PART, T_PSI, T_SLIDING,
+                        T_TAU, T_V, TOO_LONG, TR, TS, UNLIMITED, UNSTABLE, UNTOUCHED, V, V0, Y, Y0, YS)
 
 # integrators (see ensemble.integrators): fixed-step RK4, adaptive IMEX ARK3(2), ARK4(3), ARK5(4)
 RK4, ARK3, ARK4, ARK5 = 0, 1, 2, 3
@@ -50,6 +50,12 @@ _CONTROL_EXPONENT = (0.0,) + tuple(-1.0 / (pair.embedded_order + 1) for pair in 
 # is 1.0-1.15x faster at equal slip error on the step-budget events (b = 20 and 50; interpolated
 # between tolerances in benchmarks/results/step_budget_* before and after the change, 9498c4f..565d956).
 _PI_I, _PI_P = 0.7, 0.4
+
+# the transition that ends a step early (continue_event)
+NO_CUT = 0            # none inside the step
+STICK = 1             # a sliding block's velocity reaches 0
+ONSET_NEIGHBOUR = 2   # a resting neighbour of a sliding block reaches its threshold
+ONSET_LOADING = 3     # a block nobody watches reaches its threshold by loading alone (t_far)
 
 # Stability limit of classical RK4 on the negative real axis: the state equation
 # relaxes at rate 1/theta (= v in steady sliding), so dt / theta must stay below it.
@@ -67,15 +73,21 @@ def _hermite(x, y0, y1, d0, d1):
 
 
 @nb.njit(cache=True, inline="always")
-def _rest_psi(W, j, tau):
-    """psi of a block at rest since local time TR: ln(theta_rest + tau - TR)."""
-    return W[j, P] + math.log1p((tau - W[j, TR]) * math.exp(-W[j, P]))
+def _event_nu(p):
+    """The loader's velocity during an event: nu, or 0 for a law whose loader stands still then."""
+    return p.nu if loader_moves(p.law) else 0.0
+
+
+@nb.njit(cache=True, inline="always")
+def _rest_psi(W, j, tau, p):
+    """psi of a block at rest since local time TR (its state grown since)."""
+    return rest_state(p.law, W[j, P], tau - W[j, TR])
 
 
 @nb.njit(cache=True)
 def _slip_at(W, flag, j, x):
     """Slip of block j at fraction x of the current step (Hermite if it slides)."""
-    if flag[j] != 1:
+    if flag[j] != SLIDING:
         return W[j, Y]
     return _hermite(x, W[j, Y0], W[j, Y], W[j, HD0], W[j, HD1])
 
@@ -86,26 +98,26 @@ def _excess(W, flag, n, j, tau, h, x, p):
     s = tau + x * h
     yl = _slip_at(W, flag, left(j), x)
     yr = _slip_at(W, flag, right(j, n), x)
-    return spring_force(W[j, F0], s, p.nu, p.l2, yl, W[j, Y], yr) - p.b * _rest_psi(W, j, s)
+    return spring_force(W[j, F0], s, _event_nu(p), p.l2, yl, W[j, Y], yr) - threshold(p.law, _rest_psi(W, j, s, p))
 
 
 @nb.njit(cache=True)
 def _force_now(W, n, j, tau, p):
-    return spring_force(W[j, F0], tau, p.nu, p.l2, W[left(j), Y], W[j, Y], W[right(j, n), Y])
+    return spring_force(W[j, F0], tau, _event_nu(p), p.l2, W[left(j), Y], W[j, Y], W[right(j, n), Y])
 
 
 @nb.njit(cache=True)
 def _excess_now(W, n, j, tau, p):
     """Force above the static threshold of resting block j at the current time."""
-    return _force_now(W, n, j, tau, p) - p.b * _rest_psi(W, j, tau)
+    return _force_now(W, n, j, tau, p) - threshold(p.law, _rest_psi(W, j, tau, p))
 
 
 @nb.njit(cache=True)
 def _above_threshold(W, flag, n, j, tau, p):
     """Block j is at rest and its force exceeds the static threshold at local time tau."""
-    # Cheap filter first: the threshold of a resting block only grows, so a
-    # force below b * (psi when it came to rest) cannot start it.
-    return (flag[j] != 1 and _force_now(W, n, j, tau, p) > p.b * W[j, P]
+    # Cheap filter first: the threshold of a resting block never falls (laws/__init__.py), so a
+    # force below its threshold when it came to rest cannot start it.
+    return (flag[j] != SLIDING and _force_now(W, n, j, tau, p) > threshold(p.law, W[j, P])
             and _excess_now(W, n, j, tau, p) > 0.0)
 
 
@@ -113,25 +125,26 @@ def _above_threshold(W, flag, n, j, tau, p):
 def _pressed(W, n, i, tau, p):
     """Sliding block i has not moved in this step but is still at or above its threshold.
 
-    A block that starts exactly on its threshold gains force at the rate
-    nu - b / theta (> 0 at an onset), which for small nu can stay below the
+    A block that starts exactly on its threshold gains force above it slowly (for the aging
+    law at the rate nu - b / theta, > 0 at an onset), which for small nu can stay below the
     rounding of the force for a step: it has not stopped, it has not started yet.
     """
     return (W[i, V0] == 0.0 and W[i, V] == 0.0
-            and _force_now(W, n, i, tau, p) - p.b * W[i, P] >= 0.0)
+            and _force_now(W, n, i, tau, p) - threshold(p.law, W[i, P]) >= 0.0)
 
 
 @nb.njit(cache=True)
 def _adjacent_to_active(flag, n, j):
-    return flag[left(j)] == 1 or flag[right(j, n)] == 1
+    return flag[left(j)] == SLIDING or flag[right(j, n)] == SLIDING
 
 
 @nb.njit(cache=True)
 def _loading_onset(W, flag, n, j, tau, p):
-    """Local time at which resting block j starts by loading alone (inf if it is watched)."""
-    if flag[j] == 1 or _adjacent_to_active(flag, n, j):
+    """Local time at which resting block j starts by loading alone (inf if it is watched, or if
+    the loader stands still during events)."""
+    if not loader_moves(p.law) or flag[j] == SLIDING or _adjacent_to_active(flag, n, j):
         return np.inf
-    return tau + onset_delay(_force_now(W, n, j, tau, p), _rest_psi(W, j, tau), p.nu, p.b)
+    return tau + onset_delay(p.law, _force_now(W, n, j, tau, p), _rest_psi(W, j, tau, p), p.nu)
 
 
 @nb.njit(cache=True)
@@ -142,37 +155,39 @@ def _far_onset(W, flag, n, since, tree, t0, tau, p):
     from its current force and state if the event has touched it (its state
     then holds at t0), else from its stored state without changing it.
     """
+    if not loader_moves(p.law):
+        return np.inf, -1
     key, j = tree_min(tree)
     if key == np.inf:
         return np.inf, -1
     if since[j, 0] == t0[0] and since[j, 1] == t0[1]:
         return _loading_onset(W, flag, n, j, tau, p), j
-    t = (since[j, 0] - t0[0]) + (since[j, 1] - t0[1]) + onset_delay(W[j, F0], W[j, P], p.nu, p.b)
+    t = (since[j, 0] - t0[0]) + (since[j, 1] - t0[1]) + onset_delay(p.law, W[j, F0], W[j, P], p.nu)
     return max(t, tau), j
 
 
 @nb.njit(cache=True)
-def _watch(W, since, tree, t0, nu, j, event, undo):
+def _watch(W, since, tree, t0, p, j, event, undo):
     """Block j starts or neighbours a sliding block: bring it to t0, take it off the schedule."""
     log_block(W, since, event, undo, j)
-    materialize(W, since, j, t0, nu)
+    materialize(W, since, j, t0, p)
     tree_set(tree, j, np.inf)
 
 
 @nb.njit(cache=True)
-def _start(W, act, na, flag, touched, nt, since, tree, t0, nu, j, tau, yrest, event, undo):
+def _start(W, act, na, flag, touched, nt, since, tree, t0, p, j, tau, yrest, event, undo):
     """Block j starts to slide at local time tau; returns (na, nt, yrest)."""
     for k in (left(j), j, right(j, W.shape[0])):
-        _watch(W, since, tree, t0, nu, k, event, undo)
-    if flag[j] == 2:
+        _watch(W, since, tree, t0, p, k, event, undo)
+    if flag[j] == STOPPED:
         yrest -= W[j, Y]
     else:
         touched[nt] = j
         nt += 1
-    W[j, P] = _rest_psi(W, j, tau)
+    W[j, P] = _rest_psi(W, j, tau, p)
     W[j, V] = 0.0
     W[j, TS] = tau
-    flag[j] = 1
+    flag[j] = SLIDING
     act[na] = j
     return na + 1, nt, yrest
 
@@ -252,7 +267,7 @@ def begin_event(arrays, t0, n, epicenter, v_start, p):
     """
     W, act, flag, touched, since, tree = arrays.W, arrays.act, arrays.flag, arrays.touched, arrays.since, arrays.tree
     event, undo = arrays.event, arrays.undo
-    na, nt, yrest = _start(W, act, 0, flag, touched, 0, since, tree, t0, p.nu, epicenter, 0.0, 0.0, event,
+    na, nt, yrest = _start(W, act, 0, flag, touched, 0, since, tree, t0, p, epicenter, 0.0, 0.0, event,
                            undo)
     t_far, far = _far_onset(W, flag, n, since, tree, t0, 0.0, p)
     W[epicenter, V] = v_start
@@ -313,7 +328,7 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
     traced = int(event[EV_TRACED])
     status = OK
     v_limit = RK4_STABILITY / p.dt
-    psi_limit = -math.log(v_limit)
+    psi_limit = stiff_limit(p.law, v_limit)
     expo = _CONTROL_EXPONENT[p.method]
     used = 0
     while na > 0:
@@ -362,12 +377,12 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
             W[i, HD1] = h * W[i, V]
         x_cut = 2.0
         who = -1
-        kind = 0  # 1 stick, 2 onset next to a sliding block, 3 onset by loading
+        kind = NO_CUT
         for k in range(na):
             i = act[k]
             if W[i, V] <= 0.0 and W[i, V0] > 0.0:
-                a_end = spring_force(W[i, F0], tau + h, p.nu, p.l2, W[left(i), Y], W[i, Y],
-                                     W[right(i, n), Y]) - friction(W[i, V], W[i, P], p.a, p.b)
+                a_end = spring_force(W[i, F0], tau + h, _event_nu(p), p.l2, W[left(i), Y], W[i, Y],
+                                     W[right(i, n), Y]) - friction(p.law, W[i, V], W[i, P])
                 d0 = h * W[i, K1V]
                 d1 = h * a_end
                 lo = 0.0
@@ -381,7 +396,7 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
                 if hi < x_cut:
                     x_cut = hi
                     who = i
-                    kind = 1
+                    kind = STICK
         for k in range(na):
             i = act[k]
             for j in (left(i), right(i, n)):
@@ -401,14 +416,14 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
                     if hi < x_cut:
                         x_cut = hi
                         who = j
-                        kind = 2
+                        kind = ONSET_NEIGHBOUR
         if t_far <= tau + h:
             x = max(t_far - tau, 0.0) / h
             if x < x_cut:
                 x_cut = x
                 who = far
-                kind = 3
-        if kind != 0 and x_cut < 1.0:
+                kind = ONSET_LOADING
+        if kind != NO_CUT and x_cut < 1.0:
             h = x_cut * h
             cuts += 1
             dwork, dslip, _ = take_step(W, act, na, n, tau, h, p, yrest)
@@ -427,22 +442,23 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
                 status = NONFINITE
             if v > vmax:
                 vmax = v
-            if p.method == RK4 and (v > v_limit or W[i, P] < psi_limit) and status == OK:
+            if p.method == RK4 and rk4_unstable(p.law, v, W[i, P], v_limit, psi_limit) and status == OK:
                 status = UNSTABLE
         if status != OK:
             break
         # Transitions at tau: the located one, then anything that crossed with it.
-        if kind == 2 or kind == 3:
-            na, nt, yrest = _start(W, act, na, flag, touched, nt, since, tree, t0, p.nu, who, tau, yrest,
+        if kind == ONSET_NEIGHBOUR or kind == ONSET_LOADING:
+            na, nt, yrest = _start(W, act, na, flag, touched, nt, since, tree, t0, p, who, tau, yrest,
                                    event, undo)
             W[who, V] = 0.0
-        if kind == 1:
+        if kind == STICK:
             W[who, V] = 0.0
         m = 0
         nstuck = 0
         for k in range(na):
             i = act[k]
-            if W[i, V] <= 0.0 and not (i == who and kind >= 2) and not _pressed(W, n, i, tau, p):
+            started = i == who and (kind == ONSET_NEIGHBOUR or kind == ONSET_LOADING)
+            if W[i, V] <= 0.0 and not started and not _pressed(W, n, i, tau, p):
                 # Blocks never move backward: a block that started this step
                 # but could not move keeps its slip.
                 if W[i, Y] < W[i, Y0]:
@@ -450,7 +466,7 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
                 W[i, V] = 0.0
                 W[i, TR] = tau
                 W[i, YS] = W[i, Y]
-                flag[i] = 2
+                flag[i] = STOPPED
                 yrest += W[i, Y]
                 stuck[nstuck] = i
                 nstuck += 1
@@ -465,7 +481,7 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
             i = act[k] if k < m else stuck[k - m]
             for j in (left(i), right(i, n)):
                 if j != i and _above_threshold(W, flag, n, j, tau, p):
-                    na, nt, yrest = _start(W, act, na, flag, touched, nt, since, tree, t0, p.nu, j,
+                    na, nt, yrest = _start(W, act, na, flag, touched, nt, since, tree, t0, p, j,
                                            tau, yrest, event, undo)
         # Blocks no longer watched by a sliding neighbour may only start by
         # loading: back on the schedule with their analytic onset.
@@ -473,7 +489,7 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
             i = stuck[k]
             for j in (left(i), i, right(i, n)):
                 tree_set(tree, j, t0[0] + (t0[1] + _loading_onset(W, flag, n, j, tau, p)))
-        if kind != 0 or nstuck > 0 or na != m:
+        if kind != NO_CUT or nstuck > 0 or na != m:
             t_far, far = _far_onset(W, flag, n, since, tree, t0, tau, p)
     if profile.shape[0] == n:
         profile[:] = 0.0
@@ -516,13 +532,14 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, p, work, slip_t
         stored = 0.5 * y * y
         if i + 1 < n:
             stored += 0.5 * p.l2 * (W[i + 1, Y] - y) ** 2
-        if i - 1 >= 0 and flag[i - 1] == 0:
+        if i - 1 >= 0 and flag[i - 1] == UNTOUCHED:
             stored += 0.5 * p.l2 * (y - W[i - 1, Y]) ** 2
         e_change += stored - y * W[i, F0]
         gross += stored + abs(y * W[i, F0])
     elastic = e_change     # the terms apart (workspace.py): D_ELASTIC, D_LOAD_WORK
-    e_change += -p.nu * tau * slip + p.nu * slip_time
-    gross += p.nu * tau * slip + p.nu * slip_time
+    nu = _event_nu(p)
+    e_change += -nu * tau * slip + nu * slip_time
+    gross += nu * tau * slip + nu * slip_time
     diag[D_DURATION] = tau
     diag[D_SLIP] = slip
     diag[D_FIRST] = first
@@ -532,17 +549,19 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, p, work, slip_t
     diag[D_RESIDUAL] = e_change + work
     diag[D_ENERGY_SCALE] = gross
     diag[D_ELASTIC] = elastic
-    diag[D_LOAD_WORK] = p.nu * tau * slip - p.nu * slip_time
+    diag[D_LOAD_WORK] = nu * tau * slip - nu * slip_time
     # The touched blocks move to the end time (loading, state grown since they
     # stopped); their untouched neighbours stay at t0, which is just as valid.
     # Then the slip changes the forces (free ends: an end block has one spring).
+    # A law whose loader stands still during events ends them at t0 (no loading time).
+    elapsed = tau if loader_moves(p.law) else 0.0
     for k in range(nt):
         i = touched[k]
-        W[i, F0] += p.nu * tau
-        W[i, P] += math.log1p((tau - W[i, TR]) * math.exp(-W[i, P]))
+        W[i, F0] += nu * tau
+        W[i, P] = rest_state(p.law, W[i, P], tau - W[i, TR])
         since[i, 0] = t0[0]
         since[i, 1] = t0[1]
-        advance_clock(since[i], tau)
+        advance_clock(since[i], elapsed)
     for k in range(nt):
         i = touched[k]
         y = W[i, Y]
@@ -558,8 +577,8 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, p, work, slip_t
         W[i, YS] = 0.0
         W[i, V] = 0.0
         W[i, TR] = 0.0
-        flag[i] = 0
+        flag[i] = UNTOUCHED
     for k in range(nt):
         i = touched[k]
         for j in (left(i), i, right(i, n)):
-            tree_set(tree, j, onset_key(W, since, j, p.nu, p.b))
+            tree_set(tree, j, onset_key(W, since, j, p))

@@ -7,8 +7,8 @@ ensemble.integrators.kernel_params builds it from the config.
 """
 from collections import namedtuple
 
-_Fields = namedtuple("KernelParams", "l2 nu a b method dt rtol atol max_step max_duration max_steps")
-_INTEGERS = ("method", "max_steps")     # the other fields are float64
+_Fields = namedtuple("KernelParams", "l2 nu law method dt rtol atol max_step max_duration max_steps")
+_INTEGERS = ("method", "max_steps")     # law is the friction law's own record; the others are float64
 
 
 class KernelParams(_Fields):
@@ -16,8 +16,8 @@ class KernelParams(_Fields):
 
     l2            l^2, the stiffness of the springs between blocks relative to the driver spring
     nu            loading velocity of the driver plate
-    a             velocity-strengthening coefficient of a ln(1 + v) in the friction
-    b             state coefficient of b psi, psi = ln(theta): also the static threshold b psi at rest
+    law           the friction law's parameters, a namedtuple of that law's class (model/laws/): the
+                  kernels are compiled once per law, and each call of a law function resolves to it
     method        integrator code, event.RK4, ARK3, ARK4 or ARK5 (ensemble.integrators.INTEGRATORS)
     dt            step of rk4; the first step of an event for the adaptive methods
     rtol          adaptive methods: relative tolerance of the local error per step
@@ -35,8 +35,8 @@ class KernelParams(_Fields):
             unknown = [f for f in fields if f not in cls._fields]
             raise TypeError(f"KernelParams: missing {missing}, unknown {unknown}")
         # one type per field, so that every caller reaches the same compiled kernel
-        return super().__new__(cls, *(int(fields[f]) if f in _INTEGERS else float(fields[f])
-                                      for f in cls._fields))
+        return super().__new__(cls, *(int(fields[f]) if f in _INTEGERS else
+                                      fields[f] if f == "law" else float(fields[f]) for f in cls._fields))
 
     def __getnewargs_ex__(self):
         """For pickle and copy, which would otherwise call __new__ with the fields by position."""

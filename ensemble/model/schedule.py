@@ -21,7 +21,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .onset import grow_state, onset_delay
+from .laws import onset_delay, rest_state
 from .workspace import F0, P
 
 
@@ -41,20 +41,20 @@ def elapsed(clock, since, i):
 
 
 @nb.njit(cache=True)
-def materialize(W, since, i, clock, nu):
-    """Bring block i (at rest since since[i]) forward to the time `clock`."""
+def materialize(W, since, i, clock, p):
+    """Bring block i (at rest since since[i]) forward to the time `clock` (p: params.KernelParams)."""
     dt = elapsed(clock, since, i)
     if dt > 0.0:
-        W[i, F0] += nu * dt
-        W[i, P] = grow_state(W[i, P], dt)
+        W[i, F0] += p.nu * dt
+        W[i, P] = rest_state(p.law, W[i, P], dt)
     since[i, 0] = clock[0]
     since[i, 1] = clock[1]
 
 
 @nb.njit(cache=True)
-def onset_key(W, since, i, nu, b):
+def onset_key(W, since, i, p):
     """Approximate absolute onset time of block i by loading alone (orders the tree)."""
-    return since[i, 0] + (since[i, 1] + onset_delay(W[i, F0], W[i, P], nu, b))
+    return since[i, 0] + (since[i, 1] + onset_delay(p.law, W[i, F0], W[i, P], p.nu))
 
 
 # The tree: tree[1] is the root, node k has children 2k, 2k+1, and block i is
@@ -93,13 +93,13 @@ def tree_min(tree):
 
 
 @nb.njit(cache=True)
-def build_schedule(W, since, tree, nu, b):
+def build_schedule(W, since, tree, p):
     """Every block's onset key, and the minima: O(N), once per kernel call."""
     n = W.shape[0]
     m = tree.shape[0] // 2
     tree[m:] = np.inf
     for i in range(n):
-        tree[m + i] = onset_key(W, since, i, nu, b)
+        tree[m + i] = onset_key(W, since, i, p)
     for k in range(m - 1, 0, -1):
         tree[k] = min(tree[2 * k], tree[2 * k + 1])
 

@@ -18,7 +18,8 @@ to the tolerances; 0 for fixed steps).
 import math
 import numba as nb
 
-from .friction import friction, left, right, spring_force, state_rate
+from .geometry import left, right, spring_force
+from .laws import friction, has_state, implicit_state, loader_moves, state_rate
 from .tableaux import ARK324, ARK436, ARK548
 from .workspace import (ARK_A, ARK_G, ARK_V, F0, K1V, KP, KV, KY, P, P0, PS, SP, SV, SY, V, V0,
                         VS, Y, Y0, YS)
@@ -35,16 +36,17 @@ def stage_rates(W, act, na, n, tau, p, yrest, with_state=True):
     """
     power = 0.0
     ysum = yrest
+    nu = p.nu if loader_moves(p.law) else 0.0
     for k in range(na):
         i = act[k]
         v = W[i, VS]
         psi = W[i, PS]
-        phi = friction(v, psi, p.a, p.b)
+        phi = friction(p.law, v, psi)
         W[i, KY] = v
-        W[i, KV] = spring_force(W[i, F0], tau, p.nu, p.l2, W[left(i), YS], W[i, YS],
+        W[i, KV] = spring_force(W[i, F0], tau, nu, p.l2, W[left(i), YS], W[i, YS],
                                 W[right(i, n), YS]) - phi
-        if with_state:
-            W[i, KP] = state_rate(v, psi)
+        if with_state and has_state(p.law):
+            W[i, KP] = state_rate(p.law, v, psi)
         if v > 0.0:
             power += phi * v
         ysum += W[i, YS]
@@ -73,7 +75,8 @@ def rk4_step(W, act, na, n, tau, h, p, yrest):
                 i = act[k]
                 W[i, YS] = W[i, Y0] + frac * h * W[i, KY]
                 W[i, VS] = W[i, V0] + frac * h * W[i, KV]
-                W[i, PS] = W[i, P0] + frac * h * W[i, KP]
+                if has_state(p.law):
+                    W[i, PS] = W[i, P0] + frac * h * W[i, KP]
         else:
             for k in range(na):
                 i = act[k]
@@ -89,16 +92,19 @@ def rk4_step(W, act, na, n, tau, h, p, yrest):
                 W[i, K1V] = W[i, KV]
                 W[i, SY] = W[i, KY]
                 W[i, SV] = W[i, KV]
-                W[i, SP] = W[i, KP]
+                if has_state(p.law):
+                    W[i, SP] = W[i, KP]
             else:
                 W[i, SY] += weight * W[i, KY]
                 W[i, SV] += weight * W[i, KV]
-                W[i, SP] += weight * W[i, KP]
+                if has_state(p.law):
+                    W[i, SP] += weight * W[i, KP]
     for k in range(na):
         i = act[k]
         W[i, Y] = W[i, Y0] + h / 6.0 * W[i, SY]
         W[i, V] = W[i, V0] + h / 6.0 * W[i, SV]
-        W[i, P] = W[i, P0] + h / 6.0 * W[i, SP]
+        if has_state(p.law):
+            W[i, P] = W[i, P0] + h / 6.0 * W[i, SP]
         W[i, YS] = W[i, Y]
     return pw * h / 6.0, ys * h / 6.0, 0.0
 
@@ -106,63 +112,6 @@ def rk4_step(W, act, na, n, tau, h, p, yrest):
 _C3, _AE3, _AI3, _B3, _D3, _G3 = ARK324.kernel_arrays()
 _C5, _AE5, _AI5, _B5, _D5, _G5 = ARK548.kernel_arrays()
 _C4, _AE4, _AI4, _B4, _D4, _G4 = ARK436.kernel_arrays()
-
-
-# The implicit stage equation of every block: psi - hg exp(-psi) = target. Its left
-# side is increasing and concave in psi, so Newton's iterates reach the root from
-# below after the first step and never overshoot it; after a step s the distance
-# to the root is below s^2 / 2 (|f''| < f'), so a solve ends once that is below
-# 1e-16 (1 + |psi|), one exp earlier than waiting for a negligible step. The root
-# lies above `target`, and far below it Newton only climbs by about 1 per
-# iteration, so solves start at or above `target`.
-
-
-@nb.njit(cache=True, inline="always")
-def _exp_taylor(x):
-    """exp(x) by its Taylor polynomial of degree 6: relative error < x^7 / 5040 (< 2e-18 for |x| < 1e-2)."""
-    return 1.0 + x * (1.0 + x * (0.5 + x * (1.0 / 6.0 + x * (1.0 / 24.0 + x * (1.0 / 120.0 + x / 720.0)))))
-
-
-@nb.njit(cache=True, inline="always")
-def _two_steps(psi, ex, target, hg):
-    """(psi, converged): a Halley then a Newton step from psi with ex = exp(-psi), the usual case.
-
-    Halley (f'' = -hg exp(-psi)) converges cubically, so the pair solves to
-    round-off from guesses up to ~3e-3 off (two Newton steps: ~3e-4); the
-    fallback then takes 6% of ark4's and 15% of ark5's solves on large events.
-    The exp after the first step comes from Taylor, valid while that step is
-    below 1e-2; `converged` says whether both held.
-    """
-    e = hg * ex
-    f = psi - e - target
-    d = 1.0 + e
-    step1 = f * d / (d * d + 0.5 * f * e)
-    psi -= step1
-    ex *= _exp_taylor(step1)
-    e = hg * ex
-    step = (psi - e - target) / (1.0 + e)
-    psi -= step
-    return psi, abs(step1) < 1e-2 and step * step <= 2e-16 * (1.0 + abs(psi))
-
-
-@nb.njit(cache=True)
-def _newton_state(psi, target, hg):
-    """Newton from psi until converged (the rare case); NaN, a loud failure, if it does not.
-
-    Not inlined: the rare case stays out of the stage loop.
-    """
-    ex = math.exp(-psi)
-    for _ in range(60):
-        e = hg * ex
-        step = (psi - e - target) / (1.0 + e)
-        psi -= step
-        if step * step <= 2e-16 * (1.0 + abs(psi)):
-            return psi
-        if abs(step) < 1e-2:
-            ex *= _exp_taylor(step)
-        else:
-            ex = math.exp(-psi)
-    return math.nan
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
@@ -180,47 +129,19 @@ def _ark_step(W, act, na, n, tau, h, p, yrest, c, ae, ai, bw, bd, gamma):
             i = act[k]
             y = W[i, Y0]
             v = W[i, V0]
-            r = W[i, P0]
             for j in range(s):
                 y += h * ae[s, j] * W[i, ARK_V + j]
                 v += h * ae[s, j] * W[i, ARK_A + j]
-                r += h * ai[s, j] * W[i, ARK_G + j]
             W[i, YS] = y
             W[i, VS] = v
-            if s == 0:
+            if has_state(p.law):
+                r = W[i, P0]
+                for j in range(s):
+                    r += h * ai[s, j] * W[i, ARK_G + j]
                 W[i, PS] = r
-            else:
-                # the implicit stage psi - hg (exp(-psi) - max(v, 0)) = r: the solve starts from
-                # the explicit guess with the previous stage's rate (in KP), raised to at least
-                # the root's lower bound `target` (SY, SV, SP are free scratch here)
-                target = r - hg * (v if v > 0.0 else 0.0)
-                W[i, PS] = max(r + hg * W[i, KP], target)
-                W[i, SY] = target
-                W[i, SV] = r
-        if s > 0:
-            # the blocks' exps are independent: one pass for all of them keeps them out of
-            # each solve's chain of dependent operations (~10% less time per step on large events)
-            for k in range(na):
-                i = act[k]
-                W[i, SP] = math.exp(-W[i, PS])
-            unsolved = False
-            for k in range(na):
-                i = act[k]
-                psi, converged = _two_steps(W[i, PS], W[i, SP], W[i, SY], hg)
-                W[i, PS] = psi
-                W[i, SP] = 0.0 if converged else 1.0
-                unsolved |= not converged
-            if unsolved:
-                for k in range(na):
-                    i = act[k]
-                    if W[i, SP] != 0.0:
-                        W[i, PS] = _newton_state(W[i, PS], W[i, SY], hg)
-            for k in range(na):
-                i = act[k]
-                # the stage's state rate from the solved equation, without an exp (the event
-                # kernel may redo a step with h = 0)
-                psi = W[i, PS]
-                W[i, KP] = (psi - W[i, SV]) / hg if hg > 0.0 else state_rate(W[i, VS], psi)
+        if s > 0 and has_state(p.law):
+            # the stiff state: psi - hg * state_rate(v, psi) = r, one scalar equation per block
+            implicit_state(p.law, W, act, na, hg)
         power, ysum = stage_rates(W, act, na, n, tau + c[s] * h, p, yrest, s == 0)
         pw += bw[s] * power
         ys += bw[s] * ysum
@@ -228,7 +149,8 @@ def _ark_step(W, act, na, n, tau, h, p, yrest, c, ae, ai, bw, bd, gamma):
             i = act[k]
             W[i, ARK_V + s] = W[i, KY]
             W[i, ARK_A + s] = W[i, KV]
-            W[i, ARK_G + s] = W[i, KP]
+            if has_state(p.law):
+                W[i, ARK_G + s] = W[i, KP]
     err = 0.0
     for k in range(na):
         i = act[k]
@@ -238,13 +160,15 @@ def _ark_step(W, act, na, n, tau, h, p, yrest, c, ae, ai, bw, bd, gamma):
         for s in range(c.shape[0]):
             dy += bw[s] * W[i, ARK_V + s]
             dv += bw[s] * W[i, ARK_A + s]
-            dp += bw[s] * W[i, ARK_G + s]
             ey += bd[s] * W[i, ARK_V + s]
             ev += bd[s] * W[i, ARK_A + s]
-            ep += bd[s] * W[i, ARK_G + s]
+            if has_state(p.law):
+                dp += bw[s] * W[i, ARK_G + s]
+                ep += bd[s] * W[i, ARK_G + s]
         W[i, Y] = W[i, Y0] + h * dy
         W[i, V] = W[i, V0] + h * dv
-        W[i, P] = W[i, P0] + h * dp
+        if has_state(p.law):
+            W[i, P] = W[i, P0] + h * dp
         W[i, YS] = W[i, Y]
         e1, e2, e3 = _error_norms(W, i, h * ey, h * ev, h * ep, p.rtol, p.atol)
         err = max(err, e1, e2, e3)

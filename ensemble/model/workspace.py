@@ -36,18 +36,40 @@ from collections import namedtuple
 
 import numpy as np
 
-# columns of W
-Y, V, P, TR, F0, YS, VS, PS, Y0, V0, P0, KY, KV, KP, SY, SV, SP, K1V, HD0, HD1 = range(20)
-# stage derivatives of the ARK steppers: ARK_STAGES columns each from ARK_V (dy/dt), ARK_A (dv/dt),
+# Columns of W, one meaning each. "Step start" is the state a step (and its retries) starts from;
+# "stage" the state at which a Runge-Kutta stage evaluates the rates.
+Y = 0        # slip since the onset of the event (0 for a block that has not slid)
+V = 1        # velocity (0 at rest)
+P = 2        # state psi = ln(theta); between events at the block's time `since` (schedule.py)
+TR = 3       # local time at which the block came to rest in this event (its state grows from there)
+F0 = 4       # force at the onset of the event (between events: at time `since`), c-free frame
+YS = 5       # stage slip (== Y for blocks at rest: neighbours read YS)
+VS = 6       # stage velocity
+PS = 7       # stage psi
+Y0 = 8       # step start: slip
+V0 = 9       # step start: velocity
+P0 = 10      # step start: psi
+KY = 11      # stage rate of the slip (the stage velocity)
+KV = 12      # stage rate of the velocity (force minus friction)
+KP = 13      # stage rate of psi (also the implicit solve's first guess from the previous stage)
+SY = 14      # RK4: weighted sum of the stage rates of the slip
+SV = 15      # RK4: ... of the velocity
+SP = 16      # RK4: ... of psi
+K1V = 17     # rate of the velocity at the step start (slope of the Hermite interpolant of v)
+HD0 = 18     # h V0: slope of the slip's Hermite interpolant at the step start
+HD1 = 19     # h V: ... at the step end
+IM_TARGET = 20  # ARK implicit stage: lower bound of the root psi (laws/aging.py)
+IM_RHS = 21     # ARK implicit stage: explicit part r of the stage equation
+IM_EXP = 22     # ARK implicit stage: exp(-psi) of the solve's first guess
+IM_UNSOLVED = 23  # ARK implicit stage: 1 where the two-step solve did not converge
+# stage rates of the ARK steppers: ARK_STAGES columns each from ARK_V (dy/dt), ARK_A (dv/dt),
 # ARK_G (dpsi/dt)
 ARK_STAGES = 8
-ARK_V = 20
+ARK_V = 24
 ARK_A = ARK_V + ARK_STAGES
 ARK_G = ARK_A + ARK_STAGES
-# local time at which a block started to slide in this event (for the step trace)
-TS = ARK_G + ARK_STAGES
-# 1 while the block's between-events values are in the undo log of the event in progress (undo.py)
-LOGGED = TS + 1
+TS = ARK_G + ARK_STAGES   # local time at which the block started to slide in this event (step trace)
+LOGGED = TS + 1           # 1 while the block's between-events values are in the undo log (undo.py)
 NCOLS = LOGGED + 1
 
 # entries of the per-event diagnostics vector
@@ -104,6 +126,11 @@ BETWEEN, IN_EVENT = 0, 1
 U_BLOCK, U_F0, U_P, U_SINCE_HI, U_SINCE_LO = range(5)
 NUNDO = 5
 
+# values of `flag`: the block's part in the event in progress
+UNTOUCHED = 0   # has not slid in this event (and between events: every block)
+SLIDING = 1     # slides: in the active list act[:na]
+STOPPED = 2     # slid in this event and is at rest again
+
 # a work budget (chain.simulate, event.continue_event) that no run exhausts: integrate to the end
 UNLIMITED = 2**62
 
@@ -123,7 +150,7 @@ STATUS_TEXT = {
 WorkArrays = namedtuple("WorkArrays", [
     "W",        # (n, NCOLS) float64: per-block quantities, the columns above
     "act",      # (n,) int: the sliding blocks, act[:na] (event.py)
-    "flag",     # (n,) int8: 0 not slid in this event, 1 sliding, 2 slid and at rest again
+    "flag",     # (n,) int8: UNTOUCHED, SLIDING or STOPPED (below), per block, in the event in progress
     "touched",  # (n,) int: the blocks that slid in this event, touched[:nt]
     "stuck",    # (n,) int: scratch of one step, the blocks that stopped in it
     "since",    # (n, 2) float64: two-float time at which a block's F0 and P hold between events (schedule.py)
@@ -206,14 +233,16 @@ class Workspace:
             clock = self.event[[EV_CLOCK_HI, EV_CLOCK_LO]].copy()
         return force, psi, since, clock
 
-    def state(self, clock, nu):
-        """(force, psi) of every block at the two-float time `clock` (new arrays).
+    def state(self, clock, p):
+        """(force, psi) of every block at the two-float time `clock` (new arrays); p, the
+        kernels' parameters (params.KernelParams).
 
         During a paused event: of the between-events state before it (`between_events`).
         """
+        from .laws import rest_states
         force, psi, since, _ = self.between_events(clock)
         dt = np.maximum((clock[0] - since[:, 0]) + (clock[1] - since[:, 1]), 0.0)
-        return force + nu * dt, psi + np.log1p(dt * np.exp(-psi))
+        return force + p.nu * dt, rest_states(p.law, psi, dt)
 
     @property
     def force(self):

@@ -1,0 +1,181 @@
+"""Friction laws: the registry, and the calls through which the kernels use a law.
+
+A law is one module of this package that defines `LAW`, a `Law` record (below). Nothing else
+in the kernels knows which law runs: they call the functions of this module (`friction`,
+`threshold`, `state_rate`, ...), each taking the law's parameter record as its first argument.
+That record is a namedtuple of the law's own class (aging.AgingParams, ...), so numba compiles
+the kernels once per law, and each call here resolves, at compile time, to the law's own
+function (numba.extending.overload, inlined): no branch on the law at run time.
+
+Frame and units: dimensionless, forces without any constant friction (aging's c is removed by a
+shift of u), so a block at rest with force F and state psi starts to slide once
+F >= threshold(law, psi). A law without a state variable ignores psi (the kernels keep it 0).
+
+Adding a law: docs/numerics.md, section "Adding a friction law".
+"""
+import importlib
+import pkgutil
+from dataclasses import dataclass
+
+import numba as nb
+import numpy as np
+from numba.extending import overload
+
+
+@dataclass(frozen=True)
+class Key:
+    """A [model] key that belongs to a law."""
+    default: float
+    check: object       # value -> bool
+    rule: str           # what check requires, for the error message ("> 0")
+    meaning: str        # one line, for the docs and `validate`
+
+
+@dataclass(frozen=True)
+class Law:
+    """What a friction law supplies. Every function is numba-compiled and takes the law's
+    parameter record (`params`) first; see the module's docstring for the frame."""
+    name: str             # the value of model.law
+    params: type          # namedtuple class of the parameters the kernels read (a subset of keys)
+    keys: dict            # [model] keys of the law: name -> Key, in the order the config writes them
+    convention: str       # one paragraph: the law and its conventions (stored in every catalog)
+    has_state: bool       # integrate a state psi while sliding (False: psi stays 0, no state stages)
+    loader_moves: bool    # the loader advances at nu during events (False: it stands still during
+                          # an event and the clock with it; events take no loading time)
+    friction: object      # (law, v, psi) -> dynamic friction while sliding, at max(v, 0)
+    threshold: object     # (law, psi) -> static threshold of a block at rest
+    state_rate: object    # (law, v, psi) -> d psi / dt while sliding (has_state)
+    rest_state: object    # (law, psi, dt) -> psi after dt at rest
+    onset_delay: object   # (law, F, psi, nu) -> time at rest until F + nu t reaches the threshold
+    implicit_state: object  # (law, W, act, na, hg): the stiff state's implicit stage (steppers.py)
+    stiff_limit: object   # (law, rate_limit) -> the state bound beyond which RK4 is unstable
+    rk4_unstable: object  # (law, v, psi, rate_limit, state_limit) -> RK4's step left its stability region
+
+    def kernel_params(self, model):
+        """The law's parameter record for the kernels from a config's model section."""
+        return self.params(**{name: float(getattr(model, name)) for name in self.params._fields})
+
+
+def _discover():
+    laws = {}
+    for info in pkgutil.iter_modules(__path__):
+        module = importlib.import_module(f"{__name__}.{info.name}")
+        law = getattr(module, "LAW", None)
+        if isinstance(law, Law):
+            if law.name in laws:
+                raise RuntimeError(f"two friction laws named {law.name!r}")
+            laws[law.name] = law
+    return laws
+
+
+LAWS = _discover()              # model.law -> Law
+DEFAULT = "aging"
+_BY_PARAMS = {law.params: law for law in LAWS.values()}
+
+
+def get(name):
+    return LAWS[name]
+
+
+def of_params(params):
+    """The Law whose parameter record this is."""
+    return _BY_PARAMS[type(params)]
+
+
+# The kernels' calls. Each is a stub that numba replaces by the law's function.
+
+def friction(law, v, psi):
+    """Dynamic friction of a sliding block at velocity max(v, 0) and state psi."""
+
+
+def threshold(law, psi):
+    """Static threshold of a block at rest with state psi."""
+
+
+def state_rate(law, v, psi):
+    """d psi / dt of a sliding block."""
+
+
+def rest_state(law, psi, dt):
+    """psi of a block after dt at rest."""
+
+
+def onset_delay(law, force, psi, nu):
+    """Time until a block at rest (force, psi) loaded at rate nu reaches its threshold (0 if it has)."""
+
+
+def implicit_state(law, W, act, na, hg):
+    """The implicit stage of the state of the active blocks (steppers._ark_step)."""
+
+
+def stiff_limit(law, rate_limit):
+    """The state bound of RK4's stability for a step with rate_limit = RK4_STABILITY / dt."""
+
+
+def rk4_unstable(law, v, psi, rate_limit, state_limit):
+    """A block's stiff part beyond RK4's stability region."""
+
+
+def has_state(law):
+    """The law integrates a state while sliding (a compile-time constant)."""
+
+
+def loader_moves(law):
+    """The loader advances during events (a compile-time constant)."""
+
+
+def _dispatch(stub, field):
+    """Compile calls of `stub` to the law's own function `field` (chosen by the record's type).
+
+    numba inlines neither *args nor closures over them, so each arity has its own impl.
+    """
+    def choose(law):
+        return getattr(_BY_PARAMS[law.instance_class], field)
+
+    arity = stub.__code__.co_argcount - 1
+    if arity == 2:
+        @overload(stub, inline="always")
+        def _two(law, x, y):
+            fn = choose(law)
+            return lambda law, x, y: fn(law, x, y)
+    elif arity == 3:
+        @overload(stub, inline="always")
+        def _three(law, x, y, z):
+            fn = choose(law)
+            return lambda law, x, y, z: fn(law, x, y, z)
+    elif arity == 4:
+        @overload(stub, inline="always")
+        def _four(law, x, y, z, w):
+            fn = choose(law)
+            return lambda law, x, y, z, w: fn(law, x, y, z, w)
+    else:
+        @overload(stub, inline="always")
+        def _one(law, x):
+            fn = choose(law)
+            return lambda law, x: fn(law, x)
+
+
+def _constant(stub, field):
+    @overload(stub, inline="always")
+    def _choose(law):
+        value = bool(getattr(_BY_PARAMS[law.instance_class], field))
+
+        def impl(law):
+            return value
+        return impl
+
+
+for _stub in (friction, threshold, state_rate, rest_state, onset_delay, implicit_state, stiff_limit,
+              rk4_unstable):
+    _dispatch(_stub, _stub.__name__)
+for _stub in (has_state, loader_moves):
+    _constant(_stub, _stub.__name__)
+
+
+@nb.njit(cache=True)
+def rest_states(law, psi, dt):
+    """psi of every block after dt[i] at rest (arrays; a new array)."""
+    out = np.empty_like(psi)
+    for i in range(psi.shape[0]):
+        out[i] = rest_state(law, psi[i], dt[i])
+    return out
