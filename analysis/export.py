@@ -41,6 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ensemble import __version__, catalog, filekind
+from ensemble.config import LAW_KEYS
 
 from . import summary
 
@@ -136,7 +137,7 @@ def _tasks(path):
                     if name.startswith("tasks/")}, **catalog.READER_TASKS}
     values = {"task": np.arange(len(tasks["point"]), dtype=np.int64)}
     columns = {"task": ("index", "task index (events join on it)")}
-    first = ("point", "seed_index", "N", "l", "nu", "a", "b", "c", "events_written", "events_done",
+    first = ("point", "seed_index", "N", "l", "nu", "law", *LAW_KEYS, "events_written", "events_done",
              "status", "rank", "wall_time", "events_per_second", "seed_entropy", "spawn_key")
     for name in (*first, *sorted(set(tasks) - set(first) - {"integrator", "error"})):
         values[name], columns[name] = tasks[name], described.get(name, (None, "", ""))[::2]

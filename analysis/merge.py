@@ -54,9 +54,11 @@ class Inputs:
 
 def bootstrap_rng(seed, params):
     """The bootstrap generator of the point with these parameters:
-    SeedSequence(seed, spawn_key=(N, bits(l), bits(nu), bits(a), bits(b), bits(c))), where bits(x)
-    is the IEEE-754 binary64 pattern of x as an unsigned integer."""
-    key = [int(params["N"])] + [int(np.float64(params[name]).view(np.uint64)) for name in PARAMS[1:]]
+    SeedSequence(seed, spawn_key=(N, bits(l), bits(nu), bits(x) for each of its law's keys x in
+    PARAMS order)), where bits(x) is the IEEE-754 binary64 pattern of x as an unsigned integer (for
+    the aging law: bits(a), bits(b), bits(c)). Keys of other laws (NaN) are left out."""
+    key = [int(params["N"])] + [int(np.float64(params[name]).view(np.uint64)) for name in PARAMS[1:]
+                                if not np.isnan(params[name])]
     return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=tuple(key)))
 
 
@@ -121,10 +123,11 @@ def _points(paths, tasks):
     """Pool the rows of `tasks` by exact parameters; set tasks["point"]; refuse repeated streams."""
     where = {}
     for g in range(len(tasks["point"])):
-        key = tuple(tasks[name][g].item() for name in PARAMS)
-        where.setdefault(key, []).append(g)
+        # by bit pattern: keys of another law are NaN, which equals nothing, itself included
+        bits = tuple(np.float64(tasks[name][g]).view(np.uint64).item() for name in PARAMS)
+        where.setdefault(bits, (tuple(tasks[name][g].item() for name in PARAMS), []))[1].append(g)
     points = []
-    for i, (key, rows) in enumerate(where.items()):
+    for i, (key, rows) in enumerate(where.values()):
         rows.sort(key=lambda g: (int(tasks["seed_entropy"][g]), int(tasks["spawn_key"][g])))
         for a, b in zip(rows, rows[1:]):
             stream = (int(tasks["seed_entropy"][a]), int(tasks["spawn_key"][a]))
@@ -133,7 +136,7 @@ def _points(paths, tasks):
                     return f"{paths[tasks['catalog'][g]]} task {tasks['catalog_task'][g]}"
                 raise MergeError(
                     f"{task(a)} and {task(b)} are the same trajectory (seed_entropy {stream[0]}, "
-                    f"spawn_key {stream[1]}, " + ", ".join(f"{n} = {v:g}" for n, v in zip(PARAMS, key))
+                    f"spawn_key {stream[1]}, " + ", ".join(f"{n} = {v:g}" for n, v in zip(PARAMS, key) if v == v)
                     + "): give each trajectory once")
         tasks["point"][rows] = i
         points.append((dict(zip(PARAMS, key)), rows))

@@ -45,11 +45,12 @@ def legend_labels(summaries, names=None):
     for j, s in enumerate(summaries):
         for i in range(len(s["points/N"])):
             owner.append(j)
-            rows.append(tuple(s[f"points/{k}"][i].item() for k in PARAMS))
+            # None for a key of another friction law (NaN in the summary, which equals nothing)
+            rows.append(tuple(None if v != v else v for v in (s[f"points/{k}"][i].item() for k in PARAMS)))
     keys = [k for n, k in enumerate(PARAMS) if len({r[n] for r in rows}) > 1] or ["b"]
     for exact in (False, True):
         labels = [", ".join(f"{k} = {repr(r[PARAMS.index(k)]) if exact else format(r[PARAMS.index(k)], 'g')}"
-                            for k in keys) for r in rows]
+                            for k in keys if r[PARAMS.index(k)] is not None) for r in rows]
         if all(labels[a] != labels[b] or rows[a] == rows[b]
                for a in range(len(rows)) for b in range(a)):
             break

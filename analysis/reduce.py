@@ -13,11 +13,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from ensemble import catalog, filekind
+from ensemble.config import LAW_KEYS
 
 from . import stats
 from .recurrence import RecurrenceScanner
 
-PARAMS = ("N", "l", "nu", "a", "b", "c")
+# the parameters that tell points apart: the chain's, and every friction law's keys (NaN where a
+# key is not of the task's law, so tasks of two laws never pool)
+PARAMS = ("N", "l", "nu", *LAW_KEYS)
 
 
 @dataclass(frozen=True)

@@ -24,7 +24,8 @@ def varying(s):
 
 def point_label(s, i, keys=None):
     keys = keys or varying(s)
-    return ", ".join(f"{k} = {s[f'points/{k}'][i]:g}" for k in keys)
+    return ", ".join(f"{k} = {s[f'points/{k}'][i]:g}" for k in keys
+                     if not np.isnan(s[f'points/{k}'][i]))     # NaN: a key of another law
 
 
 def unreliable(s, i):

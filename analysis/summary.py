@@ -11,7 +11,8 @@
                                                 the one the runner uses: analysis/merge.py)
     /per_task/{mu, tnu, tnu_interior}           (tasks, stretches, bins) counts
     /per_task/numbers                           (tasks, stretches, 9) counts and sums (analysis.stats)
-    /points/{N, l, nu, a, b, c}                 parameters of each point (first appearance order)
+    /points/{N, l, nu, <law keys>}              parameters of each point (first appearance order;
+                                                the keys of every friction law, NaN if not its law's)
     /points/method, /points/units               resampling used ("seeds" or "blocks") and unit count
     /points/{mu, tnu, tnu_interior}_density     (points, bins): estimate; *_lo, *_hi: interval
     /points/numbers/<name>                      (points, 3): estimate, lo, hi (see reduce.NUMBERS)

@@ -57,7 +57,7 @@ def step_alone_ns(setting, model, reps=200_000):
         W[i, Y0] = W[i, Y] = W[i, YS] = 100.0 + 10.0 * k
         W[i, V0] = W[i, V] = 300.0 - 50.0 * k
         W[i, P0] = W[i, P] = -5.5 - 0.1 * k
-        W[i, F0] = p.b * 26.0
+        W[i, F0] = model.b * 26.0
     h = p.dt
     if integ.method != "rk4":     # a step the error control would accept
         h = 0.01

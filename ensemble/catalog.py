@@ -43,7 +43,8 @@ import h5py
 import numpy as np
 
 from . import __version__
-from .config import ConfigError
+from .config import LAW_KEYS, ConfigError
+from .model import laws
 from .integrity import EventCrc, commit_crc, crc, event_problems
 
 FORMAT = "bk-catalog-3"
@@ -54,9 +55,11 @@ EVENT_FIELDS = {
     "boundary": np.bool_, "duration": np.float64,
 }
 TASK_FIELDS = {
-    "point": np.int64, "seed_index": np.int64, "N": np.int64, "l": np.float64,
-    "nu": np.float64, "a": np.float64, "b": np.float64, "c": np.float64,
+    "point": np.int64, "seed_index": np.int64, "N": np.int64, "l": np.float64, "nu": np.float64,
+    # every friction law's keys (model/laws/); NaN for a key of another law than the task's
+    **{name: np.float64 for name in LAW_KEYS},
 }
+LAW_BYTES = 64        # /tasks/law: fixed-length text
 PROVENANCE_FIELDS = {
     "rank": np.int64, "wall_time": np.float64, "events_per_second": np.float64,
     "seed_entropy": np.int64, "spawn_key": np.int64,
@@ -85,9 +88,11 @@ DATASETS = {
     "tasks/N": ("count", _TASK_ROWS, "number of blocks of the chain"),
     "tasks/l": ("1", _TASK_ROWS, "inter-block spring stiffness l (l^2 relative to the driver spring)"),
     "tasks/nu": ("model length / model time", _TASK_ROWS, "loading velocity of the driver plate"),
-    "tasks/a": ("model force", _TASK_ROWS, "velocity strengthening a ln(1 + v)"),
-    "tasks/b": ("model force", _TASK_ROWS, "state weakening b ln(theta)"),
-    "tasks/c": ("model force", _TASK_ROWS, "constant friction"),
+    "tasks/law": ("text", _TASK_ROWS, "friction law (model.law); absent in catalogs written before there was a "
+                                      "choice: aging"),
+    **{f"tasks/{name}": (key.unit, _TASK_ROWS, f"{key.meaning} (model.{name} of the {law.name} law; NaN for "
+                                               f"another law; absent in older catalogs: NaN)")
+       for law in laws.LAWS.values() for name, key in law.keys.items()},
     "tasks/events_written": ("count", _TASK_ROWS,
                              "events of the task stored so far (a mirror; readers use /checkpoint/commit)"),
     "tasks/rank": ("index", _TASK_ROWS, "MPI rank that finished the task (-1 until then)"),
@@ -278,9 +283,12 @@ class _Layout:
                               dcpl=_early_allocation())
         tg = h5.create_group("tasks")
         for name, dtype in TASK_FIELDS.items():
-            values = [getattr(t.model, name) if name in ("N", "l", "nu", "a", "b", "c")
-                      else getattr(t, name) for t in tasks]
-            tg.create_dataset(name, data=np.asarray(values, dtype=dtype))
+            values = [getattr(t, name) if name in ("point", "seed_index") else getattr(t.model, name)
+                      for t in tasks]
+            tg.create_dataset(name, data=np.asarray([np.nan if v is None else v for v in values], dtype=dtype))
+        tg.create_dataset("law", data=np.array([_text(t.model.law) for t in tasks], dtype=f"S{LAW_BYTES}"))
+        tg["law"].attrs["conventions"] = "\n".join(f"{law.name}: {law.convention}" for law in laws.LAWS.values()
+                                                   if any(t.model.law == law.name for t in tasks))
         tg.create_dataset("events_written", data=np.zeros(len(tasks), dtype=np.int64))
         for name, dtype in PROVENANCE_FIELDS.items():
             tg.create_dataset(name, shape=(len(tasks),), dtype=dtype, fillvalue=_FILL[dtype])
@@ -801,7 +809,12 @@ class Reader:
             heads = [self.layout.head(k) for k in range(self.layout.n_tasks)]
         self.tasks["events_written"] = np.array([0 if h is None else h.written for h in heads], dtype=np.int64)
         self.tasks["events_done"] = np.array([0 if h is None else h.done for h in heads], dtype=np.int64)
-        for name in ("error", "integrator"):
+        n = self.layout.n_tasks
+        # catalogs written before there was a choice of law ran the aging law (a, b, c only)
+        self.tasks.setdefault("law", np.full(n, b"aging"))
+        for name in LAW_KEYS:
+            self.tasks.setdefault(name, np.full(n, np.nan))
+        for name in ("error", "integrator", "law"):
             self.tasks[name] = np.array([x.decode(errors="replace") for x in self.tasks[name]])
 
     def task_events(self, task, chunk=READ_CHUNK):

@@ -46,14 +46,16 @@ def summary(path):
         state = (f"failed: tasks {', '.join(map(str, failed))} (the others go on with `{RESUME} {path}`; "
                  f"rerun the failed ones with `{RESUME} {path} --set integrator.KEY=VALUE`)")
     lines = [f"{source}: {state}", f"version {attrs['version']}, format {attrs['format']}", ""]
-    lines.append("task point seed     N      b      a       c   events  recorded    status  rank  events/s")
+    keys = cfg.model.law_keys()     # one law per catalog (model.law is not swept)
+    lines.append("task point seed     N " + "".join(f"{k:>8s}" for k in keys)
+                 + "   events  recorded    status  rank  events/s")
     total = cfg.run.transient + cfg.run.events
     for k in range(len(tasks["point"])):
         written = int(tasks["events_written"][k])
         rate = tasks["events_per_second"][k]
         st = catalog.STATUS_NAMES[int(tasks["status"][k])]
         lines.append(f"{k:4d} {tasks['point'][k]:5d} {tasks['seed_index'][k]:4d} {tasks['N'][k]:5d} "
-                     f"{tasks['b'][k]:6g} {tasks['a'][k]:6g} {tasks['c'][k]:7g} "
+                     + "".join(f"{tasks[key][k]:8g}" for key in keys) + " "
                      f"{int(tasks['events_done'][k]):8d} {written:9d} {st:>9s}  {tasks['rank'][k]:4d}  "
                      f"{'' if np.isnan(rate) else f'{rate:8.1f}'}")
     for k in failed:

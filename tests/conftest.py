@@ -90,7 +90,7 @@ def developed_state(model, events, seed=1, dt=1e-3):
     params = kernel_params(model, Integrator(method="rk4", dt=dt))
     status, k = simulate(ws.arrays, clock, params, events, UNLIMITED, t, epi, diag)
     assert status == 0
-    return ws.state(clock, model.nu)
+    return ws.state(clock, params)
 
 
 def next_event(force, psi, model, dt, v_start=0.0):

@@ -55,7 +55,8 @@ NUMBERS = ("n_events", "n_large", "fraction_large", "n_recurrences", "mean_tnu",
 # columns of /per_task/numbers, in the order analysis/stats.py documents
 PER_TASK_COLUMNS = ("n_events", "n_large", "n_rec", "sum_tnu", "n_rec_int", "sum_tnu_int",
                     "n_gr", "sum_mu_gr", "sum_mu2_gr")
-PARAMS = ("N", "l", "nu", "a", "b", "c")
+# the chain's parameters and every friction law's keys (NaN where a key is not the task's law's)
+PARAMS = ("N", "l", "nu", "a", "b", "c", "alpha", "sigma")
 MIN_SEEDS = 10
 
 # -- the documented peak rule, in one place (replace this block when the finder changes) -----
@@ -282,7 +283,7 @@ def point(tasks, params, opt):
         units, method = [t.unit(s) for t in tasks for s in range(opt["blocks"])], "blocks"
     m = len(units)
     curves, numbers = statistics(*_pool(units, range(m)), opt)
-    key = (int(params["N"]),) + tuple(bits(params[name]) for name in PARAMS[1:])
+    key = (int(params["N"]),) + tuple(bits(params[name]) for name in PARAMS[1:] if not np.isnan(params[name]))
     rng = np.random.default_rng(np.random.SeedSequence(opt["seed"], spawn_key=key))
     q = 50.0 * (1.0 - opt["level"])
     out = {"method": method, "units": m, "curves": {}, "numbers": {}}
@@ -368,14 +369,15 @@ def expected_tasks(catalogs):
         for name, values in part.items():
             table.setdefault(name, []).append(values)
     table = {name: np.concatenate(parts) for name, parts in table.items()}
-    keys = []
+    keys, values = [], []
     for g in range(len(table["point"])):
-        key = tuple(table[name][g].item() for name in PARAMS)
+        key = tuple(bits(table[name][g]) for name in PARAMS)     # NaN == NaN by bits
         if key not in keys:
             keys.append(key)
+            values.append(tuple(table[name][g].item() for name in PARAMS))
         table["point"][g] = keys.index(key)
     points = []
-    for i, key in enumerate(keys):
+    for i, key in enumerate(values):
         rows = [g for g in range(len(table["point"])) if table["point"][g] == i]
         rows.sort(key=lambda g: (table["seed_entropy"][g], table["spawn_key"][g]))
         points.append((dict(zip(PARAMS, key)), rows))

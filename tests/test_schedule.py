@@ -69,7 +69,7 @@ def test_lazy_schedule_equals_loading_every_block_every_event():
     # stop and restart blocks at slightly different times: theta (which grows by 1
     # per unit time at rest) and the forces (nu per unit time) may differ by that much.
     # Measured: forces 4.0e-7 apart (bound 1.2e-6), theta 7.5e-9 relative (39 absolute, of ~5e9).
-    lazy_force, lazy_psi = ws.state(clock, model.nu)
+    lazy_force, lazy_psi = ws.state(clock, kernel_params(model, Integrator(method="rk4")))
     print(f"after 12 events: forces {np.max(np.abs(lazy_force - f)):.1e} apart (nu * slack = {model.nu * 20:.0e}), "
           f"theta {np.max(np.abs(np.exp(lazy_psi) / np.exp(p) - 1)):.1e} relative, "
           f"{np.max(np.abs(np.exp(lazy_psi) - np.exp(p))):.1e} absolute")

@@ -26,6 +26,7 @@ from numba.extending import overload
 class Key:
     """A [model] key that belongs to a law."""
     default: float
+    unit: str           # as the catalog names units (catalog.DATASETS): "model force", "1", ...
     check: object       # value -> bool
     rule: str           # what check requires, for the error message ("> 0")
     meaning: str        # one line, for the docs and `validate`
