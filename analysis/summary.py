@@ -203,4 +203,6 @@ def read(path):
             raise SummaryError(f"{path}: summary format {out['attrs'].get('format', '(none)')}, this version "
                                f"reads {FORMAT}; reduce the catalog again")
         out["points/method"] = np.array([m.decode() for m in out["points/method"]])
+    for name in PARAMS:   # a summary from before the friction-law registry: aging points, no other keys
+        out.setdefault(f"points/{name}", np.full(len(out["points/N"]), np.nan))
     return out

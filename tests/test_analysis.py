@@ -285,7 +285,7 @@ def test_merging_a_catalog_with_itself_or_its_trajectories_is_refused(merged):
 def fake_summary(**params):
     """The point parameters of a summary (all that legend_labels reads)."""
     n = len(next(iter(params.values())))
-    base = {"N": 800, "l": 3.0, "nu": 1e-8, "a": 0.0, "b": 20.0, "c": 1000.0}
+    base = {"N": 800, "l": 3.0, "nu": 1e-8, "a": 0.0, "b": 20.0, "c": 1000.0, "alpha": np.nan, "sigma": np.nan}
     return {f"points/{k}": np.array(params.get(k, [v] * n)) for k, v in base.items()}
 
 
@@ -302,6 +302,10 @@ def test_legend_labels_name_what_differs_between_the_plotted_points():
     # nothing differs: b names the points; six digits that cannot tell two points apart: all digits
     assert legend_labels([fake_summary(b=[20.0])]) == (["b"], ["b = 20"])
     assert legend_labels([fake_summary(b=[20.0000001, 20.0000002])])[1] == ["b = 20.0000001", "b = 20.0000002"]
+    # two friction laws: each point is named by its own law's keys (the other law's are NaN)
+    cl = fake_summary(a=[np.nan], b=[np.nan], c=[np.nan], alpha=[2.0], sigma=[0.01])
+    assert legend_labels([fake_summary(b=[20.0]), cl]) == (
+        ["a", "b", "c", "alpha", "sigma"], ["a = 0, b = 20, c = 1000", "alpha = 2, sigma = 0.01"])
 
 
 def test_plot_overlays_several_summaries(merged):

@@ -117,9 +117,9 @@ def test_non_finite_float_refused_in_file_and_override(section, key, value):
 @pytest.mark.parametrize("key", [f.name for f in fields(SECTIONS["model"]) if f.type is float])
 def test_non_finite_sweep_value_refused(key):
     with pytest.raises(ConfigError, match=rf"^sweep\.{key} must be a finite number, got inf"):
-        loads(f"[sweep]\n{key} = [1.0, inf]\n")
+        loads(f"[sweep]\n{key} = [0.5, inf]\n")   # 0.5: within every key's range (model.sigma's is (0, 1))
     with pytest.raises(ConfigError, match=rf"sweep\.{key} must be a finite number, got nan.*--set"):
-        loads("", [f"sweep.{key}=[1.0, nan]"])
+        loads("", [f"sweep.{key}=[0.5, nan]"])
 
 
 def test_integer_beyond_64_bits_refused():

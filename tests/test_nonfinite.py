@@ -56,11 +56,14 @@ def test_nonfinite_parameters_are_named():
     force, psi = -np.linspace(0.0, 1.0, model.N), np.zeros(model.N)
     ws = Workspace(model.N)
     params = kernel_params(model, Integrator())
-    for bad in ({"l2": math.nan}, {"nu": math.inf}, {"b": math.nan}, {"atol": math.inf}, {"max_step": math.nan},
-                {"max_duration": math.nan}):
+    cl = kernel_params(Model(N=30, law="carlson-langer"), Integrator())
+    for base, bad in ((params, {"l2": math.nan}), (params, {"nu": math.inf}), (params, {"atol": math.inf}),
+                      (params, {"max_step": math.nan}), (params, {"max_duration": math.nan}),
+                      (params, {"law": params.law._replace(b=math.nan)}),      # a friction law's own keys too
+                      (cl, {"law": cl.law._replace(alpha=math.inf)})):
         ws.load(force, psi)
         out = np.empty(3), np.empty(3, dtype=np.int64), np.empty((3, NDIAG))
-        assert simulate(ws.arrays, np.zeros(2), params._replace(**bad), 3, UNLIMITED, *out) == (NONFINITE, 0), bad
+        assert simulate(ws.arrays, np.zeros(2), base._replace(**bad), 3, UNLIMITED, *out) == (NONFINITE, 0), bad
     # the two bounds may be inf: none
     ws.load(force, psi)
     out = np.empty(3), np.empty(3, dtype=np.int64), np.empty((3, NDIAG))
