@@ -1,4 +1,4 @@
-"""python -m analysis reduce|plot|report|export ...
+"""python -m analysis reduce|plot|report|export|compare ...
 
 reduce streams one or more catalogs into per-task histograms (ranks split the tasks of all
 catalogs under mpirun and rank 0 merges them), pools the tasks of equal parameters (N, l, nu,
@@ -6,7 +6,8 @@ a, b, c) into one point whichever catalog holds them, computes per point the mer
 and summary numbers with bootstrap intervals and writes a summary. The same trajectory (random
 stream and parameters) in two catalogs is refused; so is an unfinished run (a *.partial
 catalog, unfinished tasks) unless --partial is given. plot overlays the points of one or more
-summaries; report prints a summary's numbers; export writes a catalog's or a summary's tables.
+summaries; report prints a summary's numbers; export writes a catalog's or a summary's tables;
+compare sets the points of catalogs of several friction laws side by side (analysis/compare.py).
 
 Exit codes: 0 done, 1 file error (missing, damaged or of the wrong kind: a summary or a
 config given for a catalog, an unfinished run without --partial, ...), 2 bad options (and the
@@ -68,7 +69,36 @@ def _parser():
     ex.add_argument("--format", choices=sorted(FORMATS), default="csv", help="file format (default csv)")
     ex.add_argument("-o", "--output", required=True, help="directory of the tables (made if missing)")
     ex.add_argument("--force", action="store_true", help="overwrite tables already in the directory")
+    cp = sub.add_parser("compare", help="catalogs of several friction laws -> table and figures on a "
+                                         "law-independent size axis (docs/laws.md)")
+    cp.add_argument("catalogs", nargs="+", metavar="catalog")
+    cp.add_argument("-o", "--output", required=True, help="directory of comparison.md, .json and the figures")
+    cp.add_argument("--n-large", type=int, default=50, help="large event: at least this many blocks slip (default 50)")
+    cp.add_argument("--n-min", type=int, default=1, help="smallest n of the power-law fit (default 1)")
+    cp.add_argument("--window", type=int, default=10, help="epicenter window in blocks (default 10)")
+    cp.add_argument("--bootstrap", type=int, default=1000, help="bootstrap resamples (default 1000)")
+    cp.add_argument("--level", type=float, default=0.95, help="interval coverage (default 0.95)")
+    cp.add_argument("--blocks", type=int, default=20, help="stretches per task when a point has fewer "
+                                                           "than 10 seeds (default 20)")
+    cp.add_argument("--seed", type=int, default=0, help="bootstrap seed (default 0)")
+    cp.add_argument("--force", action="store_true", help="overwrite an existing comparison")
     return p
+
+
+def _compare(args):
+    from .compare import Options, compare, write
+    opt = Options(args.n_large, args.n_min, args.window, args.bootstrap, args.level, args.blocks, args.seed)
+    command = "python -m analysis compare " + " ".join(
+        [str(c) for c in args.catalogs] + ["-o", args.output]
+        + [f"--{k.replace('_', '-')} {v}" for k, v in opt.__dict__.items() if v != getattr(Options, k)])
+    if not args.force:   # before the work (write checks again)
+        taken = [n for n in ("comparison.md", "comparison.json") if os.path.exists(os.path.join(args.output, n))]
+        if taken:
+            raise FileExistsError(f"{os.path.join(args.output, taken[0])} exists (use --force to overwrite "
+                                  "the comparison)")
+    for path in write(compare(args.catalogs, opt), opt, args.output, command, force=args.force):
+        print(f"wrote {path}")
+    return 0
 
 
 def _reduce(args):
@@ -178,7 +208,8 @@ def _export(args):
 def main(argv=None):
     args = _parser().parse_args(argv)
     try:
-        return {"reduce": _reduce, "plot": _plot, "report": _report, "export": _export}[args.command](args)
+        return {"reduce": _reduce, "plot": _plot, "report": _report, "export": _export,
+                "compare": _compare}[args.command](args)
     except BrokenPipeError:
         raise   # the reader of stdout went away: not a file error; __main__ ends quietly
     except (CatalogError, summary.SummaryError, ValueError, OSError) as err:

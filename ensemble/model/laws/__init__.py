@@ -11,7 +11,7 @@ Frame and units: dimensionless, forces without any constant friction (aging's c 
 shift of u), so a block at rest with force F and state psi starts to slide once
 F >= threshold(law, psi). A law without a state variable ignores psi (the kernels keep it 0).
 
-Adding a law: docs/numerics.md, section "Adding a friction law".
+Adding a law: docs/laws.md, section "Adding a friction law".
 """
 import importlib
 import pkgutil

@@ -1,0 +1,70 @@
+"""The friction-law comparison's figures (analysis/compare.py): the rupture-length distribution
+R(log10 n), R(mu) on each law's own magnitude scale, and the recurrence times over their median."""
+import os
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from .compare import MU_EDGES  # noqa: E402
+from .plot import _band  # noqa: E402
+from .stats import centers  # noqa: E402
+
+TNU_BINS = np.linspace(0.0, 5.0, 101)      # T / median(T)
+
+
+def _colors(n):
+    return plt.rcParams["axes.prop_cycle"].by_key()["color"] * (n // 10 + 1)
+
+
+def figures(points, opt, out_dir):
+    colors = _colors(len(points))
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    for p, color in zip(points, colors):
+        e = p["size_edges"]
+        x = np.sqrt(e[:-1] * (e[1:] - 1.0))          # geometric middle of the integers of the bin
+        _band(ax, x, p["size_density"], p["size_lo"], p["size_hi"], p["label"], color, log=True, style=".-")
+        tau = p["numbers"][3]
+        if np.isfinite(tau):
+            n = np.arange(opt.n_min, opt.n_large, dtype=float)
+            law = n ** -tau
+            ax.plot(n, p["fit_share"] * law / law.sum() * n * np.log(10.0), ":", color=color, lw=1)
+    ax.axvline(opt.n_large, color="0.5", lw=0.8, ls="--")
+    ax.set_ylim(bottom=min(p["size_density"][p["size_density"] > 0].min() for p in points) / 3)
+    ax.set(xscale="log", yscale="log", xlabel="blocks slipped in an event, n", ylabel="R(log10 n)",
+           title=f"rupture length (dotted: power law fitted below n = {opt.n_large})")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out_dir, "size.png"), dpi=120)
+    plt.close(fig)
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    for p, color in zip(points, colors):
+        _band(ax, centers(MU_EDGES), p["mu_density"], p["mu_lo"], p["mu_hi"], p["label"], color, log=True)
+    lowest = min(p["mu_density"][p["mu_density"] > 0].min() for p in points)
+    ax.set_ylim(bottom=lowest / 3)      # a lower bound of 0 would stretch the axis to 1e-300
+    ax.set(yscale="log", xlabel="mu = log10(total slip) (each law's own scale)", ylabel="R(mu)",
+           title="magnitude distribution")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out_dir, "magnitude.png"), dpi=120)
+    plt.close(fig)
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    x = centers(TNU_BINS)
+    for p, color in zip(points, colors):
+        T = p["T"]
+        if len(T) >= 2:
+            h, _ = np.histogram(T / np.median(T), TNU_BINS)
+            ax.plot(x, h / len(T) / np.diff(TNU_BINS), color=color, lw=1.4,
+                    label=f"{p['label']} (CV {p['numbers'][6]:.2f})")
+    ax.plot(x, np.log(2.0) * 2.0 ** -x, "k:", lw=1, label="Poisson (exponential)")
+    ax.set(xlabel=f"T / median(T), large events (n >= {opt.n_large}) within {opt.window} blocks",
+           ylabel="density", title="local recurrence time")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out_dir, "recurrence.png"), dpi=120)
+    plt.close(fig)
