@@ -6,7 +6,7 @@
 # Runs every benchmark at its default (paper-setting) sizes, one after the other on one core, and
 # writes tables (.txt), data (.json) and figures (.png) into OUT. Expected duration on this
 # machine: about 60 min in all (work precision ~5-10 min, statistics ~25 min,
-# cost scaling ~15-20 min, step budget ~4 min, step trace ~1 min, hard cases ~10 min, throughput ~1 min). Environment: PY (python,
+# cost scaling ~15-20 min, step budget ~4 min, step trace ~1 min, hard cases ~10 min, throughput ~3 min). Environment: PY (python,
 # default .venv/bin/python), JOBS (processes for the statistics run, default 1; 2 halves its time but
 # then two runs share the machine's cores, so its events/s are per process under that load).
 set -euo pipefail
@@ -36,4 +36,11 @@ step "hard cases at full size, rk4 and ark4 untuned"
 "$PY" -m benchmarks.hard_cases --out "$OUT"
 step "throughput of the paper setting"
 "$PY" benchmarks/throughput.py | tee "$OUT/throughput.txt"
+step "throughput of the friction laws (docs/laws.md)"
+{ "$PY" benchmarks/throughput.py --method ark4
+  for alpha in 1 2 3; do
+    "$PY" benchmarks/throughput.py --law carlson-langer --alpha $alpha --nu 0.01 --method ark4 --transient 100000 --events 100000
+  done
+  "$PY" benchmarks/throughput.py --law carlson-langer --alpha 3 --nu 0.01 --method rk4 --transient 100000 --events 100000
+} | tee "$OUT/throughput_laws.txt"
 step "done: results in $OUT"

@@ -2,6 +2,7 @@
 
     python benchmarks/throughput.py [--N 800] [--b 20] [--dt 1e-3] [--method rk4|ark3|ark4|ark5]
                                     [--rtol 1e-5] [--transient 1000] [--events 2000]
+                                    [--law carlson-langer --alpha 2 --sigma 0.01]
 
 Runs the transient (not timed, includes compilation), then times `events`
 recorded events and prints events/s, cost per block-step, the magnitude range
@@ -14,7 +15,7 @@ import numpy as np
 
 from ensemble.config import Config, Integrator, Model, Run
 from ensemble.events import relative_energy_residual
-from ensemble.model.workspace import D_BLOCK_STEPS, D_ENERGY_SCALE, D_RESIDUAL, D_SLIP, D_STEPS
+from ensemble.model.workspace import D_BLOCK_STEPS, D_ENERGY_SCALE, D_NSLIP, D_RESIDUAL, D_SLIP, D_STEPS
 from ensemble.runner import Trajectory
 from ensemble.tasks import task_list
 
@@ -24,6 +25,10 @@ def main():
     p.add_argument("--N", type=int, default=800)
     p.add_argument("--b", type=float, default=20.0)
     p.add_argument("--a", type=float, default=0.0)
+    p.add_argument("--law", default="aging", help="model.law (docs/laws.md)")
+    p.add_argument("--alpha", type=float, default=2.0, help="carlson-langer's alpha")
+    p.add_argument("--sigma", type=float, default=0.01, help="carlson-langer's sigma")
+    p.add_argument("--nu", type=float, default=Model().nu)
     p.add_argument("--dt", type=float, default=1e-3)
     p.add_argument("--method", default="rk4", help="rk4, ark3, ark4 or ark5")
     p.add_argument("--rtol", type=float, default=Integrator().rtol,
@@ -32,7 +37,8 @@ def main():
     p.add_argument("--events", type=int, default=2000)
     p.add_argument("--seed", type=int, default=0)
     args = p.parse_args()
-    cfg = Config(model=Model(N=args.N, b=args.b, a=args.a),
+    keys = dict(a=args.a, b=args.b) if args.law == "aging" else dict(alpha=args.alpha, sigma=args.sigma)
+    cfg = Config(model=Model(N=args.N, nu=args.nu, law=args.law, **keys),
                  run=Run(events=args.events, transient=args.transient, seed=args.seed),
                  integrator=Integrator(method=args.method, dt=args.dt, rtol=args.rtol))
     traj = Trajectory(cfg, task_list(cfg)[0])
@@ -43,11 +49,13 @@ def main():
     mu = np.log10(diag[:, D_SLIP])
     residual = relative_energy_residual(diag[:, D_RESIDUAL], diag[:, D_ENERGY_SCALE])
     how = f"dt={args.dt}" if args.method == "rk4" else f"rtol={args.rtol:g}"
-    print(f"N={args.N} b={args.b} a={args.a} {args.method} {how}: {args.events / elapsed:.1f} events/s "
+    point = " ".join(f"{k}={v:g}" for k, v in keys.items())
+    print(f"N={args.N} {args.law} {point} {args.method} {how}: {args.events / elapsed:.1f} events/s "
           f"({args.events} events in {elapsed:.1f} s after {args.transient} transient)")
     print(f"  {diag[:, D_STEPS].mean():.0f} steps and {diag[:, D_BLOCK_STEPS].mean():.0f} block-steps per event, "
           f"{elapsed / diag[:, D_BLOCK_STEPS].sum() * 1e9:.0f} ns per block-step")
     print(f"  mu in [{mu.min():.2f}, {mu.max():.2f}], fraction mu >= 4: {np.mean(mu >= 4):.3f}, "
+          f"fraction of events slipping >= 50 blocks: {np.mean(diag[:, D_NSLIP] >= 50):.3f}, "
           f"max relative energy residual {residual.max():.1e}")
 
 
