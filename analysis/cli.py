@@ -1,9 +1,10 @@
 """python -m analysis reduce|plot|report|export|compare ...
 
 reduce streams one or more catalogs into per-task histograms (ranks split the tasks of all
-catalogs under mpirun and rank 0 merges them), pools the tasks of equal parameters (N, l, nu,
-a, b, c) into one point whichever catalog holds them, computes per point the merged densities
-and summary numbers with bootstrap intervals and writes a summary. The same trajectory (random
+catalogs under mpirun and rank 0 merges them), pools the tasks of equal parameters (N, l, nu and
+the friction law's keys) into one point whichever catalog holds them, computes per point the
+merged densities and summary numbers with bootstrap intervals and writes a summary; its bins and
+large-event magnitude default to the friction law's scale (Law.scales). The same trajectory (random
 stream and parameters) in two catalogs is refused; so is an unfinished run (a *.partial
 catalog, unfinished tasks) unless --partial is given. plot overlays the points of one or more
 summaries; report prints a summary's numbers; export writes a catalog's or a summary's tables;
@@ -40,11 +41,13 @@ def _parser():
                                           ".summary.h5; required with several)")
     r.add_argument("--partial", action="store_true",
                    help="reduce unfinished runs as far as written (the summary and report say so)")
-    r.add_argument("--mu-bins", default="0:7:70", help="magnitude bins lo:hi:n (default 0:7:70)")
-    r.add_argument("--tnu-bins", default="0:2000:80", help="T*nu bins lo:hi:n (default 0:2000:80)")
-    r.add_argument("--mu-c", type=float, default=4.0, help="large-event magnitude (default 4)")
+    # the defaults of these four are the friction law's (model/laws: Law.scales), the aging law's
+    # being the paper's axes; catalogs of several laws need them given
+    r.add_argument("--mu-bins", help="magnitude bins lo:hi:n (default: the law's; aging 0:7:70)")
+    r.add_argument("--tnu-bins", help="T*nu bins lo:hi:n (default: the law's; aging 0:2000:80)")
+    r.add_argument("--mu-c", type=float, help="large-event magnitude (default: the law's; aging 4)")
     r.add_argument("--window", type=int, default=10, help="epicenter window in blocks (default 10)")
-    r.add_argument("--b-cut", type=float, default=3.0, help="magnitude cut of the GR b fit (default 3)")
+    r.add_argument("--b-cut", type=float, help="magnitude cut of the GR b fit (default: the law's; aging 3)")
     r.add_argument("--bootstrap", type=int, default=1000, help="bootstrap resamples (default 1000)")
     r.add_argument("--level", type=float, default=0.95, help="interval coverage (default 0.95)")
     r.add_argument("--blocks", type=int, default=20,
@@ -118,14 +121,40 @@ def _default_output(catalogs):
     return name.removesuffix(".h5") + ".summary.h5"
 
 
+SCALE_OPTIONS = ("mu_bins", "mu_c", "b_cut", "tnu_bins")
+
+
+def _scales(args, inputs):
+    """--mu-bins, --mu-c, --b-cut, --tnu-bins as given, else the catalogs' friction law's."""
+    missing = [name for name in SCALE_OPTIONS if getattr(args, name) is None]
+    if not missing:
+        return {name: getattr(args, name) for name in SCALE_OPTIONS}
+    from ensemble.model import laws
+    names = sorted({law.decode() if isinstance(law, bytes) else str(law) for law in inputs.tasks["law"]})
+    if len(names) > 1:
+        raise ValueError(f"the catalogs hold points of several friction laws ({', '.join(names)}), whose "
+                         "magnitudes lie on different scales: give " + ", ".join(
+                             "--" + name.replace("_", "-") for name in missing))
+    if names[0] not in laws.LAWS:
+        raise ValueError(f"friction law {names[0]!r} is unknown to this version: give "
+                         + ", ".join("--" + name.replace("_", "-") for name in missing))
+    law = laws.get(names[0]).scales
+    return {name: getattr(args, name) if getattr(args, name) is not None else getattr(law, name)
+            for name in SCALE_OPTIONS}
+
+
 def _prepare(args):
     """Options, output path, and the catalogs' task table (merge.Inputs); every check before the work."""
-    opt = Options(parse_bins(args.mu_bins), parse_bins(args.tnu_bins), args.mu_c, args.window,
-                  args.b_cut, args.bootstrap, args.level, args.blocks, args.seed)
-    if not (0 < opt.level < 1) or opt.bootstrap < 1 or opt.blocks < 1 or opt.window < 0:
+    if not (0 < args.level < 1) or args.bootstrap < 1 or args.blocks < 1 or args.window < 0:
         raise ValueError("--level must be in (0, 1); --bootstrap, --blocks >= 1; --window >= 0")
+    for name in ("mu_bins", "tnu_bins"):
+        if getattr(args, name) is not None:
+            parse_bins(getattr(args, name))      # a malformed option before any file is read
     out = args.output or _default_output(args.catalogs)
     inputs = merge.read(args.catalogs, allow_partial=args.partial)   # checks each file's kind first
+    scale = _scales(args, inputs)
+    opt = Options(parse_bins(scale["mu_bins"]), parse_bins(scale["tnu_bins"]), scale["mu_c"], args.window,
+                  scale["b_cut"], args.bootstrap, args.level, args.blocks, args.seed)
     if os.path.exists(out):
         # checked now, not after the work; and --force replaces a summary, never anything else
         if not args.force:

@@ -184,3 +184,29 @@ def test_docs_show_the_committed_comparison():
     assert len(rows.splitlines()) == 2 + len(points) == 6
     for doc in ("README.md", "docs/laws.md"):
         assert rows in (root / doc).read_text(), doc
+
+
+def test_reduce_takes_the_scales_of_the_catalogs_law(two_laws, tmp_path):
+    """`analysis reduce` without --mu-bins/--mu-c/--b-cut/--tnu-bins uses the law's scales
+    (Law.scales); catalogs of two laws need them given (exit 2 naming them); given, they win."""
+    import h5py
+    from ensemble.model import laws
+    d, (cl, aging) = two_laws
+    for path, law in ((cl, "carlson-langer"), (aging, "aging")):
+        out = tmp_path / f"{law}.summary.h5"
+        res = analysis("reduce", path, "-o", out, "--bootstrap", "5")
+        assert res.returncode == 0, res.stderr
+        scales = laws.get(law).scales
+        with h5py.File(out) as h5:
+            assert h5.attrs["mu_c"] == scales.mu_c and h5.attrs["b_cut"] == scales.b_cut
+            lo, hi, n = scales.mu_bins.split(":")
+            np.testing.assert_array_equal(h5["bins/mu"][...], np.linspace(float(lo), float(hi), int(n) + 1))
+    res = analysis("reduce", cl, aging, "-o", tmp_path / "both.h5", "--mu-c", "1")
+    assert res.returncode == 2 and res.stderr.count("\n") == 1
+    assert "several friction laws (aging, carlson-langer)" in res.stderr
+    assert "give --mu-bins, --b-cut, --tnu-bins" in res.stderr and not (tmp_path / "both.h5").exists()
+    res = analysis("reduce", cl, aging, "-o", tmp_path / "both.h5", "--mu-c", "1", "--mu-bins=-3:7:100",
+                   "--b-cut", "0", "--tnu-bins", "0:4:40", "--bootstrap", "5")
+    assert res.returncode == 0, res.stderr
+    with h5py.File(tmp_path / "both.h5") as h5:
+        assert h5.attrs["mu_c"] == 1.0 and len(h5["bins/mu"]) == 101

@@ -22,7 +22,7 @@ import math
 
 import numba as nb
 
-from . import Key, Law
+from . import Key, Law, Scales
 
 CoulombParams = namedtuple("CoulombParams", "drop")
 
@@ -73,7 +73,7 @@ LAW = Law(
     convention="Coulomb friction: static 1, dynamic 1 - drop; the loader stands still during events",
     has_state=False, loader_moves=False, friction=friction, threshold=threshold, state_rate=state_rate,
     rest_state=rest_state, onset_delay=onset_delay, implicit_state=implicit_state, stiff_limit=stiff_limit,
-    rk4_unstable=rk4_unstable)
+    rk4_unstable=rk4_unstable, scales=Scales(mu_bins="-4:0:40", mu_c=-1.0, b_cut=-2.0, tnu_bins="0:4:80"))
 '''
 
 

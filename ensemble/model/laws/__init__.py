@@ -33,6 +33,16 @@ class Key:
 
 
 @dataclass(frozen=True)
+class Scales:
+    """Where a law's statistics lie: the defaults of `analysis reduce` for catalogs of this law
+    (its magnitudes log10(total slip) and loader displacements T nu have the law's own scale)."""
+    mu_bins: str          # magnitude bins lo:hi:n of R(mu)
+    mu_c: float           # large events: mu >= mu_c (recurrence times, fraction of large events)
+    b_cut: float          # the Gutenberg-Richter fit above this magnitude
+    tnu_bins: str         # bins lo:hi:n of the local recurrence times T nu
+
+
+@dataclass(frozen=True)
 class Law:
     """What a friction law supplies. Every function is numba-compiled and takes the law's
     parameter record (`params`) first; see the module's docstring for the frame."""
@@ -51,6 +61,7 @@ class Law:
     implicit_state: object  # (law, W, act, na, hg): the stiff state's implicit stage (steppers.py)
     stiff_limit: object   # (law, rate_limit) -> the state bound beyond which RK4 is unstable
     rk4_unstable: object  # (law, v, psi, rate_limit, state_limit) -> RK4's step left its stability region
+    scales: Scales        # the reduction's defaults for this law's magnitudes and recurrence times
 
     def kernel_params(self, model):
         """The law's parameter record for the kernels from a config's model section."""

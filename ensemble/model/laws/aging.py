@@ -14,7 +14,7 @@ import numba as nb
 
 from .. import onset
 from ..workspace import IM_EXP, IM_RHS, IM_TARGET, IM_UNSOLVED, KP, PS, VS
-from . import Key, Law
+from . import Key, Law, Scales
 
 AgingParams = namedtuple("AgingParams", "a b")
 
@@ -176,4 +176,6 @@ LAW = Law(
     has_state=True, loader_moves=True,
     friction=friction, threshold=threshold, state_rate=state_rate, rest_state=rest_state,
     onset_delay=onset_delay, implicit_state=implicit_state, stiff_limit=stiff_limit,
-    rk4_unstable=rk4_unstable)
+    rk4_unstable=rk4_unstable,
+    # the paper's axes: R(mu) over 0..7, large events mu >= 4, GR fit above 3, T nu up to 2000
+    scales=Scales(mu_bins="0:7:70", mu_c=4.0, b_cut=3.0, tnu_bins="0:2000:80"))

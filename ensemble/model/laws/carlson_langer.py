@@ -17,7 +17,7 @@ from collections import namedtuple
 
 import numba as nb
 
-from . import Key, Law
+from . import Key, Law, Scales
 
 CarlsonLangerParams = namedtuple("CarlsonLangerParams", "alpha sigma")
 
@@ -82,4 +82,7 @@ LAW = Law(
     has_state=False, loader_moves=False,
     friction=friction, threshold=threshold, state_rate=state_rate, rest_state=rest_state,
     onset_delay=onset_delay, implicit_state=implicit_state, stiff_limit=stiff_limit,
-    rk4_unstable=rk4_unstable)
+    rk4_unstable=rk4_unstable,
+    # at sigma = 0.01 and alpha = 1..3 (examples/laws/carlson_langer.toml): one-block events at
+    # mu = -2.8..-1.3, events slipping 50 blocks or more at mu >= 0.7..1.2 (99%), T nu of order 1
+    scales=Scales(mu_bins="-3:3:60", mu_c=1.0, b_cut=-1.0, tnu_bins="0:4:80"))
