@@ -5,7 +5,7 @@ The magnitude mu = log10(total slip) has each law's own scale (the aging law's l
 ~10^5, Carlson-Langer's ~10^2), so "more characteristic" is decided on the number of blocks an
 event slips, n = 1..N, and on recurrence times divided by their mean:
 
-- fraction_large: share of events with n >= n_large (default 50, N / 16 at N = 800: about the 2nd
+- fraction_large: share of events with n >= n_large (default 50, N / 16 at N = 800: about the 1st
   percentile of the rupture length of the aging law's mu >= 4 events at b = 20).
 - dip: R(log10 n), the density of log10 n (as R(mu) is the density of mu: P(n) n ln 10), averaged
   over bins of 0.2 in log10 n; its highest bin at n >= n_large over its lowest bin between n = 2
