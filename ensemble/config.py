@@ -63,11 +63,18 @@ Model.__doc__ = _Chain.__doc__
 Model.__module__ = __name__
 
 
+# run.transient's default, in events per block of the longest chain of the sweep: from the random
+# start the statistics drift for at most 1.25 events per block (b = 50, N = 800; b = 20: none seen at
+# N = 800, 0.3-0.6 per block at N = 1600; benchmarks/transient.py, docs/benchmarks.md); 10 is eight
+# times the longest.
+TRANSIENT_PER_BLOCK = 10
+
+
 @dataclass(frozen=True)
 class Run:
     seeds: int = 1             # realisations per parameter point
     events: int = 200000       # events recorded per task
-    transient: int = 10000     # events discarded at the start of each task
+    transient: int = None      # events discarded at the start of each task (default TRANSIENT_PER_BLOCK N)
     seed: int = 0              # root seed: task k uses SeedSequence(seed, spawn_key=(k,))
     init_stress: float = 1.0   # initial forces are uniformly spread this far below threshold
     poll_seconds: float = 0.25  # kernel calls last about this long between MPI polls
@@ -125,6 +132,12 @@ class Config:
     run: Run = field(default_factory=Run)
     integrator: Integrator = field(default_factory=Integrator)
     output: Output = field(default_factory=Output)
+
+    def __post_init__(self):
+        """Resolve run.transient left out: TRANSIENT_PER_BLOCK events per block of the largest N."""
+        if self.run.transient is None:
+            largest = max(int(n) for n in _values(self, "model.N")[1])
+            object.__setattr__(self, "run", dataclasses.replace(self.run, transient=TRANSIENT_PER_BLOCK * largest))
 
     def to_toml(self):
         """The resolved config as TOML text (stored in every catalog)."""

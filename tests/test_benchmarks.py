@@ -191,3 +191,57 @@ def test_phase_of_a_block():
     v = np.array([300.0, 300.0, 300.0, 0.0, -1.0])
     psi = np.array([-np.log(300.0) + 1.0, -np.log(300.0) + 0.05, -np.log(300.0) - 1.0, 3.0, 3.0])
     assert step_trace.phase(v, psi).tolist() == [0, 1, 2, 2, 2]
+
+
+def test_transient_finds_a_known_drift():
+    """Seeds whose first 600 events come from another distribution: the transient ends after the
+    second window of 500 (the one holding events 500..599); without the drift, after none. The
+    events are correlated (an AR(1) with 50 events' memory), as the floor from stretches allows."""
+    from benchmarks.transient import point_curves
+    rng = np.random.default_rng(7)
+
+    def seed(drift):
+        x = np.empty(20000)
+        x[0] = 0.0
+        noise = rng.normal(size=len(x)) * np.sqrt(1 - 0.98 ** 2)
+        for i in range(1, len(x)):
+            x[i] = 0.98 * x[i - 1] + noise[i]
+        if drift:
+            x[:600] -= 3.0
+        return x
+    drifting = point_curves([seed(True) for _ in range(4)], 500, 1.0, np.random.default_rng(1))
+    assert drifting["end_events"] == 1000 and drifting["ks"][0] > 0.8
+    steady = point_curves([seed(False) for _ in range(4)], 500, 1.0, np.random.default_rng(1))
+    assert steady["end_events"] == 0
+    # the floor from stretches sees the correlation: events drawn one by one would put it far lower
+    late = np.sort(np.concatenate([seed(False)[10000:] for _ in range(4)]))
+    from benchmarks.transient import ks
+    iid = np.percentile([ks(rng.choice(late, 2000, replace=False), late) for _ in range(200)], 99)
+    assert steady["floor"] > 2 * iid
+
+
+def test_transient_tiny(tmp_path):
+    from benchmarks import transient
+    from .conftest import run_cli, write_config
+    cfg = write_config(tmp_path / "t.toml", model={"N": 30, "b": 50.0},
+                       run={"events": 2000, "transient": 0, "seeds": 2}, integrator={"method": "ark4"})
+    assert run_cli("run", cfg, "-o", tmp_path / "t.h5").returncode == 0
+    transient.main([str(tmp_path / "t.h5"), "--window", "200", "--out", str(tmp_path)])
+    rows = json.loads((tmp_path / "transient.json").read_text())
+    assert len(rows) == 1 and len(rows[0]["ks"]) == 10 and rows[0]["end_events"] % 200 == 0
+    assert (tmp_path / "transient.png").stat().st_size > 10_000
+    cfg = write_config(tmp_path / "u.toml", model={"N": 30}, run={"events": 50, "transient": 10, "seeds": 2})
+    assert run_cli("run", cfg, "-o", tmp_path / "u.h5").returncode == 0
+    with pytest.raises(SystemExit, match="run.transient is 10"):
+        transient.main([str(tmp_path / "u.h5"), "--out", str(tmp_path)])
+
+
+def test_default_transient_is_ten_events_per_block_of_the_longest_chain():
+    from ensemble.config import TRANSIENT_PER_BLOCK, Config, Run, loads
+    assert TRANSIENT_PER_BLOCK == 10
+    assert loads("").run.transient == 8000
+    assert loads("[model]\nN = 1600\n").run.transient == 16000
+    assert loads("[sweep]\nN = [100, 3000, 400]\n").run.transient == 30000
+    assert loads("[run]\ntransient = 0\n").run.transient == 0
+    assert Config(model=Model(N=60), run=Run()).run.transient == 600
+    assert "transient = 8000" in loads("").to_toml()     # resolved, as the catalog stores it
