@@ -94,7 +94,7 @@ def main(argv=None):
     os.makedirs(args.out, exist_ok=True)
     lines = [f"# python -m benchmarks.transient {' '.join(os.path.basename(c) for c in args.catalogs)} "
              f"--window {args.window}",
-             "| point | seeds | events per seed | KS floor (95%) | transient ends after | per block | "
+             "| point | seeds | events per seed | KS floor (99%) | transient ends after | per block | "
              "large fraction: first window / late |", "|---|---|---|---|---|---|---|"]
     for r in results:
         lines.append(f"| {r['label']} | {r['seeds']} | {r['events_per_seed']} | {r['floor']:.4f} | "
