@@ -10,9 +10,15 @@ static threshold) is cut at that instant, located on the cubic Hermite
 interpolant of the step, and redone with the shorter step. Clamping v to zero at
 the end of a step instead would make the slip only second-order accurate.
 
+One step of the event loop (continue_event), a function per phase: the step-size control
+(`_accepted_step`, `_next_step_size`), the earliest transition inside the step
+(`_earliest_transition`, each located by `_locate`), the health check (`_health`), the
+transitions at the step's end (`_apply_located`, `_retire_stopped`, `_start_crossed`) and
+the rescheduling of the blocks nobody watches any more (`_reschedule`).
+
 Work arrays (one record, `workspace.WorkArrays`): columns of the float array `W` hold per-block
-quantities, `act` the active list, `flag` 0 (never slid in this event), 1
-(sliding), 2 (slid and now at rest), `touched` the blocks that slid.
+quantities, `act` the active list, `flag` the blocks' states (workspace: UNTOUCHED, SLIDING,
+STOPPED), `touched` the blocks that slid.
 
 An event is begun (`begin_event`) and then integrated by `continue_event`, which returns
 after a given amount of work if the event has not finished by then, its loop variables kept
@@ -28,9 +34,9 @@ import numpy as np
 
 from .geometry import left, right, spring_force
 from .laws import friction, loader_moves, onset_delay, rest_state, rk4_unstable, stiff_limit, threshold
+from .methods import adaptive, error_weights, take_step
 from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
-from .steppers import ERROR_WEIGHTS, ark3_step, ark4_step, ark5_step, block_error, rk4_step
-from .tableaux import ARK324, ARK436, ARK548
+from .steppers import block_error
 from .undo import clear_log, log_block
 from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D_ENERGY_SCALE, D_FIRST,
                         D_LAST, D_LOAD_WORK, D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK,
@@ -40,15 +46,10 @@ from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D
                         P, P0, PAUSED, SLIDING, STOPPED, T_AGE, T_BLOCK, T_ERROR, T_H, T_OWN, T_PART, T_PSI, T_SLIDING,
                         T_TAU, T_V, TOO_LONG, TR, TS, UNLIMITED, UNSTABLE, UNTOUCHED, V, V0, Y, Y0, YS)
 
-# integrators (see ensemble.integrators): fixed-step RK4, adaptive IMEX ARK3(2), ARK4(3), ARK5(4)
-RK4, ARK3, ARK4, ARK5 = 0, 1, 2, 3
-# step-size control exponent -1 / (q + 1), q the order of the embedded method (unused for RK4)
-_CONTROL_EXPONENT = (0.0,) + tuple(-1.0 / (pair.embedded_order + 1) for pair in (ARK324, ARK436, ARK548))
 # PI control of the accepted steps (Gustafsson; Hairer & Wanner II, sec. IV.2): the next step is
-# h 0.9 err^(-0.7/(q+1)) err_prev^(0.4/(q+1)), err_prev the last accepted step's error. Against the
-# plain 0.9 err^(-1/(q+1)) it halves the rejected steps (ark4, rtol 1e-5, large event: 588 -> 279) and
-# is 1.0-1.15x faster at equal slip error on the step-budget events (b = 20 and 50; interpolated
-# between tolerances in benchmarks/results/step_budget_* before and after the change, 9498c4f..565d956).
+# h 0.9 err^(-0.7/(q+1)) err_prev^(0.4/(q+1)), err_prev the last accepted step's error, -1/(q+1) the
+# method's control exponent (methods.py). Against the plain 0.9 err^(-1/(q+1)) it halves the
+# rejected steps and is no slower at equal slip error (benchmarks/results/step_budget_*).
 _PI_I, _PI_P = 0.7, 0.4
 
 # the transition that ends a step early (continue_event)
@@ -61,8 +62,6 @@ ONSET_LOADING = 3     # a block nobody watches reaches its threshold by loading 
 # relaxes at rate 1/theta (= v in steady sliding), so dt / theta must stay below it.
 RK4_STABILITY = 2.785
 _BISECT = 60
-
-
 @nb.njit(cache=True, inline="always")
 def _hermite(x, y0, y1, d0, d1):
     """Cubic Hermite on [0, 1] with end values y0, y1 and end slopes d0, d1 (per unit x)."""
@@ -167,60 +166,50 @@ def _far_onset(W, flag, n, since, tree, t0, tau, p):
 
 
 @nb.njit(cache=True)
-def _watch(W, since, tree, t0, p, j, event, undo):
+def _watch(arrays, t0, p, j):
     """Block j starts or neighbours a sliding block: bring it to t0, take it off the schedule."""
-    log_block(W, since, event, undo, j)
-    materialize(W, since, j, t0, p)
-    tree_set(tree, j, np.inf)
+    log_block(arrays.W, arrays.since, arrays.event, arrays.undo, j)
+    materialize(arrays.W, arrays.since, j, t0, p)
+    tree_set(arrays.tree, j, np.inf)
 
 
 @nb.njit(cache=True)
-def _start(W, act, na, flag, touched, nt, since, tree, t0, p, j, tau, yrest, event, undo):
+def _start(arrays, na, nt, t0, p, j, tau, yrest):
     """Block j starts to slide at local time tau; returns (na, nt, yrest)."""
+    W, flag = arrays.W, arrays.flag
     for k in (left(j), j, right(j, W.shape[0])):
-        _watch(W, since, tree, t0, p, k, event, undo)
+        _watch(arrays, t0, p, k)
     if flag[j] == STOPPED:
         yrest -= W[j, Y]
     else:
-        touched[nt] = j
+        arrays.touched[nt] = j
         nt += 1
     W[j, P] = _rest_psi(W, j, tau, p)
     W[j, V] = 0.0
     W[j, TS] = tau
     flag[j] = SLIDING
-    act[na] = j
+    arrays.act[na] = j
     return na + 1, nt, yrest
 
 
 @nb.njit(cache=True)
-def take_step(W, act, na, n, tau, h, p, yrest):
-    """One step of the method p.method (RK4, ARK3, ARK4, ARK5) of the active blocks; see steppers.py."""
-    if p.method == RK4:
-        return rk4_step(W, act, na, n, tau, h, p, yrest)
-    if p.method == ARK3:
-        return ark3_step(W, act, na, n, tau, h, p, yrest)
-    if p.method == ARK4:
-        return ark4_step(W, act, na, n, tau, h, p, yrest)
-    return ark5_step(W, act, na, n, tau, h, p, yrest)
-
-
-@nb.njit(cache=True)
-def _record(trace, row, p, W, act, na, tau, h, err, expo):
+def _record(trace, row, p, W, act, na, tau, h, err):
     """Row `row` of the step trace (workspace.TRACE_COLUMNS) for the step just tried."""
     trace[row, T_TAU] = tau
     trace[row, T_H] = h
     trace[row, T_SLIDING] = na
     trace[row, T_ERROR] = err
     trace[row, T_BLOCK] = -1
-    if p.method == RK4:
+    if not adaptive(p.method):
         return
     # a block whose error is e could have taken a step (err / e)^(1/(q+1)) times longer (counted
     # as at most 10x: a block with a vanishing error estimate still has to step)
+    expo = p.method.control_exponent
     own = 0.0
     worst = -1.0
     for k in range(na):
         i = act[k]
-        parts = block_error(W, i, h, p.rtol, p.atol, ERROR_WEIGHTS[p.method])
+        parts = block_error(W, i, h, p.rtol, p.atol, error_weights(p.method))
         e = max(parts)
         own += 1.0 if err <= 0.0 else min(1.0, max(0.1, (e / err) ** -expo))
         if e > worst:
@@ -242,8 +231,9 @@ def integrate_event(arrays, t0, n, epicenter, v_start, p, profile, trace):
     holds every block's onset key, the epicenter is on its threshold at t0 (two-float time), the
     other columns and `flag` are zero, `event` is BETWEEN with an empty undo log. `v_start` is the epicenter's initial
     velocity (0 for a natural onset). `p` holds the parameters (params.KernelParams):
-    p.method RK4 steps by p.dt; ARK3, ARK4 and ARK5 start with p.dt and control the step (at most
-    p.max_step) so that the embedded error estimate stays below p.rtol, p.atol. On return the
+    the method p.method (methods.py) steps by p.dt if it is RK4; an adaptive one starts with p.dt
+    and controls the step (at most p.max_step) so that the embedded error estimate stays below
+    p.rtol, p.atol. On return the
     blocks the event touched hold the state at its end (the schedule updated), the other columns
     and `flag` are zero, and `diag` holds the event summary (see workspace.D_*). If `profile`
     has n entries it receives the slip of every block (else pass an empty
@@ -265,11 +255,9 @@ def begin_event(arrays, t0, n, epicenter, v_start, p):
     and the event's loop variables go into `event` (EV_*, EV_PHASE = IN_EVENT) for
     continue_event. EV_NUNDO and the clock entries are the caller's (chain.simulate).
     """
-    W, act, flag, touched, since, tree = arrays.W, arrays.act, arrays.flag, arrays.touched, arrays.since, arrays.tree
-    event, undo = arrays.event, arrays.undo
-    na, nt, yrest = _start(W, act, 0, flag, touched, 0, since, tree, t0, p, epicenter, 0.0, 0.0, event,
-                           undo)
-    t_far, far = _far_onset(W, flag, n, since, tree, t0, 0.0, p)
+    W, event = arrays.W, arrays.event
+    na, nt, yrest = _start(arrays, 0, 0, t0, p, epicenter, 0.0, 0.0)
+    t_far, far = _far_onset(W, arrays.flag, n, arrays.since, arrays.tree, t0, 0.0, p)
     W[epicenter, V] = v_start
     event[EV_PHASE] = IN_EVENT
     event[EV_EPICENTER] = epicenter
@@ -298,6 +286,15 @@ def _keep(event, na, nt, yrest, t_far, far, tau, work, slip_time, steps, block_s
     event[EV_TRACED] = traced
 
 
+@nb.njit(cache=True, inline="always")
+def _resume(event):
+    """The loop variables of the event in progress from the event-state vector, as _keep takes them."""
+    return (int(event[EV_NA]), int(event[EV_NT]), event[EV_YREST], event[EV_T_FAR], int(event[EV_FAR]),
+            event[EV_TAU], event[EV_WORK], event[EV_SLIP_TIME], int(event[EV_STEPS]),
+            int(event[EV_BLOCK_STEPS]), int(event[EV_REJECTED]), int(event[EV_CUTS]), event[EV_VMAX],
+            event[EV_H_NEXT], event[EV_ERR_PREV], int(event[EV_TRACED]))
+
+
 @nb.njit(cache=True)
 def continue_event(arrays, t0, n, p, profile, trace, budget):
     """Integrate the event in progress (begin_event) until every block is at rest, or pause.
@@ -308,28 +305,12 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
     integrate_event (which see); when the event has finished, `event` is BETWEEN and its undo
     log empty. Returns (status, work units spent in this call).
     """
-    W, act, flag, touched, stuck = arrays.W, arrays.act, arrays.flag, arrays.touched, arrays.stuck
-    since, tree, diag, event, undo = arrays.since, arrays.tree, arrays.diag, arrays.event, arrays.undo
-    na = int(event[EV_NA])
-    nt = int(event[EV_NT])
-    yrest = event[EV_YREST]
-    t_far = event[EV_T_FAR]
-    far = int(event[EV_FAR])
-    tau = event[EV_TAU]
-    work = event[EV_WORK]
-    slip_time = event[EV_SLIP_TIME]
-    steps = int(event[EV_STEPS])
-    block_steps = int(event[EV_BLOCK_STEPS])
-    rejected = int(event[EV_REJECTED])
-    cuts = int(event[EV_CUTS])
-    vmax = event[EV_VMAX]
-    h_next = event[EV_H_NEXT]
-    err_prev = event[EV_ERR_PREV]
-    traced = int(event[EV_TRACED])
+    W, act, flag, event = arrays.W, arrays.act, arrays.flag, arrays.event
+    (na, nt, yrest, t_far, far, tau, work, slip_time, steps, block_steps, rejected, cuts, vmax, h_next,
+     err_prev, traced) = _resume(event)
     status = OK
     v_limit = RK4_STABILITY / p.dt
     psi_limit = stiff_limit(p.law, v_limit)
-    expo = _CONTROL_EXPONENT[p.method]
     used = 0
     while na > 0:
         if used >= budget:
@@ -339,90 +320,16 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
         if steps >= p.max_steps or tau > p.max_duration:
             status = TOO_LONG
             break
-        for k in range(na):
-            i = act[k]
-            W[i, Y0] = W[i, Y]
-            W[i, V0] = W[i, V]
-            W[i, P0] = W[i, P]
-        h = h_next
-        retried = False
-        while True:
-            dwork, dslip, err = take_step(W, act, na, n, tau, h, p, yrest)
-            used += na
-            if traced < trace.shape[0]:
-                _record(trace, traced, p, W, act, na, tau, h, err, expo)
-                traced += 1
-            if p.method == RK4 or err <= 1.0 or h < 1e-12:
-                break
-            h *= max(0.2, 0.9 * err ** expo)    # rejected: retry from (Y0, V0, P0)
-            steps += 1
-            rejected += 1
-            retried = True
-        if p.method != RK4:
-            if err == 0.0:
-                grow = 5.0
-            else:
-                grow = min(5.0, max(0.2, 0.9 * err ** (_PI_I * expo) * max(err_prev, 1e-4) ** (-_PI_P * expo)))
-            err_prev = err
-            if retried:
-                # no growth right after a rejection (the step just failed at a larger h):
-                # 4% fewer steps, 20% fewer rejections for ark4 on large events (plain controller)
-                grow = min(grow, 1.0)
-            h_next = min(p.max_step, h * grow)
-        # Earliest transition inside the step, as a fraction x of it; the slip
-        # of a sliding block inside the step is the Hermite cubic with these slopes.
-        for k in range(na):
-            i = act[k]
-            W[i, HD0] = h * W[i, V0]
-            W[i, HD1] = h * W[i, V]
-        x_cut = 2.0
-        who = -1
-        kind = NO_CUT
-        for k in range(na):
-            i = act[k]
-            if W[i, V] <= 0.0 and W[i, V0] > 0.0:
-                a_end = spring_force(W[i, F0], tau + h, _event_nu(p), p.l2, W[left(i), Y], W[i, Y],
-                                     W[right(i, n), Y]) - friction(p.law, W[i, V], W[i, P])
-                d0 = h * W[i, K1V]
-                d1 = h * a_end
-                lo = 0.0
-                hi = 1.0
-                for _ in range(_BISECT):
-                    mid = 0.5 * (lo + hi)
-                    if _hermite(mid, W[i, V0], W[i, V], d0, d1) > 0.0:
-                        lo = mid
-                    else:
-                        hi = mid
-                if hi < x_cut:
-                    x_cut = hi
-                    who = i
-                    kind = STICK
-        for k in range(na):
-            i = act[k]
-            for j in (left(i), right(i, n)):
-                if j != i and _above_threshold(W, flag, n, j, tau + h, p):
-                    lo = 0.0
-                    hi = 1.0
-                    if _excess(W, flag, n, j, tau, h, 0.0, p) >= 0.0:
-                        hi = 0.0
-                    for _ in range(_BISECT):
-                        if hi == 0.0:
-                            break
-                        mid = 0.5 * (lo + hi)
-                        if _excess(W, flag, n, j, tau, h, mid, p) > 0.0:
-                            hi = mid
-                        else:
-                            lo = mid
-                    if hi < x_cut:
-                        x_cut = hi
-                        who = j
-                        kind = ONSET_NEIGHBOUR
-        if t_far <= tau + h:
-            x = max(t_far - tau, 0.0) / h
-            if x < x_cut:
-                x_cut = x
-                who = far
-                kind = ONSET_LOADING
+        # step-size control: a step (retried shorter until accepted), and the next one's size
+        _begin_step(W, act, na)
+        h, dwork, dslip, err, tries, traced = _accepted_step(W, act, na, n, tau, h_next, p, yrest, trace,
+                                                             traced)
+        used += tries * na
+        steps += tries - 1          # the rejected tries
+        rejected += tries - 1
+        h_next, err_prev = _next_step_size(p, h, err, err_prev, tries > 1, h_next)
+        # the earliest transition inside the step: the step is redone up to it
+        x_cut, who, kind = _earliest_transition(W, act, flag, na, n, tau, h, t_far, far, p)
         if kind != NO_CUT and x_cut < 1.0:
             h = x_cut * h
             cuts += 1
@@ -433,69 +340,21 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
         block_steps += na
         work += dwork
         slip_time += dslip
-        # Health of the step: finite, and within RK4's stability region (for a
-        # full step dt) for the state equation (rate 1/theta = exp(-psi)) and v.
-        for k in range(na):
-            i = act[k]
-            v = W[i, V]
-            if not (math.isfinite(v) and math.isfinite(W[i, P]) and math.isfinite(W[i, Y])):
-                status = NONFINITE
-            if v > vmax:
-                vmax = v
-            if p.method == RK4 and rk4_unstable(p.law, v, W[i, P], v_limit, psi_limit) and status == OK:
-                status = UNSTABLE
+        status, vmax = _health(W, act, na, p, v_limit, psi_limit, vmax)
         if status != OK:
             break
-        # Transitions at tau: the located one, then anything that crossed with it.
-        if kind == ONSET_NEIGHBOUR or kind == ONSET_LOADING:
-            na, nt, yrest = _start(W, act, na, flag, touched, nt, since, tree, t0, p, who, tau, yrest,
-                                   event, undo)
-            W[who, V] = 0.0
-        if kind == STICK:
-            W[who, V] = 0.0
-        m = 0
-        nstuck = 0
-        for k in range(na):
-            i = act[k]
-            started = i == who and (kind == ONSET_NEIGHBOUR or kind == ONSET_LOADING)
-            if W[i, V] <= 0.0 and not started and not _pressed(W, n, i, tau, p):
-                # Blocks never move backward: a block that started this step
-                # but could not move keeps its slip.
-                if W[i, Y] < W[i, Y0]:
-                    W[i, Y] = W[i, Y0]
-                W[i, V] = 0.0
-                W[i, TR] = tau
-                W[i, YS] = W[i, Y]
-                flag[i] = STOPPED
-                yrest += W[i, Y]
-                stuck[nstuck] = i
-                nstuck += 1
-            else:
-                act[m] = i
-                m += 1
-        na = m
-        # Resting neighbours of the sliding blocks and of those that just stopped
-        # (a step redone up to a located stick differs from the interpolant of the
-        # longer step, so a neighbour may have crossed its threshold in the redo).
-        for k in range(m + nstuck):
-            i = act[k] if k < m else stuck[k - m]
-            for j in (left(i), right(i, n)):
-                if j != i and _above_threshold(W, flag, n, j, tau, p):
-                    na, nt, yrest = _start(W, act, na, flag, touched, nt, since, tree, t0, p, j,
-                                           tau, yrest, event, undo)
-        # Blocks no longer watched by a sliding neighbour may only start by
-        # loading: back on the schedule with their analytic onset.
-        for k in range(nstuck):
-            i = stuck[k]
-            for j in (left(i), i, right(i, n)):
-                tree_set(tree, j, t0[0] + (t0[1] + _loading_onset(W, flag, n, j, tau, p)))
+        # transitions at tau: the located one, the blocks that stopped, the neighbours that crossed
+        na, nt, yrest = _apply_located(arrays, na, nt, yrest, t0, tau, who, kind, p)
+        m, nstuck, yrest = _retire_stopped(arrays, na, n, tau, who, kind, yrest, p)
+        na, nt, yrest = _start_crossed(arrays, m, nstuck, nt, yrest, t0, n, tau, p)
         if kind != NO_CUT or nstuck > 0 or na != m:
-            t_far, far = _far_onset(W, flag, n, since, tree, t0, tau, p)
+            t_far, far = _reschedule(arrays, nstuck, n, t0, tau, p)
     if profile.shape[0] == n:
         profile[:] = 0.0
         for k in range(nt):
-            profile[touched[k]] = W[touched[k], Y]
-    _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, p, work, slip_time, diag)
+            profile[arrays.touched[k]] = W[arrays.touched[k], Y]
+    diag = arrays.diag
+    _finish_event(W, flag, arrays.touched, nt, arrays.since, arrays.tree, t0, n, tau, p, work, slip_time, diag)
     diag[D_STEPS] = steps
     diag[D_VMAX] = vmax
     diag[D_BLOCK_STEPS] = block_steps
@@ -504,9 +363,217 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
     # the final values too, so that the vector does not depend on where the event was paused
     _keep(event, na, nt, yrest, t_far, far, tau, work, slip_time, steps, block_steps, rejected, cuts,
           vmax, h_next, err_prev, traced)
-    clear_log(W, event, undo)
+    clear_log(W, event, arrays.undo)
     event[EV_PHASE] = BETWEEN
     return status, used
+
+
+# -- step-size control ---------------------------------------------------------------------------
+
+@nb.njit(cache=True, inline="always")
+def _begin_step(W, act, na):
+    """The step start (Y0, V0, P0) of the sliding blocks, from which the tries and a cut step go."""
+    for k in range(na):
+        i = act[k]
+        W[i, Y0] = W[i, Y]
+        W[i, V0] = W[i, V]
+        W[i, P0] = W[i, P]
+
+
+@nb.njit(cache=True, inline="always")
+def _accepted_step(W, act, na, n, tau, h, p, yrest, trace, traced):
+    """A step of size h from the step start, retried shorter until its error is accepted (at once
+    for RK4); each try into the trace. Returns (h, friction work, slip integral, error norm, tries,
+    rows of the trace filled)."""
+    tries = 0
+    while True:
+        dwork, dslip, err = take_step(W, act, na, n, tau, h, p, yrest)
+        tries += 1
+        if traced < trace.shape[0]:
+            _record(trace, traced, p, W, act, na, tau, h, err)
+            traced += 1
+        if not adaptive(p.method) or err <= 1.0 or h < 1e-12:
+            return h, dwork, dslip, err, tries, traced
+        h *= max(0.2, 0.9 * err ** p.method.control_exponent)    # rejected: retry from the start
+
+
+@nb.njit(cache=True, inline="always")
+def _next_step_size(p, h, err, err_prev, retried, h_next):
+    """(the next step's size, err_prev) after a step of size h accepted with error norm err: the PI
+    controller for an adaptive method; RK4 keeps its step."""
+    if not adaptive(p.method):
+        return h_next, err_prev
+    expo = p.method.control_exponent
+    if err == 0.0:
+        grow = 5.0
+    else:
+        grow = min(5.0, max(0.2, 0.9 * err ** (_PI_I * expo) * max(err_prev, 1e-4) ** (-_PI_P * expo)))
+    if retried:
+        # no growth right after a rejection (the step just failed at a larger h): fewer steps and
+        # fewer rejections on large events
+        grow = min(grow, 1.0)
+    return min(p.max_step, h * grow), err
+
+
+# -- the earliest transition inside a step --------------------------------------------------------
+
+@nb.njit(cache=True, inline="always")
+def _earliest_transition(W, act, flag, na, n, tau, h, t_far, far, p):
+    """(x, block, kind) of the earliest transition inside the step of size h just taken from local
+    time tau, at the fraction x of it (kind NO_CUT: none; x = 1: at the step's end)."""
+    # the slip of a sliding block inside the step is the Hermite cubic with these slopes
+    for k in range(na):
+        i = act[k]
+        W[i, HD0] = h * W[i, V0]
+        W[i, HD1] = h * W[i, V]
+    x_cut = 2.0
+    who = -1
+    kind = NO_CUT
+    for k in range(na):
+        i = act[k]
+        if W[i, V] <= 0.0 and W[i, V0] > 0.0:
+            d0, d1 = _velocity_slopes(W, n, i, tau, h, p)
+            x = _locate(STICK, W, flag, n, i, tau, h, d0, d1, p)
+            if x < x_cut:
+                x_cut, who, kind = x, i, STICK
+    for k in range(na):
+        i = act[k]
+        for j in (left(i), right(i, n)):
+            if j != i and _above_threshold(W, flag, n, j, tau + h, p):
+                x = _locate(ONSET_NEIGHBOUR, W, flag, n, j, tau, h, 0.0, 0.0, p)
+                if x < x_cut:
+                    x_cut, who, kind = x, j, ONSET_NEIGHBOUR
+    if t_far <= tau + h:
+        x = max(t_far - tau, 0.0) / h
+        if x < x_cut:
+            x_cut, who, kind = x, far, ONSET_LOADING
+    return x_cut, who, kind
+
+
+@nb.njit(cache=True, inline="always")
+def _velocity_slopes(W, n, i, tau, h, p):
+    """Slopes, per unit fraction of the step, of sliding block i's velocity at the step's ends."""
+    a_end = spring_force(W[i, F0], tau + h, _event_nu(p), p.l2, W[left(i), Y], W[i, Y],
+                         W[right(i, n), Y]) - friction(p.law, W[i, V], W[i, P])
+    return h * W[i, K1V], h * a_end
+
+
+@nb.njit(cache=True, inline="always")
+def _locate(kind, W, flag, n, j, tau, h, d0, d1, p):
+    """The earliest fraction x of the step by which transition `kind` of block j has happened (it
+    has by the step's end), by bisection to 2^-60 on the step's Hermite interpolant; 0 for an onset
+    of a block on its threshold at the step start already. d0, d1: a stick's velocity slopes."""
+    if kind != STICK and _excess(W, flag, n, j, tau, h, 0.0, p) >= 0.0:
+        return 0.0
+    lo = 0.0
+    hi = 1.0
+    for _ in range(_BISECT):
+        mid = 0.5 * (lo + hi)
+        if _happened(kind, W, flag, n, j, tau, h, d0, d1, p, mid):
+            hi = mid
+        else:
+            lo = mid
+    return hi
+
+
+@nb.njit(cache=True, inline="always")
+def _happened(kind, W, flag, n, j, tau, h, d0, d1, p, x):
+    """Transition `kind` of block j has happened by the fraction x of the step: its velocity is
+    down to 0 (STICK), or its force is above its threshold (an onset)."""
+    if kind == STICK:
+        return not (_hermite(x, W[j, V0], W[j, V], d0, d1) > 0.0)
+    return _excess(W, flag, n, j, tau, h, x, p) > 0.0
+
+
+# -- health of a step -----------------------------------------------------------------------------
+
+@nb.njit(cache=True, inline="always")
+def _health(W, act, na, p, v_limit, psi_limit, vmax):
+    """(status, vmax) after a step: NONFINITE unless every sliding block's state is finite, UNSTABLE
+    (RK4) if a block is beyond RK4's stability region for a full step dt, for the state equation
+    (rate 1/theta = exp(-psi)) or v; vmax, the largest velocity so far."""
+    status = OK
+    for k in range(na):
+        i = act[k]
+        v = W[i, V]
+        if not (math.isfinite(v) and math.isfinite(W[i, P]) and math.isfinite(W[i, Y])):
+            status = NONFINITE
+        if v > vmax:
+            vmax = v
+        if not adaptive(p.method) and rk4_unstable(p.law, v, W[i, P], v_limit, psi_limit) and status == OK:
+            status = UNSTABLE
+    return status, vmax
+
+
+# -- transitions at the step's end, and rescheduling ----------------------------------------------
+
+@nb.njit(cache=True, inline="always")
+def _apply_located(arrays, na, nt, yrest, t0, tau, who, kind, p):
+    """The located transition at tau (the step's end): block `who` starts, or stops (its velocity 0;
+    _retire_stopped retires it). Returns (na, nt, yrest)."""
+    if kind == ONSET_NEIGHBOUR or kind == ONSET_LOADING:
+        na, nt, yrest = _start(arrays, na, nt, t0, p, who, tau, yrest)
+        arrays.W[who, V] = 0.0
+    if kind == STICK:
+        arrays.W[who, V] = 0.0
+    return na, nt, yrest
+
+
+@nb.njit(cache=True, inline="always")
+def _retire_stopped(arrays, na, n, tau, who, kind, yrest, p):
+    """Take the sliding blocks that stopped at tau off the active list act[:na] (kept in order) into
+    stuck. Returns (sliding blocks left, stopped blocks, yrest)."""
+    W, act, flag, stuck = arrays.W, arrays.act, arrays.flag, arrays.stuck
+    m = 0
+    nstuck = 0
+    for k in range(na):
+        i = act[k]
+        started = i == who and (kind == ONSET_NEIGHBOUR or kind == ONSET_LOADING)
+        if W[i, V] <= 0.0 and not started and not _pressed(W, n, i, tau, p):
+            # Blocks never move backward: a block that started this step
+            # but could not move keeps its slip.
+            if W[i, Y] < W[i, Y0]:
+                W[i, Y] = W[i, Y0]
+            W[i, V] = 0.0
+            W[i, TR] = tau
+            W[i, YS] = W[i, Y]
+            flag[i] = STOPPED
+            yrest += W[i, Y]
+            stuck[nstuck] = i
+            nstuck += 1
+        else:
+            act[m] = i
+            m += 1
+    return m, nstuck, yrest
+
+
+@nb.njit(cache=True, inline="always")
+def _start_crossed(arrays, na, nstuck, nt, yrest, t0, n, tau, p):
+    """Start the resting neighbours above their threshold at tau of the sliding blocks act[:na] and
+    of those that just stopped (a step redone up to a located stick differs from the interpolant of
+    the longer step, so a neighbour may have crossed its threshold in the redo). Returns (na, nt,
+    yrest)."""
+    act, stuck, flag = arrays.act, arrays.stuck, arrays.flag
+    m = na
+    for k in range(m + nstuck):
+        i = act[k] if k < m else stuck[k - m]
+        for j in (left(i), right(i, n)):
+            if j != i and _above_threshold(arrays.W, flag, n, j, tau, p):
+                na, nt, yrest = _start(arrays, na, nt, t0, p, j, tau, yrest)
+    return na, nt, yrest
+
+
+@nb.njit(cache=True, inline="always")
+def _reschedule(arrays, nstuck, n, t0, tau, p):
+    """After the set of watched blocks changed: the blocks no longer watched by a sliding neighbour
+    may only start by loading, back on the schedule with their analytic onset. Returns (t_far, far),
+    the earliest such onset."""
+    W, flag, since, tree = arrays.W, arrays.flag, arrays.since, arrays.tree
+    for k in range(nstuck):
+        i = arrays.stuck[k]
+        for j in (left(i), i, right(i, n)):
+            tree_set(tree, j, t0[0] + (t0[1] + _loading_onset(W, flag, n, j, tau, p)))
+    return _far_onset(W, flag, n, since, tree, t0, tau, p)
 
 
 @nb.njit(cache=True)
