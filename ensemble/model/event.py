@@ -11,8 +11,8 @@ interpolant of the step, and redone with the shorter step. Clamping v to zero at
 the end of a step instead would make the slip only second-order accurate.
 
 One step of the event loop (continue_event), a function per phase: the step-size control
-(`_accepted_step`, `_next_step_size`), the earliest transition inside the step
-(`_earliest_transition`, each located by `_locate`), the health check (`_health`), the
+(`accepted_step`, `next_step_size`), the earliest transition inside the step
+(`earliest_transition`, each located by `_locate`), the health check (`_health`), the
 transitions at the step's end (`_apply_located`, `_retire_stopped`, `_start_crossed`) and
 the rescheduling of the blocks nobody watches any more (`_reschedule`).
 
@@ -32,104 +32,24 @@ import math
 import numba as nb
 import numpy as np
 
-from .geometry import left, right, spring_force
-from .laws import friction, loader_moves, onset_delay, rest_state, rk4_unstable, stiff_limit, threshold
-from .methods import adaptive, error_weights, take_step
+from .control import accepted_step, begin_step, next_step_size
+from .geometry import left, right
+from .laws import loader_moves, onset_delay, rest_state, rk4_unstable, stiff_limit
+from .methods import adaptive, take_step
 from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
-from .steppers import block_error
+from .transitions import (NO_CUT, ONSET_LOADING, ONSET_NEIGHBOUR, STICK, above_threshold, earliest_transition,
+                          event_nu, force_now, pressed, rest_psi)
 from .undo import clear_log, log_block
 from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D_ENERGY_SCALE, D_FIRST,
                         D_LAST, D_LOAD_WORK, D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK,
                         EV_BLOCK_STEPS, EV_CUTS, EV_EPICENTER, EV_ERR_PREV, EV_FAR, EV_H_NEXT, EV_NA, EV_NT,
                         EV_PHASE, EV_REJECTED, EV_SLIP_TIME, EV_STEPS, EV_T_FAR, EV_TAU, EV_TRACED, EV_VMAX,
-                        EV_WORK, EV_YREST, F0, HD0, HD1, IN_EVENT, K1V, NONFINITE, OK,
-                        P, P0, PAUSED, SLIDING, STOPPED, T_AGE, T_BLOCK, T_ERROR, T_H, T_OWN, T_PART, T_PSI, T_SLIDING,
-                        T_TAU, T_V, TOO_LONG, TR, TS, UNLIMITED, UNSTABLE, UNTOUCHED, V, V0, Y, Y0, YS)
-
-# PI control of the accepted steps (Gustafsson; Hairer & Wanner II, sec. IV.2): the next step is
-# h 0.9 err^(-0.7/(q+1)) err_prev^(0.4/(q+1)), err_prev the last accepted step's error, -1/(q+1) the
-# method's control exponent (methods.py). Against the plain 0.9 err^(-1/(q+1)) it halves the
-# rejected steps and is no slower at equal slip error (benchmarks/results/step_budget_*).
-_PI_I, _PI_P = 0.7, 0.4
-
-# the transition that ends a step early (continue_event)
-NO_CUT = 0            # none inside the step
-STICK = 1             # a sliding block's velocity reaches 0
-ONSET_NEIGHBOUR = 2   # a resting neighbour of a sliding block reaches its threshold
-ONSET_LOADING = 3     # a block nobody watches reaches its threshold by loading alone (t_far)
+                        EV_WORK, EV_YREST, F0, IN_EVENT, NONFINITE, OK, P, PAUSED, SLIDING, STOPPED, TOO_LONG, TR,
+                        TS, UNLIMITED, UNSTABLE, UNTOUCHED, V, Y, Y0, YS)
 
 # Stability limit of classical RK4 on the negative real axis: the state equation
 # relaxes at rate 1/theta (= v in steady sliding), so dt / theta must stay below it.
 RK4_STABILITY = 2.785
-_BISECT = 60
-@nb.njit(cache=True, inline="always")
-def _hermite(x, y0, y1, d0, d1):
-    """Cubic Hermite on [0, 1] with end values y0, y1 and end slopes d0, d1 (per unit x)."""
-    x2 = x * x
-    x3 = x2 * x
-    return ((2 * x3 - 3 * x2 + 1) * y0 + (x3 - 2 * x2 + x) * d0
-            + (3 * x2 - 2 * x3) * y1 + (x3 - x2) * d1)
-
-
-@nb.njit(cache=True, inline="always")
-def _event_nu(p):
-    """The loader's velocity during an event: nu, or 0 for a law whose loader stands still then."""
-    return p.nu if loader_moves(p.law) else 0.0
-
-
-@nb.njit(cache=True, inline="always")
-def _rest_psi(W, j, tau, p):
-    """psi of a block at rest since local time TR (its state grown since)."""
-    return rest_state(p.law, W[j, P], tau - W[j, TR])
-
-
-@nb.njit(cache=True)
-def _slip_at(W, flag, j, x):
-    """Slip of block j at fraction x of the current step (Hermite if it slides)."""
-    if flag[j] != SLIDING:
-        return W[j, Y]
-    return _hermite(x, W[j, Y0], W[j, Y], W[j, HD0], W[j, HD1])
-
-
-@nb.njit(cache=True)
-def _excess(W, flag, n, j, tau, h, x, p):
-    """Force above the static threshold of resting block j at fraction x of the step."""
-    s = tau + x * h
-    yl = _slip_at(W, flag, left(j), x)
-    yr = _slip_at(W, flag, right(j, n), x)
-    return spring_force(W[j, F0], s, _event_nu(p), p.l2, yl, W[j, Y], yr) - threshold(p.law, _rest_psi(W, j, s, p))
-
-
-@nb.njit(cache=True)
-def _force_now(W, n, j, tau, p):
-    return spring_force(W[j, F0], tau, _event_nu(p), p.l2, W[left(j), Y], W[j, Y], W[right(j, n), Y])
-
-
-@nb.njit(cache=True)
-def _excess_now(W, n, j, tau, p):
-    """Force above the static threshold of resting block j at the current time."""
-    return _force_now(W, n, j, tau, p) - threshold(p.law, _rest_psi(W, j, tau, p))
-
-
-@nb.njit(cache=True)
-def _above_threshold(W, flag, n, j, tau, p):
-    """Block j is at rest and its force exceeds the static threshold at local time tau."""
-    # Cheap filter first: the threshold of a resting block never falls (laws/__init__.py), so a
-    # force below its threshold when it came to rest cannot start it.
-    return (flag[j] != SLIDING and _force_now(W, n, j, tau, p) > threshold(p.law, W[j, P])
-            and _excess_now(W, n, j, tau, p) > 0.0)
-
-
-@nb.njit(cache=True)
-def _pressed(W, n, i, tau, p):
-    """Sliding block i has not moved in this step but is still at or above its threshold.
-
-    A block that starts exactly on its threshold gains force above it slowly (for the aging
-    law at the rate nu - b / theta, > 0 at an onset), which for small nu can stay below the
-    rounding of the force for a step: it has not stopped, it has not started yet.
-    """
-    return (W[i, V0] == 0.0 and W[i, V] == 0.0
-            and _force_now(W, n, i, tau, p) - threshold(p.law, W[i, P]) >= 0.0)
 
 
 @nb.njit(cache=True)
@@ -143,7 +63,7 @@ def _loading_onset(W, flag, n, j, tau, p):
     the loader stands still during events)."""
     if not loader_moves(p.law) or flag[j] == SLIDING or _adjacent_to_active(flag, n, j):
         return np.inf
-    return tau + onset_delay(p.law, _force_now(W, n, j, tau, p), _rest_psi(W, j, tau, p), p.nu)
+    return tau + onset_delay(p.law, force_now(W, n, j, tau, p), rest_psi(W, j, tau, p), p.nu)
 
 
 @nb.njit(cache=True)
@@ -184,42 +104,12 @@ def _start(arrays, na, nt, t0, p, j, tau, yrest):
     else:
         arrays.touched[nt] = j
         nt += 1
-    W[j, P] = _rest_psi(W, j, tau, p)
+    W[j, P] = rest_psi(W, j, tau, p)
     W[j, V] = 0.0
     W[j, TS] = tau
     flag[j] = SLIDING
     arrays.act[na] = j
     return na + 1, nt, yrest
-
-
-@nb.njit(cache=True)
-def _record(trace, row, p, W, act, na, tau, h, err):
-    """Row `row` of the step trace (workspace.TRACE_COLUMNS) for the step just tried."""
-    trace[row, T_TAU] = tau
-    trace[row, T_H] = h
-    trace[row, T_SLIDING] = na
-    trace[row, T_ERROR] = err
-    trace[row, T_BLOCK] = -1
-    if not adaptive(p.method):
-        return
-    # a block whose error is e could have taken a step (err / e)^(1/(q+1)) times longer (counted
-    # as at most 10x: a block with a vanishing error estimate still has to step)
-    expo = p.method.control_exponent
-    own = 0.0
-    worst = -1.0
-    for k in range(na):
-        i = act[k]
-        parts = block_error(W, i, h, p.rtol, p.atol, error_weights(p.method))
-        e = max(parts)
-        own += 1.0 if err <= 0.0 else min(1.0, max(0.1, (e / err) ** -expo))
-        if e > worst:
-            worst = e
-            trace[row, T_BLOCK] = i
-            trace[row, T_PART] = 0 if e == parts[0] else (1 if e == parts[1] else 2)
-            trace[row, T_AGE] = tau + h - W[i, TS]
-            trace[row, T_V] = W[i, V]
-            trace[row, T_PSI] = W[i, P]
-    trace[row, T_OWN] = own
 
 
 @nb.njit(cache=True)
@@ -321,15 +211,15 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
             status = TOO_LONG
             break
         # step-size control: a step (retried shorter until accepted), and the next one's size
-        _begin_step(W, act, na)
-        h, dwork, dslip, err, tries, traced = _accepted_step(W, act, na, n, tau, h_next, p, yrest, trace,
+        begin_step(W, act, na)
+        h, dwork, dslip, err, tries, traced = accepted_step(W, act, na, n, tau, h_next, p, yrest, trace,
                                                              traced)
         used += tries * na
         steps += tries - 1          # the rejected tries
         rejected += tries - 1
-        h_next, err_prev = _next_step_size(p, h, err, err_prev, tries > 1, h_next)
+        h_next, err_prev = next_step_size(p, h, err, err_prev, tries > 1, h_next)
         # the earliest transition inside the step: the step is redone up to it
-        x_cut, who, kind = _earliest_transition(W, act, flag, na, n, tau, h, t_far, far, p)
+        x_cut, who, kind = earliest_transition(W, act, flag, na, n, tau, h, t_far, far, p)
         if kind != NO_CUT and x_cut < 1.0:
             h = x_cut * h
             cuts += 1
@@ -366,123 +256,6 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
     clear_log(W, event, arrays.undo)
     event[EV_PHASE] = BETWEEN
     return status, used
-
-
-# -- step-size control ---------------------------------------------------------------------------
-
-@nb.njit(cache=True, inline="always")
-def _begin_step(W, act, na):
-    """The step start (Y0, V0, P0) of the sliding blocks, from which the tries and a cut step go."""
-    for k in range(na):
-        i = act[k]
-        W[i, Y0] = W[i, Y]
-        W[i, V0] = W[i, V]
-        W[i, P0] = W[i, P]
-
-
-@nb.njit(cache=True, inline="always")
-def _accepted_step(W, act, na, n, tau, h, p, yrest, trace, traced):
-    """A step of size h from the step start, retried shorter until its error is accepted (at once
-    for RK4); each try into the trace. Returns (h, friction work, slip integral, error norm, tries,
-    rows of the trace filled)."""
-    tries = 0
-    while True:
-        dwork, dslip, err = take_step(W, act, na, n, tau, h, p, yrest)
-        tries += 1
-        if traced < trace.shape[0]:
-            _record(trace, traced, p, W, act, na, tau, h, err)
-            traced += 1
-        if not adaptive(p.method) or err <= 1.0 or h < 1e-12:
-            return h, dwork, dslip, err, tries, traced
-        h *= max(0.2, 0.9 * err ** p.method.control_exponent)    # rejected: retry from the start
-
-
-@nb.njit(cache=True, inline="always")
-def _next_step_size(p, h, err, err_prev, retried, h_next):
-    """(the next step's size, err_prev) after a step of size h accepted with error norm err: the PI
-    controller for an adaptive method; RK4 keeps its step."""
-    if not adaptive(p.method):
-        return h_next, err_prev
-    expo = p.method.control_exponent
-    if err == 0.0:
-        grow = 5.0
-    else:
-        grow = min(5.0, max(0.2, 0.9 * err ** (_PI_I * expo) * max(err_prev, 1e-4) ** (-_PI_P * expo)))
-    if retried:
-        # no growth right after a rejection (the step just failed at a larger h): fewer steps and
-        # fewer rejections on large events
-        grow = min(grow, 1.0)
-    return min(p.max_step, h * grow), err
-
-
-# -- the earliest transition inside a step --------------------------------------------------------
-
-@nb.njit(cache=True, inline="always")
-def _earliest_transition(W, act, flag, na, n, tau, h, t_far, far, p):
-    """(x, block, kind) of the earliest transition inside the step of size h just taken from local
-    time tau, at the fraction x of it (kind NO_CUT: none; x = 1: at the step's end)."""
-    # the slip of a sliding block inside the step is the Hermite cubic with these slopes
-    for k in range(na):
-        i = act[k]
-        W[i, HD0] = h * W[i, V0]
-        W[i, HD1] = h * W[i, V]
-    x_cut = 2.0
-    who = -1
-    kind = NO_CUT
-    for k in range(na):
-        i = act[k]
-        if W[i, V] <= 0.0 and W[i, V0] > 0.0:
-            d0, d1 = _velocity_slopes(W, n, i, tau, h, p)
-            x = _locate(STICK, W, flag, n, i, tau, h, d0, d1, p)
-            if x < x_cut:
-                x_cut, who, kind = x, i, STICK
-    for k in range(na):
-        i = act[k]
-        for j in (left(i), right(i, n)):
-            if j != i and _above_threshold(W, flag, n, j, tau + h, p):
-                x = _locate(ONSET_NEIGHBOUR, W, flag, n, j, tau, h, 0.0, 0.0, p)
-                if x < x_cut:
-                    x_cut, who, kind = x, j, ONSET_NEIGHBOUR
-    if t_far <= tau + h:
-        x = max(t_far - tau, 0.0) / h
-        if x < x_cut:
-            x_cut, who, kind = x, far, ONSET_LOADING
-    return x_cut, who, kind
-
-
-@nb.njit(cache=True, inline="always")
-def _velocity_slopes(W, n, i, tau, h, p):
-    """Slopes, per unit fraction of the step, of sliding block i's velocity at the step's ends."""
-    a_end = spring_force(W[i, F0], tau + h, _event_nu(p), p.l2, W[left(i), Y], W[i, Y],
-                         W[right(i, n), Y]) - friction(p.law, W[i, V], W[i, P])
-    return h * W[i, K1V], h * a_end
-
-
-@nb.njit(cache=True, inline="always")
-def _locate(kind, W, flag, n, j, tau, h, d0, d1, p):
-    """The earliest fraction x of the step by which transition `kind` of block j has happened (it
-    has by the step's end), by bisection to 2^-60 on the step's Hermite interpolant; 0 for an onset
-    of a block on its threshold at the step start already. d0, d1: a stick's velocity slopes."""
-    if kind != STICK and _excess(W, flag, n, j, tau, h, 0.0, p) >= 0.0:
-        return 0.0
-    lo = 0.0
-    hi = 1.0
-    for _ in range(_BISECT):
-        mid = 0.5 * (lo + hi)
-        if _happened(kind, W, flag, n, j, tau, h, d0, d1, p, mid):
-            hi = mid
-        else:
-            lo = mid
-    return hi
-
-
-@nb.njit(cache=True, inline="always")
-def _happened(kind, W, flag, n, j, tau, h, d0, d1, p, x):
-    """Transition `kind` of block j has happened by the fraction x of the step: its velocity is
-    down to 0 (STICK), or its force is above its threshold (an onset)."""
-    if kind == STICK:
-        return not (_hermite(x, W[j, V0], W[j, V], d0, d1) > 0.0)
-    return _excess(W, flag, n, j, tau, h, x, p) > 0.0
 
 
 # -- health of a step -----------------------------------------------------------------------------
@@ -529,7 +302,7 @@ def _retire_stopped(arrays, na, n, tau, who, kind, yrest, p):
     for k in range(na):
         i = act[k]
         started = i == who and (kind == ONSET_NEIGHBOUR or kind == ONSET_LOADING)
-        if W[i, V] <= 0.0 and not started and not _pressed(W, n, i, tau, p):
+        if W[i, V] <= 0.0 and not started and not pressed(W, n, i, tau, p):
             # Blocks never move backward: a block that started this step
             # but could not move keeps its slip.
             if W[i, Y] < W[i, Y0]:
@@ -558,7 +331,7 @@ def _start_crossed(arrays, na, nstuck, nt, yrest, t0, n, tau, p):
     for k in range(m + nstuck):
         i = act[k] if k < m else stuck[k - m]
         for j in (left(i), right(i, n)):
-            if j != i and _above_threshold(arrays.W, flag, n, j, tau, p):
+            if j != i and above_threshold(arrays.W, flag, n, j, tau, p):
                 na, nt, yrest = _start(arrays, na, nt, t0, p, j, tau, yrest)
     return na, nt, yrest
 
@@ -604,7 +377,7 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, p, work, slip_t
         e_change += stored - y * W[i, F0]
         gross += stored + abs(y * W[i, F0])
     elastic = e_change     # the terms apart (workspace.py): D_ELASTIC, D_LOAD_WORK
-    nu = _event_nu(p)
+    nu = event_nu(p)
     e_change += -nu * tau * slip + nu * slip_time
     gross += nu * tau * slip + nu * slip_time
     diag[D_DURATION] = tau

@@ -14,7 +14,6 @@ to the tolerances; 0 for fixed steps).
   block, solved by the law's implicit_state. Order p with an embedded estimate of order p - 1 for
   step-size control. Each method of the registry (methods.py) runs it with its own tableau.
 """
-import math
 import numba as nb
 
 from .geometry import left, right, spring_force
