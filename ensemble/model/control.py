@@ -19,20 +19,16 @@ _PI_I, _PI_P = 0.7, 0.4
 
 
 @nb.njit(cache=True, inline="always")
-def begin_step(W, act, na):
-    """The step start (Y0, V0, P0) of the sliding blocks, from which the tries and a cut step go."""
+def accepted_step(W, act, na, n, tau, h, p, yrest, trace, traced):
+    """A step of size h of the sliding blocks from their state now, the step start (Y0, V0, P0,
+    from which the tries and a cut step go), retried shorter until its error is accepted (at once
+    for RK4); each try into the trace. Returns (h, friction work, slip integral, error norm, tries,
+    rows of the trace filled)."""
     for k in range(na):
         i = act[k]
         W[i, Y0] = W[i, Y]
         W[i, V0] = W[i, V]
         W[i, P0] = W[i, P]
-
-
-@nb.njit(cache=True, inline="always")
-def accepted_step(W, act, na, n, tau, h, p, yrest, trace, traced):
-    """A step of size h from the step start, retried shorter until its error is accepted (at once
-    for RK4); each try into the trace. Returns (h, friction work, slip integral, error norm, tries,
-    rows of the trace filled)."""
     tries = 0
     while True:
         dwork, dslip, err = take_step(W, act, na, n, tau, h, p, yrest)

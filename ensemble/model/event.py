@@ -10,11 +10,14 @@ static threshold) is cut at that instant, located on the cubic Hermite
 interpolant of the step, and redone with the shorter step. Clamping v to zero at
 the end of a step instead would make the slip only second-order accurate.
 
-One step of the event loop (continue_event), a function per phase: the step-size control
-(`accepted_step`, `next_step_size`), the earliest transition inside the step
-(`earliest_transition`, each located by `_locate`), the health check (`_health`), the
-transitions at the step's end (`_apply_located`, `_retire_stopped`, `_start_crossed`) and
-the rescheduling of the blocks nobody watches any more (`_reschedule`).
+One step of the event loop (continue_event), phase by phase: the step-size control
+(control.py: `accepted_step`, `next_step_size`), the earliest transition inside the step
+(transitions.py: `earliest_transition`, each located by one bisection), the health check
+(`_health`), the transitions at the step's end (the located one, `_retire_stopped`, the
+neighbours that crossed) and the rescheduling of the blocks nobody watches any more
+(`_reschedule`). The phases are inlined functions; each array one receives costs numba a
+reference count per step, which is why the loop passes them the arrays one by one, not the
+WorkArrays record, and keeps the starts (which need the record) in its own body.
 
 Work arrays (one record, `workspace.WorkArrays`): columns of the float array `W` hold per-block
 quantities, `act` the active list, `flag` the blocks' states (workspace: UNTOUCHED, SLIDING,
@@ -32,12 +35,12 @@ import math
 import numba as nb
 import numpy as np
 
-from .control import accepted_step, begin_step, next_step_size
+from .control import accepted_step, next_step_size
 from .geometry import left, right
 from .laws import loader_moves, onset_delay, rest_state, rk4_unstable, stiff_limit
 from .methods import adaptive, take_step
 from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
-from .transitions import (NO_CUT, ONSET_LOADING, ONSET_NEIGHBOUR, STICK, above_threshold, earliest_transition,
+from .transitions import (NO_CUT, ONSET_LOADING, ONSET_NEIGHBOUR, above_threshold, earliest_transition,
                           event_nu, force_now, pressed, rest_psi)
 from .undo import clear_log, log_block
 from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D_ENERGY_SCALE, D_FIRST,
@@ -86,11 +89,11 @@ def _far_onset(W, flag, n, since, tree, t0, tau, p):
 
 
 @nb.njit(cache=True)
-def _watch(arrays, t0, p, j):
+def _watch(W, since, tree, event, undo, t0, p, j):
     """Block j starts or neighbours a sliding block: bring it to t0, take it off the schedule."""
-    log_block(arrays.W, arrays.since, arrays.event, arrays.undo, j)
-    materialize(arrays.W, arrays.since, j, t0, p)
-    tree_set(arrays.tree, j, np.inf)
+    log_block(W, since, event, undo, j)
+    materialize(W, since, j, t0, p)
+    tree_set(tree, j, np.inf)
 
 
 @nb.njit(cache=True)
@@ -98,7 +101,7 @@ def _start(arrays, na, nt, t0, p, j, tau, yrest):
     """Block j starts to slide at local time tau; returns (na, nt, yrest)."""
     W, flag = arrays.W, arrays.flag
     for k in (left(j), j, right(j, W.shape[0])):
-        _watch(arrays, t0, p, k)
+        _watch(W, arrays.since, arrays.tree, arrays.event, arrays.undo, t0, p, k)
     if flag[j] == STOPPED:
         yrest -= W[j, Y]
     else:
@@ -196,6 +199,7 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
     log empty. Returns (status, work units spent in this call).
     """
     W, act, flag, event = arrays.W, arrays.act, arrays.flag, arrays.event
+    stuck, since, tree = arrays.stuck, arrays.since, arrays.tree
     (na, nt, yrest, t_far, far, tau, work, slip_time, steps, block_steps, rejected, cuts, vmax, h_next,
      err_prev, traced) = _resume(event)
     status = OK
@@ -211,7 +215,6 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
             status = TOO_LONG
             break
         # step-size control: a step (retried shorter until accepted), and the next one's size
-        begin_step(W, act, na)
         h, dwork, dslip, err, tries, traced = accepted_step(W, act, na, n, tau, h_next, p, yrest, trace,
                                                              traced)
         used += tries * na
@@ -234,11 +237,22 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
         if status != OK:
             break
         # transitions at tau: the located one, the blocks that stopped, the neighbours that crossed
-        na, nt, yrest = _apply_located(arrays, na, nt, yrest, t0, tau, who, kind, p)
-        m, nstuck, yrest = _retire_stopped(arrays, na, n, tau, who, kind, yrest, p)
-        na, nt, yrest = _start_crossed(arrays, m, nstuck, nt, yrest, t0, n, tau, p)
+        if kind == ONSET_NEIGHBOUR or kind == ONSET_LOADING:
+            na, nt, yrest = _start(arrays, na, nt, t0, p, who, tau, yrest)
+        if kind != NO_CUT:
+            W[who, V] = 0.0
+        m, nstuck, yrest = _retire_stopped(W, act, flag, stuck, na, n, tau, who, kind, yrest, p)
+        na = m
+        # Resting neighbours of the sliding blocks and of those that just stopped (a step redone up
+        # to a located stick differs from the interpolant of the longer step, so a neighbour may
+        # have crossed its threshold in the redo). The loop stays here, where _start has its record.
+        for k in range(m + nstuck):
+            i = act[k] if k < m else stuck[k - m]
+            for j in (left(i), right(i, n)):
+                if j != i and above_threshold(W, flag, n, j, tau, p):
+                    na, nt, yrest = _start(arrays, na, nt, t0, p, j, tau, yrest)
         if kind != NO_CUT or nstuck > 0 or na != m:
-            t_far, far = _reschedule(arrays, nstuck, n, t0, tau, p)
+            t_far, far = _reschedule(W, flag, stuck, since, tree, nstuck, n, t0, tau, p)
     if profile.shape[0] == n:
         profile[:] = 0.0
         for k in range(nt):
@@ -281,22 +295,9 @@ def _health(W, act, na, p, v_limit, psi_limit, vmax):
 # -- transitions at the step's end, and rescheduling ----------------------------------------------
 
 @nb.njit(cache=True, inline="always")
-def _apply_located(arrays, na, nt, yrest, t0, tau, who, kind, p):
-    """The located transition at tau (the step's end): block `who` starts, or stops (its velocity 0;
-    _retire_stopped retires it). Returns (na, nt, yrest)."""
-    if kind == ONSET_NEIGHBOUR or kind == ONSET_LOADING:
-        na, nt, yrest = _start(arrays, na, nt, t0, p, who, tau, yrest)
-        arrays.W[who, V] = 0.0
-    if kind == STICK:
-        arrays.W[who, V] = 0.0
-    return na, nt, yrest
-
-
-@nb.njit(cache=True, inline="always")
-def _retire_stopped(arrays, na, n, tau, who, kind, yrest, p):
+def _retire_stopped(W, act, flag, stuck, na, n, tau, who, kind, yrest, p):
     """Take the sliding blocks that stopped at tau off the active list act[:na] (kept in order) into
     stuck. Returns (sliding blocks left, stopped blocks, yrest)."""
-    W, act, flag, stuck = arrays.W, arrays.act, arrays.flag, arrays.stuck
     m = 0
     nstuck = 0
     for k in range(na):
@@ -321,29 +322,12 @@ def _retire_stopped(arrays, na, n, tau, who, kind, yrest, p):
 
 
 @nb.njit(cache=True, inline="always")
-def _start_crossed(arrays, na, nstuck, nt, yrest, t0, n, tau, p):
-    """Start the resting neighbours above their threshold at tau of the sliding blocks act[:na] and
-    of those that just stopped (a step redone up to a located stick differs from the interpolant of
-    the longer step, so a neighbour may have crossed its threshold in the redo). Returns (na, nt,
-    yrest)."""
-    act, stuck, flag = arrays.act, arrays.stuck, arrays.flag
-    m = na
-    for k in range(m + nstuck):
-        i = act[k] if k < m else stuck[k - m]
-        for j in (left(i), right(i, n)):
-            if j != i and above_threshold(arrays.W, flag, n, j, tau, p):
-                na, nt, yrest = _start(arrays, na, nt, t0, p, j, tau, yrest)
-    return na, nt, yrest
-
-
-@nb.njit(cache=True, inline="always")
-def _reschedule(arrays, nstuck, n, t0, tau, p):
+def _reschedule(W, flag, stuck, since, tree, nstuck, n, t0, tau, p):
     """After the set of watched blocks changed: the blocks no longer watched by a sliding neighbour
     may only start by loading, back on the schedule with their analytic onset. Returns (t_far, far),
     the earliest such onset."""
-    W, flag, since, tree = arrays.W, arrays.flag, arrays.since, arrays.tree
     for k in range(nstuck):
-        i = arrays.stuck[k]
+        i = stuck[k]
         for j in (left(i), i, right(i, n)):
             tree_set(tree, j, t0[0] + (t0[1] + _loading_onset(W, flag, n, j, tau, p)))
     return _far_onset(W, flag, n, since, tree, t0, tau, p)

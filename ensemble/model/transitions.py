@@ -3,7 +3,7 @@
 A step of the event (event.py) in which a sliding block's velocity reaches 0 (STICK), a resting
 neighbour of a sliding block reaches its static threshold (ONSET_NEIGHBOUR), or a block nobody
 watches does so by loading alone (ONSET_LOADING, at the schedule's t_far) is cut at the earliest of
-these and redone up to it. Sticks and onsets are located alike, by `_locate`'s bisection, on the
+these and redone up to it. Sticks and onsets are located alike, by one bisection (`_locate`), on the
 step's cubic Hermite interpolant: of the velocity for a stick, of the slips (and so of the force)
 for an onset.
 """
@@ -92,14 +92,14 @@ def earliest_transition(W, act, flag, na, n, tau, h, t_far, far, p):
         i = act[k]
         if W[i, V] <= 0.0 and W[i, V0] > 0.0:
             d0, d1 = _velocity_slopes(W, n, i, tau, h, p)
-            x = _locate(STICK, W, flag, n, i, tau, h, d0, d1, p)
+            x = _locate(STICK, W, flag, n, i, tau, h, W[i, V0], W[i, V], d0, d1, p)
             if x < x_cut:
                 x_cut, who, kind = x, i, STICK
     for k in range(na):
         i = act[k]
         for j in (left(i), right(i, n)):
             if j != i and above_threshold(W, flag, n, j, tau + h, p):
-                x = _locate(ONSET_NEIGHBOUR, W, flag, n, j, tau, h, 0.0, 0.0, p)
+                x = _locate(ONSET_NEIGHBOUR, W, flag, n, j, tau, h, 0.0, 0.0, 0.0, 0.0, p)
                 if x < x_cut:
                     x_cut, who, kind = x, j, ONSET_NEIGHBOUR
     if t_far <= tau + h:
@@ -118,30 +118,26 @@ def _velocity_slopes(W, n, i, tau, h, p):
 
 
 @nb.njit(cache=True, inline="always")
-def _locate(kind, W, flag, n, j, tau, h, d0, d1, p):
+def _locate(kind, W, flag, n, j, tau, h, v0, v1, d0, d1, p):
     """The earliest fraction x of the step by which transition `kind` of block j has happened (it
-    has by the step's end), by bisection to 2^-60 on the step's Hermite interpolant; 0 for an onset
-    of a block on its threshold at the step start already. d0, d1: a stick's velocity slopes."""
+    has by the step's end), by bisection to 2^-60 on the step's Hermite interpolant: for a STICK,
+    of the velocity (v0, v1 at the step's ends, slopes d0, d1) down to 0, for an onset of the
+    force above the threshold (0 if it is at the step start already)."""
     if kind != STICK and _excess(W, flag, n, j, tau, h, 0.0, p) >= 0.0:
         return 0.0
     lo = 0.0
     hi = 1.0
     for _ in range(_BISECT):
         mid = 0.5 * (lo + hi)
-        if _happened(kind, W, flag, n, j, tau, h, d0, d1, p, mid):
+        if kind == STICK:
+            happened = not (_hermite(mid, v0, v1, d0, d1) > 0.0)
+        else:
+            happened = _excess(W, flag, n, j, tau, h, mid, p) > 0.0
+        if happened:
             hi = mid
         else:
             lo = mid
     return hi
-
-
-@nb.njit(cache=True, inline="always")
-def _happened(kind, W, flag, n, j, tau, h, d0, d1, p, x):
-    """Transition `kind` of block j has happened by the fraction x of the step: its velocity is
-    down to 0 (STICK), or its force is above its threshold (an onset)."""
-    if kind == STICK:
-        return not (_hermite(x, W[j, V0], W[j, V], d0, d1) > 0.0)
-    return _excess(W, flag, n, j, tau, h, x, p) > 0.0
 
 
 @nb.njit(cache=True)
