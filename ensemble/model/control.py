@@ -1,15 +1,14 @@
-"""Step-size control of the event loop (event.continue_event): the accepted step and the next one's size.
+"""Step-size control of the event loop (event.continue_event): accepting a step, and the size of the next.
 
 The method (methods.py) takes a step of the sliding blocks from the step start; an adaptive one
 retries it shorter until its error norm is at most 1, then a PI controller sizes the next step.
-RK4 takes every step at once, at its fixed dt.
+RK4 takes every step at once, at its fixed dt. Each try may fill a row of the step trace (`record`).
 """
 import numba as nb
 
-from .methods import adaptive, error_weights, take_step
+from .methods import adaptive, error_weights
 from .steppers import block_error
-from .workspace import (P, P0, T_AGE, T_BLOCK, T_ERROR, T_H, T_OWN, T_PART, T_PSI, T_SLIDING, T_TAU,
-                        T_V, TS, V, V0, Y, Y0)
+from .workspace import P, T_AGE, T_BLOCK, T_ERROR, T_H, T_OWN, T_PART, T_PSI, T_SLIDING, T_TAU, T_V, TS, V
 
 # PI control of the accepted steps (Gustafsson; Hairer & Wanner II, sec. IV.2): the next step is
 # h 0.9 err^(-0.7/(q+1)) err_prev^(0.4/(q+1)), err_prev the last accepted step's error, -1/(q+1) the
@@ -19,26 +18,16 @@ _PI_I, _PI_P = 0.7, 0.4
 
 
 @nb.njit(cache=True, inline="always")
-def accepted_step(W, act, na, n, tau, h, p, yrest, trace, traced):
-    """A step of size h of the sliding blocks from their state now, the step start (Y0, V0, P0,
-    from which the tries and a cut step go), retried shorter until its error is accepted (at once
-    for RK4); each try into the trace. Returns (h, friction work, slip integral, error norm, tries,
-    rows of the trace filled)."""
-    for k in range(na):
-        i = act[k]
-        W[i, Y0] = W[i, Y]
-        W[i, V0] = W[i, V]
-        W[i, P0] = W[i, P]
-    tries = 0
-    while True:
-        dwork, dslip, err = take_step(W, act, na, n, tau, h, p, yrest)
-        tries += 1
-        if traced < trace.shape[0]:
-            _record(trace, traced, p, W, act, na, tau, h, err)
-            traced += 1
-        if not adaptive(p.method) or err <= 1.0 or h < 1e-12:
-            return h, dwork, dslip, err, tries, traced
-        h *= max(0.2, 0.9 * err ** p.method.control_exponent)    # rejected: retry from the start
+def accepted(p, err, h):
+    """The step tried (size h, error norm err) is accepted: always for RK4, for an adaptive method
+    once its error is at most 1 (or the step has shrunk to nothing)."""
+    return not adaptive(p.method) or err <= 1.0 or h < 1e-12
+
+
+@nb.njit(cache=True, inline="always")
+def retry_size(p, h, err):
+    """The size of the retry of a rejected step of size h and error norm err."""
+    return h * max(0.2, 0.9 * err ** p.method.control_exponent)
 
 
 @nb.njit(cache=True, inline="always")
@@ -60,7 +49,7 @@ def next_step_size(p, h, err, err_prev, retried, h_next):
 
 
 @nb.njit(cache=True)
-def _record(trace, row, p, W, act, na, tau, h, err):
+def record(trace, row, p, W, act, na, tau, h, err):
     """Row `row` of the step trace (workspace.TRACE_COLUMNS) for the step just tried."""
     trace[row, T_TAU] = tau
     trace[row, T_H] = h

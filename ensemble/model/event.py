@@ -10,14 +10,14 @@ static threshold) is cut at that instant, located on the cubic Hermite
 interpolant of the step, and redone with the shorter step. Clamping v to zero at
 the end of a step instead would make the slip only second-order accurate.
 
-One step of the event loop (continue_event), phase by phase: the step-size control
-(control.py: `accepted_step`, `next_step_size`), the earliest transition inside the step
-(transitions.py: `earliest_transition`, each located by one bisection), the health check
-(`_health`), the transitions at the step's end (the located one, `_retire_stopped`, the
-neighbours that crossed) and the rescheduling of the blocks nobody watches any more
-(`_reschedule`). The phases are inlined functions; each array one receives costs numba a
-reference count per step, which is why the loop passes them the arrays one by one, not the
-WorkArrays record, and keeps the starts (which need the record) in its own body.
+One step of the event loop (continue_event) goes through its phases, each marked `# --` there:
+the step-size control (control.py), the earliest transition inside the step (transitions.py, each
+located by one bisection), the health check, the transitions at the step's end, and the
+rescheduling of the blocks nobody watches any more (`_reschedule`). The phases that loop over the
+sliding blocks every step stay in the loop's body: numba counts a reference (an atomic add and
+subtract) for every array an inlined function receives, at every call, and as functions those
+phases made an ark4 run measurably slower (a WorkArrays record counts once per array in it). The
+helpers they call take scalars, or run only at a transition.
 
 Work arrays (one record, `workspace.WorkArrays`): columns of the float array `W` hold per-block
 quantities, `act` the active list, `flag` the blocks' states (workspace: UNTOUCHED, SLIDING,
@@ -35,20 +35,20 @@ import math
 import numba as nb
 import numpy as np
 
-from .control import accepted_step, next_step_size
+from .control import accepted, next_step_size, record, retry_size
 from .geometry import left, right
 from .laws import loader_moves, onset_delay, rest_state, rk4_unstable, stiff_limit
 from .methods import adaptive, take_step
 from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
-from .transitions import (NO_CUT, ONSET_LOADING, ONSET_NEIGHBOUR, above_threshold, earliest_transition,
-                          event_nu, force_now, pressed, rest_psi)
+from .transitions import (NO_CUT, ONSET_LOADING, ONSET_NEIGHBOUR, STICK, above_threshold, event_nu, force_now,
+                          loading_cut, locate, pressed, rest_psi, velocity_slopes)
 from .undo import clear_log, log_block
 from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D_ENERGY_SCALE, D_FIRST,
                         D_LAST, D_LOAD_WORK, D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK,
                         EV_BLOCK_STEPS, EV_CUTS, EV_EPICENTER, EV_ERR_PREV, EV_FAR, EV_H_NEXT, EV_NA, EV_NT,
                         EV_PHASE, EV_REJECTED, EV_SLIP_TIME, EV_STEPS, EV_T_FAR, EV_TAU, EV_TRACED, EV_VMAX,
-                        EV_WORK, EV_YREST, F0, IN_EVENT, NONFINITE, OK, P, PAUSED, SLIDING, STOPPED, TOO_LONG, TR,
-                        TS, UNLIMITED, UNSTABLE, UNTOUCHED, V, Y, Y0, YS)
+                        EV_WORK, EV_YREST, F0, HD0, HD1, IN_EVENT, NONFINITE, OK, P, P0, PAUSED, SLIDING,
+                        STOPPED, TOO_LONG, TR, TS, UNLIMITED, UNSTABLE, UNTOUCHED, V, V0, Y, Y0, YS)
 
 # Stability limit of classical RK4 on the negative real axis: the state equation
 # relaxes at rate 1/theta (= v in steady sliding), so dt / theta must stay below it.
@@ -214,15 +214,51 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
         if steps >= p.max_steps or tau > p.max_duration:
             status = TOO_LONG
             break
-        # step-size control: a step (retried shorter until accepted), and the next one's size
-        h, dwork, dslip, err, tries, traced = accepted_step(W, act, na, n, tau, h_next, p, yrest, trace,
-                                                             traced)
+        # -- step-size control: the step from the step start, retried shorter until accepted
+        for k in range(na):
+            i = act[k]
+            W[i, Y0] = W[i, Y]
+            W[i, V0] = W[i, V]
+            W[i, P0] = W[i, P]
+        h = h_next
+        tries = 0
+        while True:
+            dwork, dslip, err = take_step(W, act, na, n, tau, h, p, yrest)
+            tries += 1
+            if traced < trace.shape[0]:
+                record(trace, traced, p, W, act, na, tau, h, err)
+                traced += 1
+            if accepted(p, err, h):
+                break
+            h = retry_size(p, h, err)
         used += tries * na
         steps += tries - 1          # the rejected tries
         rejected += tries - 1
         h_next, err_prev = next_step_size(p, h, err, err_prev, tries > 1, h_next)
-        # the earliest transition inside the step: the step is redone up to it
-        x_cut, who, kind = earliest_transition(W, act, flag, na, n, tau, h, t_far, far, p)
+        # -- the earliest transition inside the step (transitions.py), where the step is cut
+        for k in range(na):
+            # the slip of a sliding block inside the step is the Hermite cubic with these slopes
+            i = act[k]
+            W[i, HD0] = h * W[i, V0]
+            W[i, HD1] = h * W[i, V]
+        x_cut = 2.0
+        who = -1
+        kind = NO_CUT
+        for k in range(na):
+            i = act[k]
+            if W[i, V] <= 0.0 and W[i, V0] > 0.0:
+                d0, d1 = velocity_slopes(W, n, i, tau, h, p)
+                x = locate(STICK, W, flag, n, i, tau, h, W[i, V0], W[i, V], d0, d1, p)
+                if x < x_cut:
+                    x_cut, who, kind = x, i, STICK
+        for k in range(na):
+            i = act[k]
+            for j in (left(i), right(i, n)):
+                if j != i and above_threshold(W, flag, n, j, tau + h, p):
+                    x = locate(ONSET_NEIGHBOUR, W, flag, n, j, tau, h, 0.0, 0.0, 0.0, 0.0, p)
+                    if x < x_cut:
+                        x_cut, who, kind = x, j, ONSET_NEIGHBOUR
+        x_cut, who, kind = loading_cut(x_cut, who, kind, t_far, far, tau, h)
         if kind != NO_CUT and x_cut < 1.0:
             h = x_cut * h
             cuts += 1
@@ -233,24 +269,54 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
         block_steps += na
         work += dwork
         slip_time += dslip
-        status, vmax = _health(W, act, na, p, v_limit, psi_limit, vmax)
+        # -- health of the step: finite, and within RK4's stability region (for a full step dt)
+        # for the state equation (rate 1/theta = exp(-psi)) and v
+        for k in range(na):
+            i = act[k]
+            v = W[i, V]
+            if not (math.isfinite(v) and math.isfinite(W[i, P]) and math.isfinite(W[i, Y])):
+                status = NONFINITE
+            if v > vmax:
+                vmax = v
+            if not adaptive(p.method) and rk4_unstable(p.law, v, W[i, P], v_limit, psi_limit) and status == OK:
+                status = UNSTABLE
         if status != OK:
             break
-        # transitions at tau: the located one, the blocks that stopped, the neighbours that crossed
+        # -- transitions at tau: the located one, then the blocks that stopped
         if kind == ONSET_NEIGHBOUR or kind == ONSET_LOADING:
             na, nt, yrest = _start(arrays, na, nt, t0, p, who, tau, yrest)
         if kind != NO_CUT:
             W[who, V] = 0.0
-        m, nstuck, yrest = _retire_stopped(W, act, flag, stuck, na, n, tau, who, kind, yrest, p)
+        m = 0
+        nstuck = 0
+        for k in range(na):
+            i = act[k]
+            started = i == who and (kind == ONSET_NEIGHBOUR or kind == ONSET_LOADING)
+            if W[i, V] <= 0.0 and not started and not pressed(W, n, i, tau, p):
+                # Blocks never move backward: a block that started this step
+                # but could not move keeps its slip.
+                if W[i, Y] < W[i, Y0]:
+                    W[i, Y] = W[i, Y0]
+                W[i, V] = 0.0
+                W[i, TR] = tau
+                W[i, YS] = W[i, Y]
+                flag[i] = STOPPED
+                yrest += W[i, Y]
+                stuck[nstuck] = i
+                nstuck += 1
+            else:
+                act[m] = i
+                m += 1
         na = m
         # Resting neighbours of the sliding blocks and of those that just stopped (a step redone up
         # to a located stick differs from the interpolant of the longer step, so a neighbour may
-        # have crossed its threshold in the redo). The loop stays here, where _start has its record.
+        # have crossed its threshold in the redo).
         for k in range(m + nstuck):
             i = act[k] if k < m else stuck[k - m]
             for j in (left(i), right(i, n)):
                 if j != i and above_threshold(W, flag, n, j, tau, p):
                     na, nt, yrest = _start(arrays, na, nt, t0, p, j, tau, yrest)
+        # -- rescheduling, once the set of watched blocks has changed
         if kind != NO_CUT or nstuck > 0 or na != m:
             t_far, far = _reschedule(W, flag, stuck, since, tree, nstuck, n, t0, tau, p)
     if profile.shape[0] == n:
@@ -258,7 +324,7 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
         for k in range(nt):
             profile[arrays.touched[k]] = W[arrays.touched[k], Y]
     diag = arrays.diag
-    _finish_event(W, flag, arrays.touched, nt, arrays.since, arrays.tree, t0, n, tau, p, work, slip_time, diag)
+    _finish_event(W, flag, arrays.touched, nt, since, tree, t0, n, tau, p, work, slip_time, diag)
     diag[D_STEPS] = steps
     diag[D_VMAX] = vmax
     diag[D_BLOCK_STEPS] = block_steps
@@ -270,55 +336,6 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
     clear_log(W, event, arrays.undo)
     event[EV_PHASE] = BETWEEN
     return status, used
-
-
-# -- health of a step -----------------------------------------------------------------------------
-
-@nb.njit(cache=True, inline="always")
-def _health(W, act, na, p, v_limit, psi_limit, vmax):
-    """(status, vmax) after a step: NONFINITE unless every sliding block's state is finite, UNSTABLE
-    (RK4) if a block is beyond RK4's stability region for a full step dt, for the state equation
-    (rate 1/theta = exp(-psi)) or v; vmax, the largest velocity so far."""
-    status = OK
-    for k in range(na):
-        i = act[k]
-        v = W[i, V]
-        if not (math.isfinite(v) and math.isfinite(W[i, P]) and math.isfinite(W[i, Y])):
-            status = NONFINITE
-        if v > vmax:
-            vmax = v
-        if not adaptive(p.method) and rk4_unstable(p.law, v, W[i, P], v_limit, psi_limit) and status == OK:
-            status = UNSTABLE
-    return status, vmax
-
-
-# -- transitions at the step's end, and rescheduling ----------------------------------------------
-
-@nb.njit(cache=True, inline="always")
-def _retire_stopped(W, act, flag, stuck, na, n, tau, who, kind, yrest, p):
-    """Take the sliding blocks that stopped at tau off the active list act[:na] (kept in order) into
-    stuck. Returns (sliding blocks left, stopped blocks, yrest)."""
-    m = 0
-    nstuck = 0
-    for k in range(na):
-        i = act[k]
-        started = i == who and (kind == ONSET_NEIGHBOUR or kind == ONSET_LOADING)
-        if W[i, V] <= 0.0 and not started and not pressed(W, n, i, tau, p):
-            # Blocks never move backward: a block that started this step
-            # but could not move keeps its slip.
-            if W[i, Y] < W[i, Y0]:
-                W[i, Y] = W[i, Y0]
-            W[i, V] = 0.0
-            W[i, TR] = tau
-            W[i, YS] = W[i, Y]
-            flag[i] = STOPPED
-            yrest += W[i, Y]
-            stuck[nstuck] = i
-            nstuck += 1
-        else:
-            act[m] = i
-            m += 1
-    return m, nstuck, yrest
 
 
 @nb.njit(cache=True, inline="always")

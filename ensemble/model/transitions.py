@@ -3,7 +3,7 @@
 A step of the event (event.py) in which a sliding block's velocity reaches 0 (STICK), a resting
 neighbour of a sliding block reaches its static threshold (ONSET_NEIGHBOUR), or a block nobody
 watches does so by loading alone (ONSET_LOADING, at the schedule's t_far) is cut at the earliest of
-these and redone up to it. Sticks and onsets are located alike, by one bisection (`_locate`), on the
+these and redone up to it. Sticks and onsets are located alike, by one bisection (`locate`), on the
 step's cubic Hermite interpolant: of the velocity for a stick, of the slips (and so of the force)
 for an onset.
 """
@@ -77,40 +77,18 @@ def pressed(W, n, i, tau, p):
 
 
 @nb.njit(cache=True, inline="always")
-def earliest_transition(W, act, flag, na, n, tau, h, t_far, far, p):
-    """(x, block, kind) of the earliest transition inside the step of size h just taken from local
-    time tau, at the fraction x of it (kind NO_CUT: none; x = 1: at the step's end)."""
-    # the slip of a sliding block inside the step is the Hermite cubic with these slopes
-    for k in range(na):
-        i = act[k]
-        W[i, HD0] = h * W[i, V0]
-        W[i, HD1] = h * W[i, V]
-    x_cut = 2.0
-    who = -1
-    kind = NO_CUT
-    for k in range(na):
-        i = act[k]
-        if W[i, V] <= 0.0 and W[i, V0] > 0.0:
-            d0, d1 = _velocity_slopes(W, n, i, tau, h, p)
-            x = _locate(STICK, W, flag, n, i, tau, h, W[i, V0], W[i, V], d0, d1, p)
-            if x < x_cut:
-                x_cut, who, kind = x, i, STICK
-    for k in range(na):
-        i = act[k]
-        for j in (left(i), right(i, n)):
-            if j != i and above_threshold(W, flag, n, j, tau + h, p):
-                x = _locate(ONSET_NEIGHBOUR, W, flag, n, j, tau, h, 0.0, 0.0, 0.0, 0.0, p)
-                if x < x_cut:
-                    x_cut, who, kind = x, j, ONSET_NEIGHBOUR
+def loading_cut(x_cut, who, kind, t_far, far, tau, h):
+    """(x, block, kind): the earliest transition found so far inside the step of size h from local
+    time tau, or the onset by loading alone at t_far of block `far` if it is earlier."""
     if t_far <= tau + h:
         x = max(t_far - tau, 0.0) / h
         if x < x_cut:
-            x_cut, who, kind = x, far, ONSET_LOADING
+            return x, far, ONSET_LOADING
     return x_cut, who, kind
 
 
 @nb.njit(cache=True, inline="always")
-def _velocity_slopes(W, n, i, tau, h, p):
+def velocity_slopes(W, n, i, tau, h, p):
     """Slopes, per unit fraction of the step, of sliding block i's velocity at the step's ends."""
     a_end = spring_force(W[i, F0], tau + h, event_nu(p), p.l2, W[left(i), Y], W[i, Y],
                          W[right(i, n), Y]) - friction(p.law, W[i, V], W[i, P])
@@ -118,7 +96,7 @@ def _velocity_slopes(W, n, i, tau, h, p):
 
 
 @nb.njit(cache=True, inline="always")
-def _locate(kind, W, flag, n, j, tau, h, v0, v1, d0, d1, p):
+def locate(kind, W, flag, n, j, tau, h, v0, v1, d0, d1, p):
     """The earliest fraction x of the step by which transition `kind` of block j has happened (it
     has by the step's end), by bisection to 2^-60 on the step's Hermite interpolant: for a STICK,
     of the velocity (v0, v1 at the step's ends, slopes d0, d1) down to 0, for an onset of the
