@@ -27,7 +27,7 @@ import numpy as np
 from ensemble.config import Model
 from ensemble.events import check, run_event
 from ensemble.integrators import kernel_params
-from ensemble.model.event import take_step
+from ensemble.model.methods import take_step
 from ensemble.model.workspace import F0, NCOLS, P, P0, V, V0, Y, Y0, YS
 
 from .common import parse_setting, single_event_parser, write_outputs

@@ -10,9 +10,18 @@ static threshold) is cut at that instant, located on the cubic Hermite
 interpolant of the step, and redone with the shorter step. Clamping v to zero at
 the end of a step instead would make the slip only second-order accurate.
 
+One step of the event loop (continue_event) goes through its phases, each marked `# --` there:
+the step-size control (control.py), the earliest transition inside the step (transitions.py, each
+located by one bisection), the health check, the transitions at the step's end, and the
+rescheduling of the blocks nobody watches any more (`_reschedule`). The phases that loop over the
+sliding blocks every step stay in the loop's body: numba counts a reference (an atomic add and
+subtract) for every array an inlined function receives, at every call, and as functions those
+phases made an ark4 run measurably slower (a WorkArrays record counts once per array in it). The
+helpers they call take scalars, or run only at a transition.
+
 Work arrays (one record, `workspace.WorkArrays`): columns of the float array `W` hold per-block
-quantities, `act` the active list, `flag` 0 (never slid in this event), 1
-(sliding), 2 (slid and now at rest), `touched` the blocks that slid.
+quantities, `act` the active list, `flag` the blocks' states (workspace: UNTOUCHED, SLIDING,
+STOPPED), `touched` the blocks that slid.
 
 An event is begun (`begin_event`) and then integrated by `continue_event`, which returns
 after a given amount of work if the event has not finished by then, its loop variables kept
@@ -26,111 +35,24 @@ import math
 import numba as nb
 import numpy as np
 
-from .geometry import left, right, spring_force
-from .laws import friction, loader_moves, onset_delay, rest_state, rk4_unstable, stiff_limit, threshold
+from .control import accepted, next_step_size, record, retry_size
+from .geometry import left, right
+from .laws import loader_moves, onset_delay, rest_state, rk4_unstable, stiff_limit
+from .methods import adaptive, take_step
 from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
-from .steppers import ERROR_WEIGHTS, ark3_step, ark4_step, ark5_step, block_error, rk4_step
-from .tableaux import ARK324, ARK436, ARK548
+from .transitions import (NO_CUT, ONSET_LOADING, ONSET_NEIGHBOUR, STICK, above_threshold, event_nu, force_now,
+                          loading_cut, locate, pressed, rest_psi, velocity_slopes)
 from .undo import clear_log, log_block
 from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D_ENERGY_SCALE, D_FIRST,
                         D_LAST, D_LOAD_WORK, D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK,
                         EV_BLOCK_STEPS, EV_CUTS, EV_EPICENTER, EV_ERR_PREV, EV_FAR, EV_H_NEXT, EV_NA, EV_NT,
                         EV_PHASE, EV_REJECTED, EV_SLIP_TIME, EV_STEPS, EV_T_FAR, EV_TAU, EV_TRACED, EV_VMAX,
-                        EV_WORK, EV_YREST, F0, HD0, HD1, IN_EVENT, K1V, NONFINITE, OK,
-                        P, P0, PAUSED, SLIDING, STOPPED, T_AGE, T_BLOCK, T_ERROR, T_H, T_OWN, T_PART, T_PSI, T_SLIDING,
-                        T_TAU, T_V, TOO_LONG, TR, TS, UNLIMITED, UNSTABLE, UNTOUCHED, V, V0, Y, Y0, YS)
-
-# integrators (see ensemble.integrators): fixed-step RK4, adaptive IMEX ARK3(2), ARK4(3), ARK5(4)
-RK4, ARK3, ARK4, ARK5 = 0, 1, 2, 3
-# step-size control exponent -1 / (q + 1), q the order of the embedded method (unused for RK4)
-_CONTROL_EXPONENT = (0.0,) + tuple(-1.0 / (pair.embedded_order + 1) for pair in (ARK324, ARK436, ARK548))
-# PI control of the accepted steps (Gustafsson; Hairer & Wanner II, sec. IV.2): the next step is
-# h 0.9 err^(-0.7/(q+1)) err_prev^(0.4/(q+1)), err_prev the last accepted step's error. Against the
-# plain 0.9 err^(-1/(q+1)) it halves the rejected steps (ark4, rtol 1e-5, large event: 588 -> 279) and
-# is 1.0-1.15x faster at equal slip error on the step-budget events (b = 20 and 50; interpolated
-# between tolerances in benchmarks/results/step_budget_* before and after the change, 9498c4f..565d956).
-_PI_I, _PI_P = 0.7, 0.4
-
-# the transition that ends a step early (continue_event)
-NO_CUT = 0            # none inside the step
-STICK = 1             # a sliding block's velocity reaches 0
-ONSET_NEIGHBOUR = 2   # a resting neighbour of a sliding block reaches its threshold
-ONSET_LOADING = 3     # a block nobody watches reaches its threshold by loading alone (t_far)
+                        EV_WORK, EV_YREST, F0, HD0, HD1, IN_EVENT, NONFINITE, OK, P, P0, PAUSED, SLIDING,
+                        STOPPED, TOO_LONG, TR, TS, UNLIMITED, UNSTABLE, UNTOUCHED, V, V0, Y, Y0, YS)
 
 # Stability limit of classical RK4 on the negative real axis: the state equation
 # relaxes at rate 1/theta (= v in steady sliding), so dt / theta must stay below it.
 RK4_STABILITY = 2.785
-_BISECT = 60
-
-
-@nb.njit(cache=True, inline="always")
-def _hermite(x, y0, y1, d0, d1):
-    """Cubic Hermite on [0, 1] with end values y0, y1 and end slopes d0, d1 (per unit x)."""
-    x2 = x * x
-    x3 = x2 * x
-    return ((2 * x3 - 3 * x2 + 1) * y0 + (x3 - 2 * x2 + x) * d0
-            + (3 * x2 - 2 * x3) * y1 + (x3 - x2) * d1)
-
-
-@nb.njit(cache=True, inline="always")
-def _event_nu(p):
-    """The loader's velocity during an event: nu, or 0 for a law whose loader stands still then."""
-    return p.nu if loader_moves(p.law) else 0.0
-
-
-@nb.njit(cache=True, inline="always")
-def _rest_psi(W, j, tau, p):
-    """psi of a block at rest since local time TR (its state grown since)."""
-    return rest_state(p.law, W[j, P], tau - W[j, TR])
-
-
-@nb.njit(cache=True)
-def _slip_at(W, flag, j, x):
-    """Slip of block j at fraction x of the current step (Hermite if it slides)."""
-    if flag[j] != SLIDING:
-        return W[j, Y]
-    return _hermite(x, W[j, Y0], W[j, Y], W[j, HD0], W[j, HD1])
-
-
-@nb.njit(cache=True)
-def _excess(W, flag, n, j, tau, h, x, p):
-    """Force above the static threshold of resting block j at fraction x of the step."""
-    s = tau + x * h
-    yl = _slip_at(W, flag, left(j), x)
-    yr = _slip_at(W, flag, right(j, n), x)
-    return spring_force(W[j, F0], s, _event_nu(p), p.l2, yl, W[j, Y], yr) - threshold(p.law, _rest_psi(W, j, s, p))
-
-
-@nb.njit(cache=True)
-def _force_now(W, n, j, tau, p):
-    return spring_force(W[j, F0], tau, _event_nu(p), p.l2, W[left(j), Y], W[j, Y], W[right(j, n), Y])
-
-
-@nb.njit(cache=True)
-def _excess_now(W, n, j, tau, p):
-    """Force above the static threshold of resting block j at the current time."""
-    return _force_now(W, n, j, tau, p) - threshold(p.law, _rest_psi(W, j, tau, p))
-
-
-@nb.njit(cache=True)
-def _above_threshold(W, flag, n, j, tau, p):
-    """Block j is at rest and its force exceeds the static threshold at local time tau."""
-    # Cheap filter first: the threshold of a resting block never falls (laws/__init__.py), so a
-    # force below its threshold when it came to rest cannot start it.
-    return (flag[j] != SLIDING and _force_now(W, n, j, tau, p) > threshold(p.law, W[j, P])
-            and _excess_now(W, n, j, tau, p) > 0.0)
-
-
-@nb.njit(cache=True)
-def _pressed(W, n, i, tau, p):
-    """Sliding block i has not moved in this step but is still at or above its threshold.
-
-    A block that starts exactly on its threshold gains force above it slowly (for the aging
-    law at the rate nu - b / theta, > 0 at an onset), which for small nu can stay below the
-    rounding of the force for a step: it has not stopped, it has not started yet.
-    """
-    return (W[i, V0] == 0.0 and W[i, V] == 0.0
-            and _force_now(W, n, i, tau, p) - threshold(p.law, W[i, P]) >= 0.0)
 
 
 @nb.njit(cache=True)
@@ -144,7 +66,7 @@ def _loading_onset(W, flag, n, j, tau, p):
     the loader stands still during events)."""
     if not loader_moves(p.law) or flag[j] == SLIDING or _adjacent_to_active(flag, n, j):
         return np.inf
-    return tau + onset_delay(p.law, _force_now(W, n, j, tau, p), _rest_psi(W, j, tau, p), p.nu)
+    return tau + onset_delay(p.law, force_now(W, n, j, tau, p), rest_psi(W, j, tau, p), p.nu)
 
 
 @nb.njit(cache=True)
@@ -167,7 +89,7 @@ def _far_onset(W, flag, n, since, tree, t0, tau, p):
 
 
 @nb.njit(cache=True)
-def _watch(W, since, tree, t0, p, j, event, undo):
+def _watch(W, since, tree, event, undo, t0, p, j):
     """Block j starts or neighbours a sliding block: bring it to t0, take it off the schedule."""
     log_block(W, since, event, undo, j)
     materialize(W, since, j, t0, p)
@@ -175,62 +97,22 @@ def _watch(W, since, tree, t0, p, j, event, undo):
 
 
 @nb.njit(cache=True)
-def _start(W, act, na, flag, touched, nt, since, tree, t0, p, j, tau, yrest, event, undo):
+def _start(arrays, na, nt, t0, p, j, tau, yrest):
     """Block j starts to slide at local time tau; returns (na, nt, yrest)."""
+    W, flag = arrays.W, arrays.flag
     for k in (left(j), j, right(j, W.shape[0])):
-        _watch(W, since, tree, t0, p, k, event, undo)
+        _watch(W, arrays.since, arrays.tree, arrays.event, arrays.undo, t0, p, k)
     if flag[j] == STOPPED:
         yrest -= W[j, Y]
     else:
-        touched[nt] = j
+        arrays.touched[nt] = j
         nt += 1
-    W[j, P] = _rest_psi(W, j, tau, p)
+    W[j, P] = rest_psi(W, j, tau, p)
     W[j, V] = 0.0
     W[j, TS] = tau
     flag[j] = SLIDING
-    act[na] = j
+    arrays.act[na] = j
     return na + 1, nt, yrest
-
-
-@nb.njit(cache=True)
-def take_step(W, act, na, n, tau, h, p, yrest):
-    """One step of the method p.method (RK4, ARK3, ARK4, ARK5) of the active blocks; see steppers.py."""
-    if p.method == RK4:
-        return rk4_step(W, act, na, n, tau, h, p, yrest)
-    if p.method == ARK3:
-        return ark3_step(W, act, na, n, tau, h, p, yrest)
-    if p.method == ARK4:
-        return ark4_step(W, act, na, n, tau, h, p, yrest)
-    return ark5_step(W, act, na, n, tau, h, p, yrest)
-
-
-@nb.njit(cache=True)
-def _record(trace, row, p, W, act, na, tau, h, err, expo):
-    """Row `row` of the step trace (workspace.TRACE_COLUMNS) for the step just tried."""
-    trace[row, T_TAU] = tau
-    trace[row, T_H] = h
-    trace[row, T_SLIDING] = na
-    trace[row, T_ERROR] = err
-    trace[row, T_BLOCK] = -1
-    if p.method == RK4:
-        return
-    # a block whose error is e could have taken a step (err / e)^(1/(q+1)) times longer (counted
-    # as at most 10x: a block with a vanishing error estimate still has to step)
-    own = 0.0
-    worst = -1.0
-    for k in range(na):
-        i = act[k]
-        parts = block_error(W, i, h, p.rtol, p.atol, ERROR_WEIGHTS[p.method])
-        e = max(parts)
-        own += 1.0 if err <= 0.0 else min(1.0, max(0.1, (e / err) ** -expo))
-        if e > worst:
-            worst = e
-            trace[row, T_BLOCK] = i
-            trace[row, T_PART] = 0 if e == parts[0] else (1 if e == parts[1] else 2)
-            trace[row, T_AGE] = tau + h - W[i, TS]
-            trace[row, T_V] = W[i, V]
-            trace[row, T_PSI] = W[i, P]
-    trace[row, T_OWN] = own
 
 
 @nb.njit(cache=True)
@@ -242,8 +124,9 @@ def integrate_event(arrays, t0, n, epicenter, v_start, p, profile, trace):
     holds every block's onset key, the epicenter is on its threshold at t0 (two-float time), the
     other columns and `flag` are zero, `event` is BETWEEN with an empty undo log. `v_start` is the epicenter's initial
     velocity (0 for a natural onset). `p` holds the parameters (params.KernelParams):
-    p.method RK4 steps by p.dt; ARK3, ARK4 and ARK5 start with p.dt and control the step (at most
-    p.max_step) so that the embedded error estimate stays below p.rtol, p.atol. On return the
+    the method p.method (methods.py) steps by p.dt if it is RK4; an adaptive one starts with p.dt
+    and controls the step (at most p.max_step) so that the embedded error estimate stays below
+    p.rtol, p.atol. On return the
     blocks the event touched hold the state at its end (the schedule updated), the other columns
     and `flag` are zero, and `diag` holds the event summary (see workspace.D_*). If `profile`
     has n entries it receives the slip of every block (else pass an empty
@@ -265,11 +148,9 @@ def begin_event(arrays, t0, n, epicenter, v_start, p):
     and the event's loop variables go into `event` (EV_*, EV_PHASE = IN_EVENT) for
     continue_event. EV_NUNDO and the clock entries are the caller's (chain.simulate).
     """
-    W, act, flag, touched, since, tree = arrays.W, arrays.act, arrays.flag, arrays.touched, arrays.since, arrays.tree
-    event, undo = arrays.event, arrays.undo
-    na, nt, yrest = _start(W, act, 0, flag, touched, 0, since, tree, t0, p, epicenter, 0.0, 0.0, event,
-                           undo)
-    t_far, far = _far_onset(W, flag, n, since, tree, t0, 0.0, p)
+    W, event = arrays.W, arrays.event
+    na, nt, yrest = _start(arrays, 0, 0, t0, p, epicenter, 0.0, 0.0)
+    t_far, far = _far_onset(W, arrays.flag, n, arrays.since, arrays.tree, t0, 0.0, p)
     W[epicenter, V] = v_start
     event[EV_PHASE] = IN_EVENT
     event[EV_EPICENTER] = epicenter
@@ -298,6 +179,15 @@ def _keep(event, na, nt, yrest, t_far, far, tau, work, slip_time, steps, block_s
     event[EV_TRACED] = traced
 
 
+@nb.njit(cache=True, inline="always")
+def _resume(event):
+    """The loop variables of the event in progress from the event-state vector, as _keep takes them."""
+    return (int(event[EV_NA]), int(event[EV_NT]), event[EV_YREST], event[EV_T_FAR], int(event[EV_FAR]),
+            event[EV_TAU], event[EV_WORK], event[EV_SLIP_TIME], int(event[EV_STEPS]),
+            int(event[EV_BLOCK_STEPS]), int(event[EV_REJECTED]), int(event[EV_CUTS]), event[EV_VMAX],
+            event[EV_H_NEXT], event[EV_ERR_PREV], int(event[EV_TRACED]))
+
+
 @nb.njit(cache=True)
 def continue_event(arrays, t0, n, p, profile, trace, budget):
     """Integrate the event in progress (begin_event) until every block is at rest, or pause.
@@ -308,28 +198,13 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
     integrate_event (which see); when the event has finished, `event` is BETWEEN and its undo
     log empty. Returns (status, work units spent in this call).
     """
-    W, act, flag, touched, stuck = arrays.W, arrays.act, arrays.flag, arrays.touched, arrays.stuck
-    since, tree, diag, event, undo = arrays.since, arrays.tree, arrays.diag, arrays.event, arrays.undo
-    na = int(event[EV_NA])
-    nt = int(event[EV_NT])
-    yrest = event[EV_YREST]
-    t_far = event[EV_T_FAR]
-    far = int(event[EV_FAR])
-    tau = event[EV_TAU]
-    work = event[EV_WORK]
-    slip_time = event[EV_SLIP_TIME]
-    steps = int(event[EV_STEPS])
-    block_steps = int(event[EV_BLOCK_STEPS])
-    rejected = int(event[EV_REJECTED])
-    cuts = int(event[EV_CUTS])
-    vmax = event[EV_VMAX]
-    h_next = event[EV_H_NEXT]
-    err_prev = event[EV_ERR_PREV]
-    traced = int(event[EV_TRACED])
+    W, act, flag, event = arrays.W, arrays.act, arrays.flag, arrays.event
+    stuck, since, tree = arrays.stuck, arrays.since, arrays.tree
+    (na, nt, yrest, t_far, far, tau, work, slip_time, steps, block_steps, rejected, cuts, vmax, h_next,
+     err_prev, traced) = _resume(event)
     status = OK
     v_limit = RK4_STABILITY / p.dt
     psi_limit = stiff_limit(p.law, v_limit)
-    expo = _CONTROL_EXPONENT[p.method]
     used = 0
     while na > 0:
         if used >= budget:
@@ -339,39 +214,30 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
         if steps >= p.max_steps or tau > p.max_duration:
             status = TOO_LONG
             break
+        # -- step-size control: the step from the step start, retried shorter until accepted
         for k in range(na):
             i = act[k]
             W[i, Y0] = W[i, Y]
             W[i, V0] = W[i, V]
             W[i, P0] = W[i, P]
         h = h_next
-        retried = False
+        tries = 0
         while True:
             dwork, dslip, err = take_step(W, act, na, n, tau, h, p, yrest)
-            used += na
+            tries += 1
             if traced < trace.shape[0]:
-                _record(trace, traced, p, W, act, na, tau, h, err, expo)
+                record(trace, traced, p, W, act, na, tau, h, err)
                 traced += 1
-            if p.method == RK4 or err <= 1.0 or h < 1e-12:
+            if accepted(p, err, h):
                 break
-            h *= max(0.2, 0.9 * err ** expo)    # rejected: retry from (Y0, V0, P0)
-            steps += 1
-            rejected += 1
-            retried = True
-        if p.method != RK4:
-            if err == 0.0:
-                grow = 5.0
-            else:
-                grow = min(5.0, max(0.2, 0.9 * err ** (_PI_I * expo) * max(err_prev, 1e-4) ** (-_PI_P * expo)))
-            err_prev = err
-            if retried:
-                # no growth right after a rejection (the step just failed at a larger h):
-                # 4% fewer steps, 20% fewer rejections for ark4 on large events (plain controller)
-                grow = min(grow, 1.0)
-            h_next = min(p.max_step, h * grow)
-        # Earliest transition inside the step, as a fraction x of it; the slip
-        # of a sliding block inside the step is the Hermite cubic with these slopes.
+            h = retry_size(p, h, err)
+        used += tries * na
+        steps += tries - 1          # the rejected tries
+        rejected += tries - 1
+        h_next, err_prev = next_step_size(p, h, err, err_prev, tries > 1, h_next)
+        # -- the earliest transition inside the step (transitions.py), where the step is cut
         for k in range(na):
+            # the slip of a sliding block inside the step is the Hermite cubic with these slopes
             i = act[k]
             W[i, HD0] = h * W[i, V0]
             W[i, HD1] = h * W[i, V]
@@ -381,48 +247,18 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
         for k in range(na):
             i = act[k]
             if W[i, V] <= 0.0 and W[i, V0] > 0.0:
-                a_end = spring_force(W[i, F0], tau + h, _event_nu(p), p.l2, W[left(i), Y], W[i, Y],
-                                     W[right(i, n), Y]) - friction(p.law, W[i, V], W[i, P])
-                d0 = h * W[i, K1V]
-                d1 = h * a_end
-                lo = 0.0
-                hi = 1.0
-                for _ in range(_BISECT):
-                    mid = 0.5 * (lo + hi)
-                    if _hermite(mid, W[i, V0], W[i, V], d0, d1) > 0.0:
-                        lo = mid
-                    else:
-                        hi = mid
-                if hi < x_cut:
-                    x_cut = hi
-                    who = i
-                    kind = STICK
+                d0, d1 = velocity_slopes(W, n, i, tau, h, p)
+                x = locate(STICK, W, flag, n, i, tau, h, W[i, V0], W[i, V], d0, d1, p)
+                if x < x_cut:
+                    x_cut, who, kind = x, i, STICK
         for k in range(na):
             i = act[k]
             for j in (left(i), right(i, n)):
-                if j != i and _above_threshold(W, flag, n, j, tau + h, p):
-                    lo = 0.0
-                    hi = 1.0
-                    if _excess(W, flag, n, j, tau, h, 0.0, p) >= 0.0:
-                        hi = 0.0
-                    for _ in range(_BISECT):
-                        if hi == 0.0:
-                            break
-                        mid = 0.5 * (lo + hi)
-                        if _excess(W, flag, n, j, tau, h, mid, p) > 0.0:
-                            hi = mid
-                        else:
-                            lo = mid
-                    if hi < x_cut:
-                        x_cut = hi
-                        who = j
-                        kind = ONSET_NEIGHBOUR
-        if t_far <= tau + h:
-            x = max(t_far - tau, 0.0) / h
-            if x < x_cut:
-                x_cut = x
-                who = far
-                kind = ONSET_LOADING
+                if j != i and above_threshold(W, flag, n, j, tau + h, p):
+                    x = locate(ONSET_NEIGHBOUR, W, flag, n, j, tau, h, 0.0, 0.0, 0.0, 0.0, p)
+                    if x < x_cut:
+                        x_cut, who, kind = x, j, ONSET_NEIGHBOUR
+        x_cut, who, kind = loading_cut(x_cut, who, kind, t_far, far, tau, h)
         if kind != NO_CUT and x_cut < 1.0:
             h = x_cut * h
             cuts += 1
@@ -433,8 +269,8 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
         block_steps += na
         work += dwork
         slip_time += dslip
-        # Health of the step: finite, and within RK4's stability region (for a
-        # full step dt) for the state equation (rate 1/theta = exp(-psi)) and v.
+        # -- health of the step: finite, and within RK4's stability region (for a full step dt)
+        # for the state equation (rate 1/theta = exp(-psi)) and v
         for k in range(na):
             i = act[k]
             v = W[i, V]
@@ -442,23 +278,21 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
                 status = NONFINITE
             if v > vmax:
                 vmax = v
-            if p.method == RK4 and rk4_unstable(p.law, v, W[i, P], v_limit, psi_limit) and status == OK:
+            if not adaptive(p.method) and rk4_unstable(p.law, v, W[i, P], v_limit, psi_limit) and status == OK:
                 status = UNSTABLE
         if status != OK:
             break
-        # Transitions at tau: the located one, then anything that crossed with it.
+        # -- transitions at tau: the located one, then the blocks that stopped
         if kind == ONSET_NEIGHBOUR or kind == ONSET_LOADING:
-            na, nt, yrest = _start(W, act, na, flag, touched, nt, since, tree, t0, p, who, tau, yrest,
-                                   event, undo)
-            W[who, V] = 0.0
-        if kind == STICK:
+            na, nt, yrest = _start(arrays, na, nt, t0, p, who, tau, yrest)
+        if kind != NO_CUT:
             W[who, V] = 0.0
         m = 0
         nstuck = 0
         for k in range(na):
             i = act[k]
             started = i == who and (kind == ONSET_NEIGHBOUR or kind == ONSET_LOADING)
-            if W[i, V] <= 0.0 and not started and not _pressed(W, n, i, tau, p):
+            if W[i, V] <= 0.0 and not started and not pressed(W, n, i, tau, p):
                 # Blocks never move backward: a block that started this step
                 # but could not move keeps its slip.
                 if W[i, Y] < W[i, Y0]:
@@ -474,28 +308,23 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
                 act[m] = i
                 m += 1
         na = m
-        # Resting neighbours of the sliding blocks and of those that just stopped
-        # (a step redone up to a located stick differs from the interpolant of the
-        # longer step, so a neighbour may have crossed its threshold in the redo).
+        # Resting neighbours of the sliding blocks and of those that just stopped (a step redone up
+        # to a located stick differs from the interpolant of the longer step, so a neighbour may
+        # have crossed its threshold in the redo).
         for k in range(m + nstuck):
             i = act[k] if k < m else stuck[k - m]
             for j in (left(i), right(i, n)):
-                if j != i and _above_threshold(W, flag, n, j, tau, p):
-                    na, nt, yrest = _start(W, act, na, flag, touched, nt, since, tree, t0, p, j,
-                                           tau, yrest, event, undo)
-        # Blocks no longer watched by a sliding neighbour may only start by
-        # loading: back on the schedule with their analytic onset.
-        for k in range(nstuck):
-            i = stuck[k]
-            for j in (left(i), i, right(i, n)):
-                tree_set(tree, j, t0[0] + (t0[1] + _loading_onset(W, flag, n, j, tau, p)))
+                if j != i and above_threshold(W, flag, n, j, tau, p):
+                    na, nt, yrest = _start(arrays, na, nt, t0, p, j, tau, yrest)
+        # -- rescheduling, once the set of watched blocks has changed
         if kind != NO_CUT or nstuck > 0 or na != m:
-            t_far, far = _far_onset(W, flag, n, since, tree, t0, tau, p)
+            t_far, far = _reschedule(W, flag, stuck, since, tree, nstuck, n, t0, tau, p)
     if profile.shape[0] == n:
         profile[:] = 0.0
         for k in range(nt):
-            profile[touched[k]] = W[touched[k], Y]
-    _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, p, work, slip_time, diag)
+            profile[arrays.touched[k]] = W[arrays.touched[k], Y]
+    diag = arrays.diag
+    _finish_event(W, flag, arrays.touched, nt, since, tree, t0, n, tau, p, work, slip_time, diag)
     diag[D_STEPS] = steps
     diag[D_VMAX] = vmax
     diag[D_BLOCK_STEPS] = block_steps
@@ -504,9 +333,21 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
     # the final values too, so that the vector does not depend on where the event was paused
     _keep(event, na, nt, yrest, t_far, far, tau, work, slip_time, steps, block_steps, rejected, cuts,
           vmax, h_next, err_prev, traced)
-    clear_log(W, event, undo)
+    clear_log(W, event, arrays.undo)
     event[EV_PHASE] = BETWEEN
     return status, used
+
+
+@nb.njit(cache=True, inline="always")
+def _reschedule(W, flag, stuck, since, tree, nstuck, n, t0, tau, p):
+    """After the set of watched blocks changed: the blocks no longer watched by a sliding neighbour
+    may only start by loading, back on the schedule with their analytic onset. Returns (t_far, far),
+    the earliest such onset."""
+    for k in range(nstuck):
+        i = stuck[k]
+        for j in (left(i), i, right(i, n)):
+            tree_set(tree, j, t0[0] + (t0[1] + _loading_onset(W, flag, n, j, tau, p)))
+    return _far_onset(W, flag, n, since, tree, t0, tau, p)
 
 
 @nb.njit(cache=True)
@@ -537,7 +378,7 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, p, work, slip_t
         e_change += stored - y * W[i, F0]
         gross += stored + abs(y * W[i, F0])
     elastic = e_change     # the terms apart (workspace.py): D_ELASTIC, D_LOAD_WORK
-    nu = _event_nu(p)
+    nu = event_nu(p)
     e_change += -nu * tau * slip + nu * slip_time
     gross += nu * tau * slip + nu * slip_time
     diag[D_DURATION] = tau

@@ -8,7 +8,8 @@ ensemble.integrators.kernel_params builds it from the config.
 from collections import namedtuple
 
 _Fields = namedtuple("KernelParams", "l2 nu law method dt rtol atol max_step max_duration max_steps")
-_INTEGERS = ("method", "max_steps")     # law is the friction law's own record; the others are float64
+_INTEGERS = ("max_steps",)
+_RECORDS = ("law", "method")     # records of their own classes (below); the others are float64
 
 
 class KernelParams(_Fields):
@@ -18,7 +19,9 @@ class KernelParams(_Fields):
     nu            loading velocity of the driver plate
     law           the friction law's parameters, a namedtuple of that law's class (model/laws/): the
                   kernels are compiled once per law, and each call of a law function resolves to it
-    method        integrator code, event.RK4, ARK3, ARK4 or ARK5 (ensemble.integrators.INTEGRATORS)
+    method        the integrator's record, of that method's own class (model/methods.py): the kernels are
+                  compiled once per method, each with its stepper and tableau; its field
+                  control_exponent is -1 / (q + 1), q the embedded order (0 for rk4)
     dt            step of rk4; the first step of an event for the adaptive methods
     rtol          adaptive methods: relative tolerance of the local error per step
     atol          adaptive methods: absolute tolerance (slip, velocity)
@@ -36,7 +39,7 @@ class KernelParams(_Fields):
             raise TypeError(f"KernelParams: missing {missing}, unknown {unknown}")
         # one type per field, so that every caller reaches the same compiled kernel
         return super().__new__(cls, *(int(fields[f]) if f in _INTEGERS else
-                                      fields[f] if f == "law" else float(fields[f]) for f in cls._fields))
+                                      fields[f] if f in _RECORDS else float(fields[f]) for f in cls._fields))
 
     def __getnewargs_ex__(self):
         """For pickle and copy, which would otherwise call __new__ with the fields by position."""

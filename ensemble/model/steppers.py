@@ -7,20 +7,17 @@ returns (friction work, time integral of the total slip, error estimate relative
 to the tolerances; 0 for fixed steps).
 
 - rk4_step: classical RK4, the paper's method; stable only while h / theta < 2.785.
-- ark3_step, ark4_step, ark5_step: the additive (IMEX) Runge-Kutta pairs ARK3(2)4L[2]SA,
+- ark_step: a step of an additive (IMEX) Runge-Kutta pair of tableaux.py, such as ARK3(2)4L[2]SA,
   ARK4(3)6L[2]SA and ARK5(4)8L[2]SA of Kennedy & Carpenter (2003): explicit for slip and velocity,
   L-stable ESDIRK for the state psi, whose relaxation at rate 1/theta (~ v while
   sliding) is the stiff part. Each implicit stage is one scalar equation per
-  block, solved by a Halley and a Newton step (more Newton steps in the rare
-  case that is not enough). Order p with an embedded estimate of order p - 1 for
-  step-size control. All run the same kernel `_ark_step` with their tableau.
+  block, solved by the law's implicit_state. Order p with an embedded estimate of order p - 1 for
+  step-size control. Each method of the registry (methods.py) runs it with its own tableau.
 """
-import math
 import numba as nb
 
 from .geometry import left, right, spring_force
 from .laws import friction, has_state, implicit_state, loader_moves, state_rate
-from .tableaux import ARK324, ARK436, ARK548
 from .workspace import (ARK_A, ARK_G, ARK_V, F0, K1V, KP, KV, KY, P, P0, PS, SP, SV, SY, V, V0,
                         VS, Y, Y0, YS)
 
@@ -109,14 +106,10 @@ def rk4_step(W, act, na, n, tau, h, p, yrest):
     return pw * h / 6.0, ys * h / 6.0, 0.0
 
 
-_C3, _AE3, _AI3, _B3, _D3, _G3 = ARK324.kernel_arrays()
-_C5, _AE5, _AI5, _B5, _D5, _G5 = ARK548.kernel_arrays()
-_C4, _AE4, _AI4, _B4, _D4, _G4 = ARK436.kernel_arrays()
-
-
 @nb.njit(cache=True, error_model="numpy", inline="always")
-def _ark_step(W, act, na, n, tau, h, p, yrest, c, ae, ai, bw, bd, gamma):
-    """One step of the IMEX pair (c, ae, ai, gamma; weights bw, error weights bd = b - bhat).
+def ark_step(W, act, na, n, tau, h, p, yrest, c, ae, ai, bw, bd, gamma):
+    """One step of the IMEX pair (c, ae, ai, gamma; weights bw, error weights bd = b - bhat), as
+    tableaux.ArkPair.kernel_arrays gives them (methods.py compiles one copy per pair).
 
     Stage s: slip and velocity explicit from the earlier stages' rates, psi
     implicit (one scalar solve per block) with diagonal gamma.
@@ -191,7 +184,7 @@ def _error_norms(W, i, dy, dv, dp, rtol, atol):
 @nb.njit(cache=True)
 def block_error(W, i, h, rtol, atol, bd):
     """(slip, velocity, psi) error norms of block i in the adaptive step of size h just taken,
-    from the stages still in W; bd, the method's error weights (ERROR_WEIGHTS[method]).
+    from the stages still in W; bd, the method's error weights (methods.error_weights).
 
     For diagnostics (the step trace): the step itself only keeps the largest.
     """
@@ -201,25 +194,3 @@ def block_error(W, i, h, rtol, atol, bd):
         ev += bd[s] * W[i, ARK_A + s]
         ep += bd[s] * W[i, ARK_G + s]
     return _error_norms(W, i, h * ey, h * ev, h * ep, rtol, atol)
-
-
-# error weights b - bhat by method code (RK4, ARK3, ARK4, ARK5 as in event.py; RK4 has none)
-ERROR_WEIGHTS = (_D3[:0], _D3, _D4, _D5)
-
-
-@nb.njit(cache=True, error_model="numpy")
-def ark3_step(W, act, na, n, tau, h, p, yrest):
-    """ARK3(2)4L[2]SA step of the active blocks; see the module docstring."""
-    return _ark_step(W, act, na, n, tau, h, p, yrest, _C3, _AE3, _AI3, _B3, _D3, _G3)
-
-
-@nb.njit(cache=True, error_model="numpy")
-def ark4_step(W, act, na, n, tau, h, p, yrest):
-    """ARK4(3)6L[2]SA step of the active blocks; see the module docstring."""
-    return _ark_step(W, act, na, n, tau, h, p, yrest, _C4, _AE4, _AI4, _B4, _D4, _G4)
-
-
-@nb.njit(cache=True, error_model="numpy")
-def ark5_step(W, act, na, n, tau, h, p, yrest):
-    """ARK5(4)8L[2]SA step of the active blocks; see the module docstring."""
-    return _ark_step(W, act, na, n, tau, h, p, yrest, _C5, _AE5, _AI5, _B5, _D5, _G5)
