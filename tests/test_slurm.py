@@ -28,6 +28,7 @@ from .processes import child_env, poll_until, run_bounded
 from .same_catalogs import assert_same_events
 
 PACKAGES = ["slurmctld", "slurmd", "slurm-client", "munge"]
+RELEASE_DELAY = 3   # seconds between a requeue and the release of the job (Cluster.wait)
 DAEMONS = ["munged", "slurmctld", "slurmd", "sbatch", "srun", "scontrol", "sinfo"]
 FINISHED = {"COMPLETED", "FAILED", "CANCELLED", "TIMEOUT", "NODE_FAIL", "OUT_OF_MEMORY",
             "BOOT_FAIL", "DEADLINE", "PREEMPTED"}
@@ -285,15 +286,22 @@ PartitionName=debug Nodes=ALL Default=YES MaxTime=INFINITE State=UP
         return [dict(re.findall(r"(\w+)=(\S*)", line)) for line in res.stdout.strip().splitlines()]
 
     def wait(self, job_ids, timeout, check=None):
-        """Wait until every job (every element) has finished. Requeued jobs are released at
-        once: Slurm holds a requeued job for 120 s before it may start again (hard-coded), which
-        would only make the test longer. `check()` runs at each poll while jobs are left."""
+        """Wait until every job (every element) has finished. Requeued jobs are released early:
+        Slurm holds a requeued job for 120 s before it may start again (hard-coded), which would
+        only make the test longer. Not at once, though: a start within a few tens of ms of the
+        requeue can meet the revocation of the previous start's credential, and slurmctld then
+        kills the job ("Killing non-startable batch JobId=5: Job credential revoked", seen under
+        load), so each requeue is released once, RELEASE_DELAY seconds on. `check()` runs at each
+        poll while jobs are left."""
         end = time.monotonic() + timeout
+        released = set()
         while time.monotonic() < end:
             states = [j for job_id in job_ids for j in self.jobs(job_id)]
             for j in states:
-                if j["JobState"] == "PENDING" and j["Reason"] == "BeginTime" and int(j["Restarts"]) > 0:
-                    self.run("scontrol", "update", f"JobId={j['JobId']}", "StartTime=now")
+                if j["JobState"] == "PENDING" and j["Reason"] == "BeginTime" and int(j["Restarts"]) > 0 \
+                        and (j["JobId"], j["Restarts"]) not in released:
+                    released.add((j["JobId"], j["Restarts"]))
+                    self.run("scontrol", "update", f"JobId={j['JobId']}", f"StartTime=now+{RELEASE_DELAY}")
             if all(j["JobState"] in FINISHED for j in states):
                 return states
             if check is not None:
