@@ -37,7 +37,7 @@ class ArkPair(NamedTuple):
                 _fractions(self.bhat))
 
     def kernel_arrays(self):
-        """What `_ark_step` takes: c, A_E, A_I left of the diagonal, b, b - bhat (float arrays), gamma.
+        """What `ark_step` takes: c, A_E, A_I left of the diagonal, b, b - bhat (float arrays), gamma.
 
         b - bhat is the difference of the rounded weights, so that the error
         estimate is exactly the difference of the two solutions as computed.

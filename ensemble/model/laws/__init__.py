@@ -117,7 +117,7 @@ def onset_delay(law, force, psi, nu):
 
 
 def implicit_state(law, W, act, na, hg):
-    """The implicit stage of the state of the active blocks (steppers._ark_step)."""
+    """The implicit stage of the state of the active blocks (steppers.ark_step)."""
 
 
 def stiff_limit(law, rate_limit):
