@@ -89,16 +89,12 @@ def _parser():
 
 
 def _compare(args):
-    from .compare import Options, compare, write
+    from .compare import Options, check_output, compare, write
     opt = Options(args.n_large, args.n_min, args.window, args.bootstrap, args.level, args.blocks, args.seed)
     command = "python -m analysis compare " + " ".join(
         [str(c) for c in args.catalogs] + ["-o", args.output]
         + [f"--{k.replace('_', '-')} {v}" for k, v in opt.__dict__.items() if v != getattr(Options, k)])
-    if not args.force:   # before the work (write checks again)
-        taken = [n for n in ("comparison.md", "comparison.json") if os.path.exists(os.path.join(args.output, n))]
-        if taken:
-            raise FileExistsError(f"{os.path.join(args.output, taken[0])} exists (use --force to overwrite "
-                                  "the comparison)")
+    check_output(args.output, args.force)   # before the work
     for path in write(compare(args.catalogs, opt), opt, args.output, command, force=args.force):
         print(f"wrote {path}")
     return 0

@@ -266,14 +266,21 @@ def table(points, opt, command):
     return "\n".join(lines) + "\n"
 
 
+OUTPUTS = ("comparison.md", "comparison.json", "size.png", "magnitude.png", "recurrence.png")
+
+
+def check_output(out_dir, force):
+    """Refuse to overwrite a comparison in out_dir unless forced (before the work, and when writing)."""
+    taken = [n for n in OUTPUTS if os.path.exists(os.path.join(out_dir, n))]
+    if taken and not force:
+        raise FileExistsError(f"{os.path.join(out_dir, taken[0])} exists (use --force to overwrite the comparison)")
+
+
 def write(points, opt, out_dir, command, force=False):
     """comparison.md, comparison.json, size.png, magnitude.png, recurrence.png in out_dir."""
     from .compare_plot import figures
-    names = ["comparison.md", "comparison.json", "size.png", "magnitude.png", "recurrence.png"]
+    check_output(out_dir, force)
     os.makedirs(out_dir, exist_ok=True)
-    taken = [n for n in names if os.path.exists(os.path.join(out_dir, n))]
-    if taken and not force:
-        raise FileExistsError(f"{os.path.join(out_dir, taken[0])} exists (use --force to overwrite the comparison)")
     with open(os.path.join(out_dir, "comparison.md"), "w") as f:
         f.write(table(points, opt, command))
     numbers = [{"label": p["label"], "law": p["law"], "method": p["method"], "units": p["units"],
@@ -282,4 +289,4 @@ def write(points, opt, out_dir, command, force=False):
     with open(os.path.join(out_dir, "comparison.json"), "w") as f:
         json.dump({"options": opt.__dict__, "points": numbers}, f, indent=1)
     figures(points, opt, out_dir)
-    return [os.path.join(out_dir, n) for n in names]
+    return [os.path.join(out_dir, n) for n in OUTPUTS]
