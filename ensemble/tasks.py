@@ -48,6 +48,31 @@ def initial_state(cfg, task):
     return force, psi
 
 
+# second spawn-key entry of a branch's perturbation stream: task k draws its perturbation from
+# SeedSequence(run.seed, spawn_key=(k, BRANCH_STREAM)), independent of its own initial-state stream (k,)
+BRANCH_STREAM = 1
+
+
+def spinup_task(tasks, point):
+    """The task whose initial state the spin-up of `point` starts from: the point's seed 0, so that
+    an unperturbed branch records exactly what that task records without branching."""
+    return next(t for t in tasks if t.point == point and t.seed_index == 0)
+
+
+def branch_rng(cfg, task):
+    """The generator of a branch's perturbation (not of its initial state)."""
+    return np.random.default_rng(np.random.SeedSequence(cfg.run.seed, spawn_key=(task.index, BRANCH_STREAM)))
+
+
+def perturb(force, perturbation, rng):
+    """Forces lowered by independent amounts uniform in [0, perturbation) (model force units).
+
+    Lowering keeps every block at rest below its threshold, so a spun-up state between events
+    stays one; perturbation = 0 leaves the state exactly as it was.
+    """
+    return force - perturbation * rng.random(len(force))
+
+
 def describe(tasks):
     """One line per task for `validate`."""
     return [f"task {t.index}: point {t.point} seed {t.seed_index} "
