@@ -11,8 +11,12 @@ killed at any moment leaves a file whose metadata is intact.
 
     /events/*       one row per event; task k owns rows [k * E, (k + 1) * E), E = events_per_task
     /tasks/*        one row per task: its parameters, committed count, provenance, status
-    /checkpoint/*   per task two slots of its state and a commit row for each
-    attributes of /: config (resolved TOML text), version, format, events_per_task, transient,
+    /checkpoint/*   per task two slots of its state and a commit row for each; with run.branch
+                    then per parameter point its spin-up's (record n_tasks + point)
+    /spinup/*       with run.branch only: one row per point's spin-up (whose state its tasks branch from)
+    attributes of /: config (resolved TOML text), version, format, events_per_task, transient
+                    (events each task discards: run.transient, or with run.branch run.decorrelation),
+                    spinup (with run.branch only: events of each spin-up, run.transient),
                     software (MPI, HDF5, versions and writer of the run that created it)
 
 Every dataset is a line of the table DATASETS below (unit, shape, meaning; printed at the end of
@@ -45,6 +49,7 @@ import numpy as np
 from . import __version__
 from .config import LAW_KEYS, ConfigError
 from .model import laws
+from .tasks import spinups as spinup_points
 from .integrity import EventCrc, commit_crc, crc, event_problems
 
 FORMAT = "bk-catalog-3"
@@ -106,12 +111,19 @@ DATASETS = {
     "tasks/error": ("text", _TASK_ROWS, f"why a failed task failed, empty otherwise (UTF-8, {TEXT_BYTES} bytes at most)"),
     "tasks/integrator": ("text", _TASK_ROWS, "the task's [integrator] as TOML (a failed task may be rerun "
                                              f"with another; UTF-8, {TEXT_BYTES} bytes at most)"),
-    "checkpoint/state": ("mixed", "(sum over tasks of 2 (4 N + 2),)",
+    "tasks/branch_of": ("index", _TASK_ROWS, "the spin-up (row of /spinup, = its point) whose state the task "
+                                             "started from, perturbed (run.branch); -1: its own initial state"),
+    "spinup/point": ("index", "(points,)", "parameter point of the spin-up (run.branch only)"),
+    "spinup/spawn_key": ("index", "(points,)", "the task whose initial state the spin-up started from (its "
+                                                "point's seed 0); it ran run.transient events from there"),
+    "spinup/N": ("count", "(points,)", "number of blocks of the spin-up's chain"),
+    "checkpoint/state": ("mixed", "(sum over tasks, then spin-ups, of 2 (4 N + 2),)",
                          "per task two slots of [force (N, model force), psi = ln theta (N), since (2N, model "
                          "time), clock (2, model time)]: block i's force and psi hold at the two-float time "
                          "(since[2i], since[2i+1]); clock = (hi, lo) now"),
-    "checkpoint/offset": ("index", _TASK_ROWS, "start of each task's two slots in /checkpoint/state"),
-    "checkpoint/commit": ("count, CRC-32", "(tasks, 2 slots, 6)",
+    "checkpoint/offset": ("index", "(tasks + spin-ups,)", "start of each task's (then spin-up's) two slots in "
+                                                          "/checkpoint/state"),
+    "checkpoint/commit": ("count, CRC-32", "(tasks + spin-ups, 2 slots, 6)",
                           "per task and slot: [sequence, events done incl. transient, events written, CRC of "
                           "the state slot, CRC of the written events, CRC of the row]; the valid row with the "
                           "highest sequence is the task's truth"),
@@ -247,17 +259,24 @@ class _Layout:
             self.per_task = int(h5.attrs["events_per_task"])
             self.transient = int(h5.attrs["transient"])
             self.n_blocks = self.tasks["N"][...]
+            # spin-ups (run.branch): records n_tasks + point of /checkpoint, after the tasks'
+            self.spinup_events = int(h5.attrs.get("spinup", 0))
+            self.spinup = {name: ds[...] for name, ds in h5["spinup"].items()} if "spinup" in h5 else {}
         except (KeyError, OSError, ValueError) as err:
             raise CatalogError(f"{self.path}: damaged catalog ({err})") from None
-        n_tasks = len(self.offset)
-        sizes = 2 * (4 * self.n_blocks + 2)
-        if (self.commit.shape != (n_tasks, 2, NCOMMIT) or len(self.n_blocks) != n_tasks
+        n_tasks = len(self.n_blocks)
+        self.record_blocks = np.concatenate([self.n_blocks, self.spinup.get("N", np.zeros(0, np.int64))])
+        n_records = len(self.record_blocks)
+        sizes = 2 * (4 * self.record_blocks + 2)
+        if (self.commit.shape != (n_records, 2, NCOMMIT) or len(self.offset) != n_records
                 or any(ds.shape[0] != n_tasks * self.per_task for ds in self.events.values())
-                or np.any(self.n_blocks < 2) or self.per_task < 1 or self.transient < 0
+                or np.any(self.record_blocks < 2) or self.per_task < 1 or self.transient < 0
+                or self.spinup_events < 0 or (self.spinup_events > 0) != bool(self.spinup)
                 or np.any(self.offset != np.concatenate([[0], np.cumsum(sizes)[:-1]]))
                 or self.state.shape[0] != int(sizes.sum())):
             raise CatalogError(f"{self.path}: damaged catalog (its datasets do not fit together)")
         self.n_tasks = n_tasks
+        self.n_records = n_records
         self._crc = {}    # task -> EventCrc of its rows written so far (on the writing process)
         self._head = {}   # task -> Head in use (on the writing process)
 
@@ -269,11 +288,14 @@ class _Layout:
         the metadata does not change after creation, which lets readers read while a run writes).
         """
         rows = len(tasks) * cfg.run.events
+        spinups = spinup_points(cfg, tasks)
         h5.attrs["config"] = cfg.to_toml()
         h5.attrs["version"] = __version__
         h5.attrs["format"] = FORMAT
         h5.attrs["events_per_task"] = cfg.run.events
-        h5.attrs["transient"] = cfg.run.transient
+        h5.attrs["transient"] = cfg.run.discarded
+        if spinups:
+            h5.attrs["spinup"] = cfg.run.transient
         h5.attrs["software"] = software
         ev = h5.create_group("events")
         for name, dtype in EVENT_FIELDS.items():
@@ -295,17 +317,24 @@ class _Layout:
         tg.create_dataset("status", data=np.full(len(tasks), OPEN, dtype=np.int64))
         tg.create_dataset("error", shape=(len(tasks),), dtype=f"S{TEXT_BYTES}")
         tg.create_dataset("integrator", data=np.full(len(tasks), _text(integrator_text), dtype=f"S{TEXT_BYTES}"))
-        sizes = np.array([2 * _state_size(t.model.N) for t in tasks], dtype=np.int64)
+        tg.create_dataset("branch_of", data=np.array([t.point if spinups else -1 for t in tasks], dtype=np.int64))
+        if spinups:
+            sg = h5.create_group("spinup")
+            sg.create_dataset("point", data=np.array([t.point for t in spinups], dtype=np.int64))
+            sg.create_dataset("spawn_key", data=np.array([t.index for t in spinups], dtype=np.int64))
+            sg.create_dataset("N", data=np.array([t.model.N for t in spinups], dtype=np.int64))
+        sizes = np.array([2 * _state_size(t.model.N) for t in list(tasks) + spinups], dtype=np.int64)
         offset = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
         cp = h5.create_group("checkpoint")
         cp.create_dataset("state", shape=(int(sizes.sum()),), dtype=np.float64, fillvalue=np.nan,
                           dcpl=_early_allocation())
         cp.create_dataset("offset", data=offset)
-        cp.create_dataset("commit", data=np.zeros((len(tasks), 2, NCOMMIT), dtype=np.int64))
+        cp.create_dataset("commit", data=np.zeros((len(sizes), 2, NCOMMIT), dtype=np.int64))
         # metadata, written once here like the rest of the layout; under mpio every rank runs
         # this with the same values in the same order, as attribute writes are collective
         for name, entry in DATASETS.items():
-            h5[name].attrs["description"] = description(entry)
+            if name in h5:    # /spinup only with run.branch
+                h5[name].attrs["description"] = description(entry)
 
     def _fail(self, task, what):
         return CatalogError(f"{self.path}: task {task}: {what} (corrupt catalog)")
@@ -323,7 +352,9 @@ class _Layout:
             if row[C_ROW_CRC] != commit_crc(task, slot, row[:C_ROW_CRC]):
                 raise self._fail(task, f"commit row {slot} fails its checksum")
             seq, done, written = row[C_SEQ], row[C_DONE], row[C_WRITTEN]
-            if not (seq >= 1 and 0 <= written <= self.per_task and written == max(0, done - self.transient)):
+            # a spin-up records nothing: it is done after spinup_events
+            limit, discarded = (self.per_task, self.transient) if task < self.n_tasks else (0, self.spinup_events)
+            if not (seq >= 1 and 0 <= written <= limit and written == max(0, done - discarded)):
                 raise self._fail(task, f"commit row {slot} out of range (sequence {seq}, done {done}, "
                                        f"written {written})")
             if best is not None and best.seq == seq:
@@ -372,7 +403,7 @@ class _Layout:
                 return stop.value
 
     def read_state(self, task, head):
-        size = _state_size(int(self.n_blocks[task]))
+        size = _state_size(int(self.record_blocks[task]))
         lo = self.offset[task] + head.slot * size
         flat = self.state[lo:lo + size]
         if crc(flat) != head.state_crc:
@@ -388,9 +419,12 @@ class _Layout:
         """
         head = self.head(task)
         self._head[task] = head
-        rec = TaskRecord(status=int(self.tasks["status"][task]),
-                         integrator=self.tasks["integrator"][task].decode(errors="replace"),
-                         error=self.tasks["error"][task].decode(errors="replace"))
+        if task >= self.n_tasks:     # a spin-up: only its state
+            rec = TaskRecord()
+        else:
+            rec = TaskRecord(status=int(self.tasks["status"][task]),
+                             integrator=self.tasks["integrator"][task].decode(errors="replace"),
+                             error=self.tasks["error"][task].decode(errors="replace"))
         if rec.status not in STATUS_NAMES:
             raise self._fail(task, f"status {rec.status} out of range")
         if head is None or restart:
@@ -437,7 +471,8 @@ class _Layout:
         row = np.array(fields + [commit_crc(task, slot, fields)], dtype=np.int64)
         self._write(task, "commit row", lambda: self.commit.__setitem__((task, slot), row))
         self._head[task] = Head(slot, seq, checkpoint.done, written, fields[3], fields[4])
-        self._write(task, "event count", lambda: self.tasks["events_written"].__setitem__(task, written))
+        if task < self.n_tasks:    # (a spin-up records no events)
+            self._write(task, "event count", lambda: self.tasks["events_written"].__setitem__(task, written))
         self.barrier()
 
     def write_provenance(self, task, values):

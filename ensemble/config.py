@@ -68,16 +68,27 @@ Model.__module__ = __name__
 # N = 800, 0.3-0.6 per block at N = 1600; benchmarks/transient.py, docs/benchmarks.md); 10 is eight
 # times the longest.
 TRANSIENT_PER_BLOCK = 10
+# run.decorrelation's default (events): two branches of one spun-up state become as different as two
+# independent chains within DECORRELATION_MEASURED events (benchmarks/decorrelation.py); twice that
+DECORRELATION = 2000
 
 
 @dataclass(frozen=True)
 class Run:
     seeds: int = 1             # realisations per parameter point
     events: int = 200000       # events recorded per task
-    transient: int = None      # events discarded at the start of each task (default TRANSIENT_PER_BLOCK N)
+    transient: int = None      # events discarded at the start of each task, or of each spin-up (default TRANSIENT_PER_BLOCK N)
     seed: int = 0              # root seed: task k uses SeedSequence(seed, spawn_key=(k,))
     init_stress: float = 1.0   # initial forces are uniformly spread this far below threshold
     poll_seconds: float = 0.25  # kernel calls last about this long between MPI polls
+    branch: bool = False       # spin each point up once (run.transient events), start its seeds from that state
+    perturbation: float = 1e-6  # branch: each block's force is lowered by a uniform [0, this) (model force)
+    decorrelation: int = None  # branch: events each seed discards after the branch point (default DECORRELATION)
+
+    @property
+    def discarded(self):
+        """Events each task runs before it records: the transient, or after branching the decorrelation stretch."""
+        return self.decorrelation if self.branch else self.transient
 
 
 @dataclass(frozen=True)
@@ -109,6 +120,8 @@ _RULES = {
     ("run", "transient"): (_nonneg, "an integer >= 0"),
     ("run", "seed"): (_nonneg, "an integer >= 0"),
     ("run", "init_stress"): (_positive, "> 0"),
+    ("run", "perturbation"): (_nonneg, ">= 0"),
+    ("run", "decorrelation"): (_nonneg, "an integer >= 0"),
     ("integrator", "dt"): (lambda x: 0 < x <= 1, "in (0, 1]"),
     ("integrator", "max_duration"): (_positive, "> 0"),
     ("integrator", "rtol"): (lambda x: 0 < x < 1, "in (0, 1)"),
@@ -134,10 +147,13 @@ class Config:
     output: Output = field(default_factory=Output)
 
     def __post_init__(self):
-        """Resolve run.transient left out: TRANSIENT_PER_BLOCK events per block of the largest N."""
+        """Resolve run.transient left out (TRANSIENT_PER_BLOCK events per block of the largest N) and
+        run.decorrelation left out (DECORRELATION)."""
         if self.run.transient is None:
             largest = max(int(n) for n in _values(self, "model.N")[1])
             object.__setattr__(self, "run", dataclasses.replace(self.run, transient=TRANSIENT_PER_BLOCK * largest))
+        if self.run.decorrelation is None:
+            object.__setattr__(self, "run", dataclasses.replace(self.run, decorrelation=DECORRELATION))
 
     def to_toml(self):
         """The resolved config as TOML text (stored in every catalog)."""
@@ -177,7 +193,10 @@ def _coerce(section, key, value, typ, where=None):
     where: the name the message gives the value (default section.key; sweep.KEY for a swept one).
     """
     where = where or f"{section}.{key}"
-    if typ is float:
+    if typ is bool:
+        if not isinstance(value, bool):
+            raise ConfigError(f"{where} must be true or false, got {value!r}")
+    elif typ is float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise ConfigError(f"{where} must be a number, got {value!r}")
         try:

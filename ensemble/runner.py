@@ -9,11 +9,12 @@ import os
 import sys
 import time
 import tomllib
+from dataclasses import dataclass
 
 import numpy as np
 
 from . import catalog, environment
-from .catalog import FAILED, FINISHED, Checkpoint, CatalogError
+from .catalog import FAILED, FINISHED, OPEN, Checkpoint, CatalogError
 from .config import ConfigError, from_dict, loads, section_lines
 from .integrators import kernel_params
 from .lock import RunLock
@@ -21,7 +22,7 @@ from .model.chain import simulate
 from .model.workspace import (D_DURATION, D_FIRST, D_LAST, D_NSLIP, D_SLIP, NDIAG, OK, PAUSED,
                               STATUS_TEXT, UNLIMITED, Workspace)
 from .parallel import Coordinator
-from .tasks import initial_state, task_list
+from .tasks import Task, branch_rng, initial_state, perturb, spinups, task_list
 
 EXIT_INTERRUPTED = 75   # checkpointed after a signal; continue with --resume (EX_TEMPFAIL)
 EXIT_FAILED = 1         # some tasks failed (recorded in the catalog); the others finished
@@ -41,12 +42,40 @@ class SimulationError(RuntimeError):
     """A task that cannot go on; the message names the task and the event."""
 
 
+@dataclass(frozen=True)
+class Spin:
+    """A point's spin-up to run (or read) before its tasks branch (run.branch)."""
+    point: int
+    task: Task      # whose initial state it starts from (tasks.spinup_task)
+    rerun: bool     # its point's tasks all failed: a spin-up not finished failed, rerun it with `rerun`
+
+
+def spins_needed(cfg, tasks, stored=None, rerun=None):
+    """The spin-ups a run needs: those of the points with a task still to start from its branch point.
+
+    stored: the catalog's tasks (catalog.read_tasks) when resuming, None for a new run.
+    """
+    needed = []
+    for spin in spinups(cfg, tasks):
+        mine = [t.index for t in tasks if t.point == spin.point]
+        if stored is None:
+            needed.append(Spin(spin.point, spin, False))
+            continue
+        status, done = stored["status"][mine], stored["events_done"][mine]
+        failed = status == FAILED
+        if np.any((status == OPEN) & (done == 0)) or (rerun is not None and np.any(failed)):
+            needed.append(Spin(spin.point, spin, bool(np.all(failed))))
+    return needed
+
+
 class Trajectory:
     """One task's chain between events: its workspace, clock and event counter."""
 
-    def __init__(self, cfg, task, checkpoint=None, integrator=None):
+    def __init__(self, cfg, task, checkpoint=None, integrator=None, label=None, discarded=None):
         self.cfg = cfg
         self.task = task
+        self.label = f"task {task.index}" if label is None else label     # in error messages
+        self.discarded = cfg.run.discarded if discarded is None else discarded
         self.integrator = cfg.integrator if integrator is None else integrator
         self.ws = Workspace(task.model.N)
         if checkpoint is None:
@@ -81,8 +110,8 @@ class Trajectory:
         status, k = simulate(ws.arrays, self.clock, self.params, n, budget, t, epicenter, diag)
         if status not in (OK, PAUSED):
             where = self.done + k
-            phase = "transient " if where < self.cfg.run.transient else ""
-            raise SimulationError(f"task {self.task.index} {phase}event {where}: {STATUS_TEXT[status]} "
+            phase = "transient " if where < self.discarded else ""
+            raise SimulationError(f"{self.label} {phase}event {where}: {STATUS_TEXT[status]} "
                                   f"(method={self.integrator.method}, dt={self.integrator.dt}, "
                                   f"rtol={self.integrator.rtol})")
         self.done += k
@@ -167,6 +196,8 @@ class TaskRunner:
         self.rerun = rerun
         self.failed = []      # (task index, message) of the tasks that failed on this rank
         self.io_time = 0.0    # seconds spent handing events and checkpoints to the writer
+        self.spun = {}        # run.branch: point -> its spun-up state (Checkpoint), once all are known
+        self.spin_failed = {}  # run.branch: point -> why its spin-up failed in this run
 
     def run(self, task):
         """Returns True if the task finished or failed, False if a stop request interrupted it."""
@@ -188,36 +219,94 @@ class TaskRunner:
         """(Trajectory, events written) to continue, or None if there is nothing to do."""
         cfg = self.cfg
         where = f"task {task.index}"
+        if cfg.run.branch and task.point in self.spin_failed:
+            return None     # recorded as failed (and counted) by the rank that spun its point up
         rec = self.writer.record(task.index)
         if rec.status == FAILED:
-            if self.rerun is None:
+            if self.rerun is None or (cfg.run.branch and task.point not in self.spun):
                 self.failed.append((task.index, rec.error))
                 return None
             rec = self.writer.record(task.index, restart=True)
             self.writer.start(task.index, integrator_text(self.rerun))
-            return Trajectory(cfg, task, None, self.rerun), 0
+            return Trajectory(cfg, task, self._start(task), self.rerun), 0
         if rec.checkpoint is not None:
             self.coord.count_events(rec.checkpoint.done, resumed=True)
         if rec.written >= cfg.run.events:
             if rec.status != FINISHED:   # stopped between its last commit and the finish record
                 self.writer.finish(task.index, {})
             return None
-        return Trajectory(cfg, task, rec.checkpoint, parse_integrator(rec.integrator, where)), rec.written
+        checkpoint = rec.checkpoint if rec.checkpoint is not None else self._start(task)
+        return Trajectory(cfg, task, checkpoint, parse_integrator(rec.integrator, where)), rec.written
+
+    def _start(self, task):
+        """The state a task starts from: None (its own initial state), or after branching its point's
+        spun-up state with the task's own perturbation."""
+        if not self.cfg.run.branch:
+            return None
+        spun = self.spun[task.point]
+        force = perturb(spun.force, self.cfg.run.perturbation, branch_rng(self.cfg, task))
+        return Checkpoint(force, spun.psi.copy(), spun.since.copy(), spun.clock.copy(), 0)
 
     def _run(self, task):
-        cfg = self.cfg
         taken = self._take_up(task)
         if taken is None:
             self.coord.task_done()
             return True
         traj, written = taken
-        total = cfg.run.transient + cfg.run.events
+        wall = time.perf_counter()
+        rate = self._integrate(task.index, traj, written, self.cfg.run.events)
+        if rate is None:
+            return False
+        self.writer.finish(task.index, {
+            "rank": self.coord.rank, "wall_time": time.perf_counter() - wall,
+            "events_per_second": rate, "seed_entropy": self.cfg.run.seed, "spawn_key": task.index})
+        self.coord.task_done()
+        return True
+
+    def spin_up(self, spin, tasks):
+        """Spin up a point (or read its finished spin-up): its state after run.transient events
+        (Checkpoint), the error message if it failed (its point's tasks are then recorded as failed),
+        or None if a stop request interrupted it (checkpointed). spin: the Spin; tasks: all tasks."""
+        cfg = self.cfg
+        record = len(tasks) + spin.point
+        rec = self.writer.record(record)
+        if rec.checkpoint is not None and rec.checkpoint.done >= cfg.run.transient:
+            self.coord.task_done()
+            return rec.checkpoint
+        integrator = cfg.integrator
+        if spin.rerun and self.rerun is not None:   # it failed: from its start with the rerun's integrator
+            rec, integrator = self.writer.record(record, restart=True), self.rerun
+        if rec.checkpoint is not None:
+            self.coord.count_events(rec.checkpoint.done, resumed=True)
+        traj = Trajectory(cfg, spin.task, rec.checkpoint, integrator, label=f"spin-up of point {spin.point}",
+                          discarded=cfg.run.transient)
+        try:
+            if self._integrate(record, traj, 0, 0) is None:
+                return None
+        except SimulationError as err:
+            message = str(err)
+            for task in tasks:
+                if task.point == spin.point:
+                    self.writer.fail(task.index, message)
+                    self.failed.append((task.index, message))
+            print(f"error: rank {self.coord.rank}: {message}; the tasks of point {spin.point} are recorded "
+                  f"as failed, the others go on", file=sys.stderr, flush=True)
+            self.coord.task_done()
+            return message
+        self.coord.task_done()
+        return traj.checkpoint()
+
+    def _integrate(self, record, traj, written, events):
+        """Integrate a trajectory until it has recorded `events` after its `traj.discarded`, committing
+        to catalog record `record` as it goes; its recorded events per second of kernel time, or
+        None if a stop request interrupted it (checkpointed)."""
+        cfg = self.cfg
+        total = traj.discarded + events
         buffer = []
         buffered = 0
         chunk = 4
         budget = FIRST_BUDGET
-        wall = time.perf_counter()
-        last_flush = wall
+        last_flush = time.perf_counter()
         record_time = 0.0
         recorded_here = 0
 
@@ -226,7 +315,7 @@ class TaskRunner:
             start = time.perf_counter()
             batch = ({name: np.concatenate([b[name] for b in buffer]) for name in buffer[0]}
                      if buffer else None)
-            self.writer.commit(task.index, written, batch, traj.checkpoint())
+            self.writer.commit(record, written, batch, traj.checkpoint())
             written += buffered
             buffer, buffered = [], 0
             last_flush = time.perf_counter()
@@ -235,10 +324,10 @@ class TaskRunner:
         while traj.done < total:
             if self.coord.poll():
                 flush()
-                return False
+                return None
             self.writer.poll()
-            recording = traj.done >= cfg.run.transient
-            phase_left = (total if recording else cfg.run.transient) - traj.done
+            recording = traj.done >= traj.discarded
+            phase_left = (total if recording else traj.discarded) - traj.done
             n = min(chunk, phase_left, cfg.output.batch - buffered)
             t0 = time.perf_counter()
             out = traj.advance(n, budget)
@@ -255,19 +344,14 @@ class TaskRunner:
             if recording and k:
                 record_time += elapsed
                 recorded_here += k
-                buffer.append(event_rows(task, *out))
+                buffer.append(event_rows(traj.task, *out))
                 buffered += k
             now = time.perf_counter()
             if buffered >= cfg.output.batch or now - last_flush >= cfg.output.flush_seconds:
                 flush()
             self.progress.maybe_print()
         flush()
-        self.writer.finish(task.index, {
-            "rank": self.coord.rank, "wall_time": time.perf_counter() - wall,
-            "events_per_second": recorded_here / max(record_time, 1e-9),
-            "seed_entropy": cfg.run.seed, "spawn_key": task.index})
-        self.coord.task_done()
-        return True
+        return recorded_here / max(record_time, 1e-9)
 
 
 def config_differences(stored_text, cfg, sections=("model", "run", "integrator")):
@@ -298,7 +382,8 @@ def _check_output(path):
 
 
 def _prepare(cfg, path, resume, force, rerun=None):
-    """Rank 0's decision about the files (under the run's lock); returns (mode, message) or raises.
+    """Rank 0's decision about the files (under the run's lock); returns (mode, message, spin-ups
+    to run) or raises.
 
     rerun: the failed tasks are to be rerun with this [integrator] (which may differ from the stored one).
     """
@@ -312,7 +397,7 @@ def _prepare(cfg, path, resume, force, rerun=None):
                 if diffs:
                     raise ConfigError(f"{final}: --resume with a different config ({'; '.join(diffs)}); "
                                       f"the catalog is complete")
-                return "complete", f"{final} is complete; nothing to resume"
+                return "complete", f"{final} is complete; nothing to resume", []
             raise Refused(f"{partial}: no interrupted run to resume")
         _, tasks, attrs = catalog.read_tasks(partial)
         diffs = config_differences(attrs["config"], cfg, ("model", "run") if rerun else
@@ -322,13 +407,13 @@ def _prepare(cfg, path, resume, force, rerun=None):
         if rerun is not None and not np.any(tasks["status"] == FAILED):
             raise ConfigError(f"{partial}: no failed task to rerun (a changed [integrator] applies to "
                               f"failed tasks only)")
-        return "resume", None
+        return "resume", None, spins_needed(cfg, task_list(cfg), tasks, rerun)
     if os.path.exists(final) and not force:
         raise Refused(f"{final}: catalog exists (use --force to overwrite it)")
     if os.path.exists(partial) and not force:
         raise Refused(f"{partial}: an interrupted run exists (use --resume to continue it, "
                       f"--force to start over)")
-    return "new", None
+    return "new", None, spins_needed(cfg, task_list(cfg))
 
 
 def _kernels_cached():
@@ -379,17 +464,17 @@ def run(cfg, path, comm, resume=False, force=False, log=print, rerun=None, comma
         decision = comm.bcast(decision, root=0)
         if isinstance(decision, Exception):
             raise decision
-        mode, message = decision
+        mode, message, spins = decision
         if mode == "complete":
             say(message)
             return 0
-        return _run_locked(cfg, path, comm, mode, log, say, rerun, lock)
+        return _run_locked(cfg, path, comm, mode, spins, log, say, rerun, lock)
     finally:
         if lock is not None:
             lock.release()
 
 
-def _run_locked(cfg, path, comm, mode, log, say, rerun, lock):
+def _run_locked(cfg, path, comm, mode, spins, log, say, rerun, lock):
     tasks = task_list(cfg)
     n_ranks = comm.Get_size()
     Writer = catalog.choose_writer(cfg.output.writer, comm)
@@ -408,23 +493,24 @@ def _run_locked(cfg, path, comm, mode, log, say, rerun, lock):
     coord = Coordinator(comm, report_seconds=min(max(1.0, comm.Get_size() / 100),
                                                   cfg.output.progress_seconds / 2))
     coord.install_signal_handlers()
-    progress = Progress(coord, len(tasks), len(tasks) * (cfg.run.transient + cfg.run.events),
+    progress = Progress(coord, len(spins) + len(tasks),
+                        len(spins) * cfg.run.transient + len(tasks) * (cfg.run.discarded + cfg.run.events),
                         cfg.output.progress_seconds, log, lock)
     worker = TaskRunner(cfg, writer, coord, progress, rerun)
     try:
-        return _serve(cfg, path, comm, tasks, writer, coord, progress, worker, log, t_start)
+        return _serve(cfg, path, comm, tasks, spins, writer, coord, progress, worker, log, t_start)
     finally:
         # until here a signal only sets a flag that nobody reads once the work is over
         coord.restore_signal_handlers()
 
 
-def _serve(cfg, path, comm, tasks, writer, coord, progress, worker, log, t_start):
+def _serve(cfg, path, comm, tasks, spins, writer, coord, progress, worker, log, t_start):
     rank = comm.Get_rank()
     partial = catalog.partial_path(path)
     try:
         _compile_kernels(cfg, tasks[0], coord, log if rank == 0 else (lambda *a, **k: None))
         progress.restart_clock()
-        busy, idle = _work(tasks, worker, writer, coord, progress)
+        busy, idle = _work(tasks, spins, worker, writer, coord, progress)
     except BaseException as err:
         # with more ranks the caller aborts them all; a broken file is not touched again
         if comm.Get_size() == 1 and not getattr(err, "broken", False):
@@ -434,7 +520,7 @@ def _serve(cfg, path, comm, tasks, writer, coord, progress, worker, log, t_start
     writer.close()   # first: rank 0 may still have to receive rows from the others
     # every rank counted its finished tasks before it could pass the collective close
     done = coord.tasks_done()
-    stopped = done < len(tasks)
+    stopped = done < len(spins) + len(tasks)
     coord.close()
     progress.maybe_print(tasks=done)
     per_rank = comm.gather((busy, idle, coord.rma_wait, worker.io_time), root=0)
@@ -459,21 +545,50 @@ def _serve(cfg, path, comm, tasks, writer, coord, progress, worker, log, t_start
     return EXIT_INTERRUPTED if stopped else (EXIT_FAILED if failed else 0)
 
 
-def _work(tasks, worker, writer, coord, progress):
-    """Take tasks until none is left (or a stop request); returns (busy, idle) seconds."""
-    busy = 0.0
+def _work(tasks, spins, worker, writer, coord, progress):
+    """Take work until none is left (or a stop request): first the spin-ups (run.branch), then, once
+    all are done and their states known on every rank, the tasks. Returns (busy, idle) seconds.
+
+    One counter numbers the work: items [0, len(spins)) are the spin-ups, then the tasks.
+    """
+    busy = idle = 0.0
+    first = len(spins)
+    total = first + len(tasks)
     stopped = coord.poll()
+    mine = {}
+    k = total
     while not stopped:
         k = coord.next_task()
-        if k >= len(tasks):
+        if k >= first:
             break
         t0 = time.perf_counter()
-        stopped = not worker.run(tasks[k])
+        mine[spins[k].point] = state = worker.spin_up(spins[k], tasks)
+        stopped = state is None
         busy += time.perf_counter() - t0
-    # Nothing left to take: keep serving MPI (and rank 0's writer) until all are done.
+    if spins:
+        idle += _wait(first, writer, coord, progress)
+        # one decision for all: a stop seen by some ranks only must not split the collective below
+        if any(coord.comm.allgather(coord.poll())):
+            return busy, idle
+        for part in coord.comm.allgather(mine):
+            for point, state in part.items():
+                (worker.spun if isinstance(state, Checkpoint) else worker.spin_failed)[point] = state
+        stopped = False
+    while not stopped and k < total:
+        t0 = time.perf_counter()
+        stopped = not worker.run(tasks[k - first])
+        busy += time.perf_counter() - t0
+        if not stopped:
+            k = coord.next_task()
+    return busy, idle + _wait(total, writer, coord, progress)
+
+
+def _wait(count, writer, coord, progress):
+    """Keep serving MPI (and rank 0's writer) until `count` items are done or a stop is requested;
+    returns the seconds waited."""
     waited = time.perf_counter()
-    while not coord.poll() and coord.tasks_done() < len(tasks):
+    while not coord.poll() and coord.tasks_done() < count:
         writer.poll()
         progress.maybe_print()
         time.sleep(0.05)
-    return busy, time.perf_counter() - waited
+    return time.perf_counter() - waited

@@ -59,6 +59,15 @@ def spinup_task(tasks, point):
     return next(t for t in tasks if t.point == point and t.seed_index == 0)
 
 
+def spinups(cfg, tasks):
+    """The spin-ups of a run, one per point in point order, each named by the task whose initial
+    state it starts from (spinup_task); none without run.branch. Spin-up p is catalog record
+    len(tasks) + p (after the tasks' records)."""
+    if not cfg.run.branch:
+        return []
+    return [spinup_task(tasks, p) for p in range(max(t.point for t in tasks) + 1)]
+
+
 def branch_rng(cfg, task):
     """The generator of a branch's perturbation (not of its initial state)."""
     return np.random.default_rng(np.random.SeedSequence(cfg.run.seed, spawn_key=(task.index, BRANCH_STREAM)))
