@@ -124,7 +124,9 @@ def write_config(path, **sections):
     for name, values in base.items():
         lines.append(f"[{name}]")
         for k, v in values.items():
-            if isinstance(v, str):
+            if isinstance(v, bool):
+                lines.append(f"{k} = {'true' if v else 'false'}")
+            elif isinstance(v, str):
                 lines.append(f'{k} = "{v}"')
             elif isinstance(v, list):
                 lines.append(f"{k} = {v!r}")

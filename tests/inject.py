@@ -160,6 +160,33 @@ def signal_after_rename(signum):
     runner.os.replace = patched
 
 
+def signal_in_spin_up(signum, point, after_events):
+    """Send this process `signum` once the spin-up of `point` has run `after_events` events."""
+    from ensemble import runner
+    advance = runner.Trajectory.advance
+    sent = [False]
+
+    def patched(self, *args, **kwargs):
+        out = advance(self, *args, **kwargs)
+        if not sent[0] and self.label == f"spin-up of point {point}" and self.done >= after_events:
+            sent[0] = True
+            _signal_self(signum)
+        return out
+    runner.Trajectory.advance = patched
+
+
+def fail_spin_up(point, after_events=1):
+    """Make the spin-up of `point` fail numerically once it has run `after_events` events."""
+    from ensemble import runner
+    advance = runner.Trajectory.advance
+
+    def patched(self, *args, **kwargs):
+        if self.label == f"spin-up of point {point}" and self.done >= after_events:
+            raise runner.SimulationError(f"{self.label} event {self.done}: injected failure")
+        return advance(self, *args, **kwargs)
+    runner.Trajectory.advance = patched
+
+
 def main(argv):
     from ensemble.cli import main as cli_main
     sys.exit(cli_main(argv))
