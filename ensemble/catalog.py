@@ -842,6 +842,10 @@ class Reader:
             self.per_task = self.layout.per_task
             self.tasks = {name: ds[...] for name, ds in self.layout.tasks.items()}
             heads = [self.layout.head(k) for k in range(self.layout.n_tasks)]
+            spun = [self.layout.head(k) for k in range(self.layout.n_tasks, self.layout.n_records)]
+        # run.branch: each point's spin-up, its events done (of attrs["spinup"])
+        self.spinups = {**self.layout.spinup,
+                        "events_done": np.array([0 if h is None else h.done for h in spun], dtype=np.int64)}
         self.tasks["events_written"] = np.array([0 if h is None else h.written for h in heads], dtype=np.int64)
         self.tasks["events_done"] = np.array([0 if h is None else h.done for h in heads], dtype=np.int64)
         n = self.layout.n_tasks
@@ -849,6 +853,7 @@ class Reader:
         self.tasks.setdefault("law", np.full(n, b"aging"))
         for name in LAW_KEYS:
             self.tasks.setdefault(name, np.full(n, np.nan))
+        self.tasks.setdefault("branch_of", np.full(n, -1, dtype=np.int64))   # catalogs before run.branch
         for name in ("error", "integrator", "law"):
             self.tasks[name] = np.array([x.decode(errors="replace") for x in self.tasks[name]])
 

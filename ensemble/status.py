@@ -39,7 +39,8 @@ def summary(path):
     source, state = _state(path)
     if source is None:
         return f"{path}: {state}\n(the catalog is being created)"
-    per_task, tasks, attrs = catalog.read_tasks(source)
+    with catalog.Reader(source) as cat:
+        per_task, tasks, attrs, spinups = cat.per_task, cat.tasks, cat.attrs, cat.spinups
     cfg = loads(attrs["config"])
     failed = np.flatnonzero(tasks["status"] == catalog.FAILED)
     if len(failed) and not state.startswith("running"):
@@ -49,7 +50,7 @@ def summary(path):
     keys = cfg.model.law_keys()     # one law per catalog (model.law is not swept)
     lines.append("task point seed     N " + "".join(f"{k:>8s}" for k in keys)
                  + "   events  recorded    status  rank  events/s")
-    total = cfg.run.transient + cfg.run.events
+    total = cfg.run.discarded + cfg.run.events
     for k in range(len(tasks["point"])):
         written = int(tasks["events_written"][k])
         rate = tasks["events_per_second"][k]
@@ -61,8 +62,12 @@ def summary(path):
     for k in failed:
         lines.append(f"  task {k} failed: {tasks['error'][k]}")
     done = int(np.sum(tasks["status"] == catalog.FINISHED))
-    lines += ["", f"(events: done incl. the transient of {cfg.run.transient}, as of each task's last "
-                  f"checkpoint; of {total} per task)",
+    for point, spun in zip(spinups.get("point", []), spinups["events_done"]):
+        lines.append(f"spin-up of point {point}: {spun}/{cfg.run.transient} events "
+                     f"({'done' if spun >= cfg.run.transient else 'not done'}; its tasks branch from it)")
+    discarded = (f"the decorrelation stretch of {cfg.run.decorrelation} after branching" if cfg.run.branch
+                 else f"the transient of {cfg.run.transient}")
+    lines += ["", f"(events: done incl. {discarded}, as of each task's last checkpoint; of {total} per task)",
               f"tasks finished {done}/{len(tasks['point'])}, events recorded "
               f"{int(tasks['events_written'].sum())}/{len(tasks['point']) * per_task}", "",
               "config:", attrs["config"]]

@@ -21,6 +21,7 @@ from ensemble.config import DECORRELATION, ConfigError, loads
 from .conftest import run_cli, write_config
 from .processes import ROOT, child_env, run_bounded
 from .same_catalogs import assert_same_events
+from .test_export import assert_described, descriptions
 
 TIMEOUT = 180
 SEEDS, EVENTS, SPINUP, DECORRELATE = 3, 150, 120, 40
@@ -89,6 +90,8 @@ def test_branches_differ_and_the_catalog_records_their_branch_point(branched):
         np.testing.assert_array_equal(h5["spinup/point"][...], [0, 1])
         np.testing.assert_array_equal(h5["spinup/spawn_key"][...], [0, SEEDS])   # each point's seed 0
         assert "run.branch" in h5["tasks/branch_of"].attrs["description"]
+    assert_described(d / "full.h5", catalog.DATASETS)
+    assert set(descriptions(d / "full.h5")) == set(catalog.DATASETS)
     with catalog.Reader(d / "full.h5") as cat:
         for point in (0, 1):
             head = cat.layout.head(2 * SEEDS + point)
@@ -134,6 +137,8 @@ def test_interrupt_during_a_spin_up_resumes_to_the_uninterrupted_catalog(branche
     out = tmp_path / "spin.h5"
     done = interrupted_spin_up(ranks, out, cfg)
     assert 0 < done[1] < SPINUP        # checkpointed in the middle of the spin-up of point 1
+    status = run_cli("status", out)
+    assert f"spin-up of point 1: {done[1]}/{SPINUP} events (not done" in status.stdout, status.stdout
     res = mpirun(2, "resume", out) if ranks else run_cli("resume", out)
     assert res.returncode == 0, res.stderr
     assert_same_events(d / "full.h5", out)

@@ -113,7 +113,8 @@ def test_rendered_scripts_are_complete_and_valid_bash(tmp_path, kind):
 
 
 def test_array_elements_are_standalone_configs_one_per_point(tmp_path):
-    cfg = load(tiny_config(tmp_path / "tiny.toml", sweep={"b": [20.0, 30.0, 40.0]}, run={"seed": 7}))
+    cfg = load(tiny_config(tmp_path / "tiny.toml", sweep={"b": [20.0, 30.0, 40.0]},
+                           run={"seed": 7, "branch": True, "decorrelation": 30}))
     out = render(cfg, JobOptions(kind="array", ntasks=2, time="10", array_limit=2), tmp_path / "job")
     assert "#SBATCH --array=0-2%2" in out.run_script.read_text()
     assert [c.name for c in out.catalogs] == ["point-0000.h5", "point-0001.h5", "point-0002.h5"]
@@ -122,6 +123,8 @@ def test_array_elements_are_standalone_configs_one_per_point(tmp_path):
         sub = load(out.directory / "points" / f"point-{i:04d}.toml")
         assert sub.sweep == () and sub.model.b == b and sub.run.seeds == 2
         assert sub.run.seed == element_seed(7, i) and sub.output.path == str(out.catalogs[i])
+        # an element branches its seeds from its own spin-up, as the point would in one run
+        assert sub.run.branch and sub.run.decorrelation == 30 and sub.run.transient == 20
         seeds.add(sub.run.seed)
     assert len(seeds) == 3
     # the reduction merges the elements' catalogs into one summary of the sweep, named after the config
