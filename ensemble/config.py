@@ -68,9 +68,11 @@ Model.__module__ = __name__
 # N = 800, 0.3-0.6 per block at N = 1600; benchmarks/transient.py, docs/benchmarks.md); 10 is eight
 # times the longest.
 TRANSIENT_PER_BLOCK = 10
-# run.decorrelation's default (events): two branches of one spun-up state become as different as two
-# independent chains within DECORRELATION_MEASURED events (benchmarks/decorrelation.py); twice that
-DECORRELATION = 2000
+# run.decorrelation's default, in events per block of the longest chain of the sweep: two branches of
+# one spun-up state are as different as two independent chains after at most 0.30 events per block
+# (220 events at N = 800, b = 50; median 0.1-0.15; benchmarks/decorrelation.py, docs/benchmarks.md);
+# 1 is 3.3 times the longest.
+DECORRELATION_PER_BLOCK = 1
 
 
 @dataclass(frozen=True)
@@ -83,7 +85,7 @@ class Run:
     poll_seconds: float = 0.25  # kernel calls last about this long between MPI polls
     branch: bool = False       # spin each point up once (run.transient events), start its seeds from that state
     perturbation: float = 1e-6  # branch: each block's force is lowered by a uniform [0, this) (model force)
-    decorrelation: int = None  # branch: events each seed discards after the branch point (default DECORRELATION)
+    decorrelation: int = None  # branch: events each seed discards after the branch point (default 1 N)
 
     @property
     def discarded(self):
@@ -147,13 +149,14 @@ class Config:
     output: Output = field(default_factory=Output)
 
     def __post_init__(self):
-        """Resolve run.transient left out (TRANSIENT_PER_BLOCK events per block of the largest N) and
-        run.decorrelation left out (DECORRELATION)."""
+        """Resolve run.transient and run.decorrelation left out: TRANSIENT_PER_BLOCK and
+        DECORRELATION_PER_BLOCK events per block of the largest N."""
+        largest = max(int(n) for n in _values(self, "model.N")[1])
         if self.run.transient is None:
-            largest = max(int(n) for n in _values(self, "model.N")[1])
             object.__setattr__(self, "run", dataclasses.replace(self.run, transient=TRANSIENT_PER_BLOCK * largest))
         if self.run.decorrelation is None:
-            object.__setattr__(self, "run", dataclasses.replace(self.run, decorrelation=DECORRELATION))
+            object.__setattr__(self, "run", dataclasses.replace(
+                self.run, decorrelation=DECORRELATION_PER_BLOCK * largest))
 
     def to_toml(self):
         """The resolved config as TOML text (stored in every catalog)."""

@@ -90,6 +90,71 @@ def test_statistics_tiny(tmp_path):
         assert np.isfinite(band["mean"]) and 0 <= band["min"] <= band["mean"] <= band["max"]
 
 
+def brute_recurrences(t, epicenter, mu, mu_c=4.0, window=10):
+    """Local recurrence times by their definition, O(n^2): for each large event the time to the
+    next large one with its epicenter within `window` blocks (none if there is no such event)."""
+    large = np.flatnonzero(mu >= mu_c)
+    T = []
+    for i in large:
+        later = [j for j in large if j > i and abs(epicenter[j] - epicenter[i]) <= window]
+        if later:
+            T.append(t[later[0]] - t[i])
+    return np.array(T)
+
+
+def test_statistics_from_catalogs(tmp_path, capsys):
+    from ensemble import catalog
+    from .conftest import run_cli, write_config
+    cfg = write_config(tmp_path / "c.toml", model={"N": 30}, sweep={"b": [20.0, 50.0]},
+                       run={"events": 300, "transient": 50, "seeds": 2}, integrator={"method": "ark4"})
+    ref, cand, other = tmp_path / "ref.h5", tmp_path / "cand.h5", tmp_path / "other.h5"
+    for out, sets in ((ref, ["integrator.rtol=1e-6", "run.seed=1"]), (cand, ["integrator.rtol=1e-3"]),
+                      (other, ["model.N=20", "run.events=30", "run.transient=10"])):
+        assert run_cli("run", cfg, "-o", out, *[a for s in sets for a in ("--set", s)]).returncode == 0
+    # the reference is also a candidate: its distance to itself is 0
+    data = statistics.main(["--catalogs", str(ref), str(cand), str(ref), "--name", "tol", "--out", str(tmp_path)])
+    assert sorted(data) == ["tol_N30_b20", "tol_N30_b50"]
+    events, tasks, _ = catalog.read(ref)
+    for b in (20, 50):
+        stem = f"tol_N30_b{b}"
+        d = data[stem]
+        assert json.loads((tmp_path / f"{stem}.json").read_text())["rows"] == json.loads(json.dumps(d["rows"]))
+        assert (tmp_path / f"{stem}.png").stat().st_size > 10_000
+        r, c, self_ = d["rows"]
+        assert [x["setting"] for x in d["rows"]] == ["ark4:rtol=1e-6", "ark4:rtol=1e-3", "ark4:rtol=1e-6"]
+        assert r["events"] == c["events"] == self_["events"] == 600
+        # the reference's samples are its catalog's: mu and the recurrence times by their definition
+        rows = np.flatnonzero(tasks["b"] == b)
+        mine = np.isin(events["task"], rows)
+        assert r["fraction_large"] == pytest.approx(np.mean(events["mu"][mine] >= 4.0))
+        T = np.concatenate([brute_recurrences(*(events[k][events["task"] == g] for k in ("t", "epicenter", "mu")))
+                            for g in rows]) * tasks["nu"][rows[0]]
+        assert r["recurrences"] == len(T) > 0 and r["mean_tnu"] == pytest.approx(T.mean())
+        assert r["events_per_second"] == pytest.approx(np.mean(tasks["events_per_second"][rows]))
+        for key in ("ks_mu", "ks_tnu", "w1_mu", "w1_tnu"):
+            assert self_[key] == 0.0
+            assert 0 <= c[key] and (c[key] <= 1 if key.startswith("ks") else np.isfinite(c[key]))
+        assert c["ks_mu"] > 0 and c["w1_tnu"] > 0
+        text = (tmp_path / f"{stem}.txt").read_text()
+        assert f"b = {b}," in text and "ark4:rtol=1e-3" in text and "600 / 600" in text
+        assert "the reference's root seed" not in text.split("ark4:rtol=1e-3")[-1].splitlines()[0]
+    labelled = statistics.main(["--catalogs", str(ref), str(cand), "--label", "tight", "loose",
+                                "--out", str(tmp_path)])
+    assert [x["setting"] for x in labelled["catalogs_N30_b20"]["rows"]] == ["tight", "loose"]
+    capsys.readouterr()
+    with pytest.raises(SystemExit) as refused:
+        statistics.main(["--catalogs", str(ref), str(cand), str(other), "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert refused.value.code == 2 and str(other) in err and "N = 20" in err and len(err.splitlines()) == 1
+
+
+def test_catalog_labels():
+    assert statistics.integrator_label(['method = "rk4"\ndt = 0.001\nrtol = 1e-05\natol = 1e-12']) == "rk4:dt=1e-3"
+    assert statistics.integrator_label(['method = "ark4"\ndt = 0.001\nrtol = 2.5e-07\natol = 1e-10'] * 2
+                                       ) == "ark4:rtol=2.5e-7,atol=1e-10"
+    assert statistics.short(0.5) == "0.5" and statistics.short(800.0) == "800" and statistics.short(1e-8) == "1e-8"
+
+
 def test_cost_scaling_tiny(tmp_path):
     data = cost_scaling.main(["--runs", "rk4:dt=1e-3", "--Ns", "40", "80", "--bs", "20", "30", "--N-at", "40",
                               "--events", "60", "--min-transient", "40", "--out", str(tmp_path)])
@@ -245,3 +310,115 @@ def test_default_transient_is_ten_events_per_block_of_the_longest_chain():
     assert loads("[run]\ntransient = 0\n").run.transient == 0
     assert Config(model=Model(N=60), run=Run()).run.transient == 600
     assert "transient = 8000" in loads("").to_toml()     # resolved, as the catalog stores it
+
+
+def test_decorrelation_rule_finds_a_known_crossing():
+    """Window means of D (windows of 5 events) 1e-6, 0.9 (a spike that falls back), 1e-3, 0.5, 1, ...
+    against the edge 0.4 (half the independent minimum 0.8): decorrelated for good from the fourth
+    window on, i.e. after 20 events; a late window near identity again means not decorrelated."""
+    from benchmarks.decorrelation import decorrelation_length, edges, settled
+    assert settled([0.1, 2.0, 0.1, 2.0, 3.0], 1.0) == 3
+    assert settled([2.0, 3.0], 1.0) == 0 and settled([2.0, 0.5], 1.0) is None and settled([], 1.0) is None
+    assert settled([0.9, 0.1, 0.8, 0.2], 0.5, rising=False) == 3
+    edge = edges(np.array([[0.8, 1.1], [0.9, 1.0]]), np.array([[0.0, 0.2]]))
+    assert edge == {"distance": 0.4, "agree": pytest.approx(0.6)}
+    d = np.repeat([1e-6, 0.9, 1e-3, 0.5, 1.0, 1.0, 1.0, 0.6], 5)
+    d[15:20] = [0.1, 0.9, 0.9, 0.2, 0.4]                  # mean 0.5, and single events below the edge
+    assert decorrelation_length(d, edge["distance"], 5) == 20
+    assert decorrelation_length(d[:-1], edge["distance"], 5) == 20    # a partial last window is dropped
+    d[-5:] = 0.01                                         # the last window close to identity again
+    assert decorrelation_length(d, edge["distance"], 5) is None
+    agree = np.r_[np.ones(12), np.zeros(28)]              # identical for 12 events, then nothing matches
+    assert decorrelation_length(agree, edge["agree"], 5, rising=False) == 15
+    agree[33] = 1.0                                       # one chance match in a late window: 0.2 <= 0.6
+    assert decorrelation_length(agree, edge["agree"], 5, rising=False) == 15
+
+
+def test_decorrelation_sequences_are_compared_in_time():
+    from benchmarks.decorrelation import first_difference, matched
+    t = np.arange(10) * 100.0
+    epicenter = np.arange(10) % 4
+    slipped = np.ones(10, dtype=int)
+    ref = (t, epicenter, slipped)
+    # the same events, 20 later or earlier by turns, and one extra event between the 3rd and the 4th
+    shifted = t + 20.0 * (-1.0) ** np.arange(10)
+    other = (np.insert(shifted, 3, 250.0), np.insert(epicenter, 3, 7), np.insert(slipped, 3, 1))
+    assert first_difference(ref, ref) is None
+    assert first_difference(ref, other) == 4                       # at equal index: the extra event
+    assert matched(ref, other, 30.0).all()                        # in time: every event is there
+    assert not matched(ref, other, 10.0).any()                    # ... but not within 10
+    moved = (other[0], other[1] + 1, other[2])
+    assert not matched(ref, moved, 30.0).any()                    # another epicenter is no match
+
+
+def test_decorrelation_forces_are_read_at_one_time():
+    """Follower.force_at: the forces of every block at the time asked (brought there from each
+    block's own time), as Trajectory.state gives them at the trajectory's clock."""
+    from benchmarks.decorrelation import Follower
+    from ensemble.config import Config, Run
+    from ensemble.runner import Trajectory
+    from ensemble.tasks import task_list
+    cfg = Config(model=Model(N=40, b=20.0), run=Run(seeds=1))
+    task = task_list(cfg)[0]
+    traj = Trajectory(cfg, task)
+    traj.advance(60)
+    force, _ = traj.state()
+    clock = traj.checkpoint().clock
+    assert np.ptp(traj.checkpoint().since[:, 0]) > 0       # the stored forces hold at different times
+    follower = Follower(traj)                              # integrates the next event
+    now = float(clock[0] + clock[1])
+    assert follower.rest[0] == now and follower.onsets[0] > now
+    assert np.allclose(follower.force_at(now), force, rtol=0, atol=1e-9)
+    later = now + 0.5 * (follower.onsets[0] - now)
+    assert np.allclose(follower.force_at(later), force + cfg.model.nu * (later - now), rtol=0, atol=1e-9)
+    assert len(follower.onsets) == 1                       # no event before `later`
+    follower.force_at(follower.onsets[0] + 1.0)
+    assert len(follower.onsets) == 2 and follower.rest[1] > follower.onsets[0]
+
+
+def test_decorrelation_unperturbed_branch_continues_the_trajectory():
+    """A branch without perturbation records what the trajectory it was taken from records next,
+    exactly; one with a perturbation starts its first event later (forces only lowered)."""
+    from benchmarks.decorrelation import branched
+    from ensemble.config import Config, Run
+    from ensemble.runner import Trajectory
+    from ensemble.tasks import branch_rng, task_list
+    cfg = Config(model=Model(N=40, b=20.0), run=Run(seeds=2))
+    tasks = task_list(cfg)
+    traj = Trajectory(cfg, tasks[0])
+    traj.advance(60)
+    start = traj.checkpoint()
+    force = start.force.copy()
+    same = branched(cfg, tasks[0], start, 0.0, None)
+    moved = branched(cfg, tasks[0], start, 1e-3, branch_rng(cfg, tasks[1]))
+    expected = traj.advance(30)
+    for got, want in zip(same.advance(30), expected):
+        assert np.array_equal(got, want)
+    t, _, _ = moved.advance(30)
+    assert t[0] > expected[0][0] and not np.array_equal(t, expected[0])
+    assert np.array_equal(start.force, force)      # the branch point is left as it was
+
+
+def test_decorrelation_tiny(tmp_path):
+    from benchmarks import decorrelation
+    data = decorrelation.main(["--N", "40", "--b", "20", "--spinup", "200", "--events", "200", "--branches", "2",
+                               "--repeats", "2", "--perturbation", "0", "1e-3", "--window", "5",
+                               "--out", str(tmp_path)])
+    assert json.loads((tmp_path / "decorrelation.json").read_text())["config"]["events"] == 200
+    assert (tmp_path / "decorrelation.png").stat().st_size > 10_000
+    assert "suggested decorrelation stretch" in (tmp_path / "decorrelation.txt").read_text()
+    (point,) = data["points"]
+    zero, positive = point["perturbations"]
+    # no perturbation: the branches are the reference, event for event and force for force, to the end
+    assert zero["first_difference"] == [None] * 4
+    assert np.max(zero["distance"]["max"]) == 0.0 and np.min(zero["agree"]["min"]) == 1.0
+    assert zero["stress_events"] == zero["sequence_events"] == [None] * 4
+    # a perturbation: forces differ at once, events later, and then as much as independent chains';
+    # while the events are the same, so are the forces at one time (not at each one's own time)
+    assert np.min(positive["distance"]["min"]) > 0
+    assert np.max(positive["distance"]["max"][:min(positive["first_difference"]) - 2]) < 1e-2
+    assert all(1 < f < 200 for f in positive["first_difference"])
+    assert all(k is not None and 0 < k < 200 for k in positive["stress_events"] + positive["sequence_events"])
+    assert 0.7 < positive["late_distance_ratio"] < 1.3
+    lo, median, hi = point["band"]["distance"]
+    assert 0 < point["edges"]["distance"] < lo <= median <= hi

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from ensemble import catalog
-from ensemble.config import DECORRELATION, ConfigError, loads
+from ensemble.config import DECORRELATION_PER_BLOCK, ConfigError, loads
 
 from .conftest import run_cli, write_config
 from .processes import ROOT, child_env, run_bounded
@@ -186,6 +186,6 @@ def test_branch_keys_are_validated_by_name():
         loads("[run]\nperturbation = -1e-6\n")
     with pytest.raises(ConfigError, match=r"run\.decorrelation must be an integer"):
         loads("[run]\ndecorrelation = 1.5\n")
-    cfg = loads("[run]\nbranch = true\ntransient = 100\n")
-    assert cfg.run.decorrelation == DECORRELATION and cfg.run.discarded == DECORRELATION
+    cfg = loads("[model]\nN = 400\n[sweep]\nN = [200, 300]\n[run]\nbranch = true\ntransient = 100\n")
+    assert cfg.run.decorrelation == cfg.run.discarded == DECORRELATION_PER_BLOCK * 300   # the longest chain
     assert loads("[run]\ntransient = 100\n").run.discarded == 100
