@@ -422,3 +422,27 @@ def test_decorrelation_tiny(tmp_path):
     assert 0.7 < positive["late_distance_ratio"] < 1.3
     lo, median, hi = point["band"]["distance"]
     assert 0 < point["edges"]["distance"] < lo <= median <= hi
+
+
+def test_statistics_rerun_widens_the_floor_and_names_the_settings_within_it():
+    """--rerun: the floor takes the rerun's halves and its full-size distance from the reference;
+    a candidate is within the noise when every distance is at most the floor's max."""
+    rng = np.random.default_rng(3)
+
+    def seeds(shift):
+        return {k: {"status": "ok", "mu": rng.normal(shift, 1, 2000), "tnu": rng.exponential(1 + shift, 500),
+                    "seconds": 1.0} for k in range(4)}
+    ref, rerun = seeds(0.0), seeds(0.3)          # a rerun far off: its direct distance sets the max
+    floor = statistics.noise_floor(ref)
+    wide = statistics.with_rerun(floor, ref, rerun)
+    direct = statistics.distances(statistics.pooled(rerun)["mu"], statistics.pooled(ref)["mu"])["ks"]
+    for key in floor:
+        assert len(wide[key]["splits"]) == 2 * len(floor[key]["splits"]) + 1
+    assert wide["ks_mu"]["max"] == pytest.approx(direct) and direct > 3 * floor["ks_mu"]["max"]
+    keys = [f"{n}_{s}" for s in statistics.SAMPLES for n in statistics.DISTANCES]
+    rows = [{"setting": "ref", "status": "ok"},
+            {"setting": "close", "status": "ok", **{k: 0.5 * wide[k]["max"] for k in keys}},
+            {"setting": "one off", "status": "ok", **{k: 0.5 * wide[k]["max"] for k in keys}, "w1_tnu": 1e9}]
+    assert statistics.within_noise(rows, wide) == ["close"]
+    with pytest.raises(SystemExit):
+        statistics.main(["--rerun", "x.h5"])      # a catalog-mode option without --catalogs
