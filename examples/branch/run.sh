@@ -21,9 +21,11 @@ for name in branched long; do
     mpiexec -n "$RANKS" $PY -m ensemble run "examples/branch/$name.toml" -o "$out" 2>&1 | tee -a "runs/branch/$name.log"
   fi
 done
-if [ ! -f runs/tolerance/ark4-1e-5.h5 ]; then
-  echo "runs/tolerance/ark4-1e-5.h5 missing: the independent seeds come from bash examples/tolerance/run.sh" >&2
+if [ ! -f runs/tolerance/ark4-1e-5.h5 ] || [ ! -f runs/tolerance/reference.h5 ]; then
+  echo "runs/tolerance/{ark4-1e-5,reference}.h5 missing: they come from bash examples/tolerance/run.sh" >&2
   exit 1
 fi
+# the noise floor: the independent seeds' halves, and those of examples/tolerance's reference (rtol 1e-7,
+# whose statistics equal rtol 1e-5's at this size) with its distance from them
 $PY -m benchmarks.statistics --catalogs runs/tolerance/ark4-1e-5.h5 runs/branch/branched.h5 runs/branch/long.h5 \
-  --label branched long --name branching
+  --label "independent seeds" branched "one trajectory" --rerun runs/tolerance/reference.h5 --name branching
