@@ -9,12 +9,11 @@ import os
 import sys
 import time
 import tomllib
-from dataclasses import dataclass
 
 import numpy as np
 
 from . import catalog, environment
-from .catalog import FAILED, FINISHED, OPEN, Checkpoint, CatalogError
+from .catalog import FAILED, FINISHED, Checkpoint, CatalogError
 from .config import ConfigError, from_dict, loads, section_lines
 from .integrators import kernel_params
 from .lock import RunLock
@@ -22,7 +21,8 @@ from .model.chain import simulate
 from .model.workspace import (D_DURATION, D_FIRST, D_LAST, D_NSLIP, D_SLIP, NDIAG, OK, PAUSED,
                               STATUS_TEXT, UNLIMITED, Workspace)
 from .parallel import Coordinator
-from .tasks import Task, branch_rng, initial_state, perturb, spinups, task_list
+from .branching import branch_start, spins_needed
+from .tasks import initial_state, task_list
 
 EXIT_INTERRUPTED = 75   # checkpointed after a signal; continue with --resume (EX_TEMPFAIL)
 EXIT_FAILED = 1         # some tasks failed (recorded in the catalog); the others finished
@@ -40,32 +40,6 @@ class Refused(RuntimeError):
 
 class SimulationError(RuntimeError):
     """A task that cannot go on; the message names the task and the event."""
-
-
-@dataclass(frozen=True)
-class Spin:
-    """A point's spin-up to run (or read) before its tasks branch (run.branch)."""
-    point: int
-    task: Task      # whose initial state it starts from (tasks.spinup_task)
-    rerun: bool     # its point's tasks all failed: a spin-up not finished failed, rerun it with `rerun`
-
-
-def spins_needed(cfg, tasks, stored=None, rerun=None):
-    """The spin-ups a run needs: those of the points with a task still to start from its branch point.
-
-    stored: the catalog's tasks (catalog.read_tasks) when resuming, None for a new run.
-    """
-    needed = []
-    for spin in spinups(cfg, tasks):
-        mine = [t.index for t in tasks if t.point == spin.point]
-        if stored is None:
-            needed.append(Spin(spin.point, spin, False))
-            continue
-        status, done = stored["status"][mine], stored["events_done"][mine]
-        failed = status == FAILED
-        if np.any((status == OPEN) & (done == 0)) or (rerun is not None and np.any(failed)):
-            needed.append(Spin(spin.point, spin, bool(np.all(failed))))
-    return needed
 
 
 class Trajectory:
@@ -243,9 +217,7 @@ class TaskRunner:
         spun-up state with the task's own perturbation."""
         if not self.cfg.run.branch:
             return None
-        spun = self.spun[task.point]
-        force = perturb(spun.force, self.cfg.run.perturbation, branch_rng(self.cfg, task))
-        return Checkpoint(force, spun.psi.copy(), spun.since.copy(), spun.clock.copy(), 0)
+        return branch_start(self.cfg, task, self.spun[task.point])
 
     def _run(self, task):
         taken = self._take_up(task)

@@ -1,0 +1,45 @@
+"""Branching (run.branch): which spin-ups a run needs, and the state a branch starts from.
+
+Each parameter point is spun up once (tasks.spinup_task: from its seed 0's initial state, run.transient
+events); its tasks then start from that state, each perturbed by its own stream (tasks.perturb,
+tasks.branch_rng). The runner (runner.py) runs the spin-ups first, then the tasks.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from .catalog import FAILED, OPEN, Checkpoint
+from .tasks import Task, branch_rng, perturb, spinups
+
+
+@dataclass(frozen=True)
+class Spin:
+    """A point's spin-up to run (or read) before its tasks branch (run.branch)."""
+    point: int
+    task: Task      # whose initial state it starts from (tasks.spinup_task)
+    rerun: bool     # its point's tasks all failed: a spin-up not finished failed, rerun it with `rerun`
+
+
+def spins_needed(cfg, tasks, stored=None, rerun=None):
+    """The spin-ups a run needs: those of the points with a task still to start from its branch point.
+
+    stored: the catalog's tasks (catalog.read_tasks) when resuming, None for a new run.
+    """
+    needed = []
+    for spin in spinups(cfg, tasks):
+        mine = [t.index for t in tasks if t.point == spin.point]
+        if stored is None:
+            needed.append(Spin(spin.point, spin, False))
+            continue
+        status, done = stored["status"][mine], stored["events_done"][mine]
+        failed = status == FAILED
+        if np.any((status == OPEN) & (done == 0)) or (rerun is not None and np.any(failed)):
+            needed.append(Spin(spin.point, spin, bool(np.all(failed))))
+    return needed
+
+
+def branch_start(cfg, task, spun):
+    """The state a branched task starts from: its point's spun-up state (Checkpoint) with the task's
+    own perturbation, no events done."""
+    force = perturb(spun.force, cfg.run.perturbation, branch_rng(cfg, task))
+    return Checkpoint(force, spun.psi.copy(), spun.since.copy(), spun.clock.copy(), 0)
