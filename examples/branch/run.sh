@@ -29,3 +29,6 @@ fi
 # whose statistics equal rtol 1e-5's at this size) with its distance from them
 $PY -m benchmarks.statistics --catalogs runs/tolerance/ark4-1e-5.h5 runs/branch/branched.h5 runs/branch/long.h5 \
   --label "independent seeds" branched "one trajectory" --rerun runs/tolerance/reference.h5 --name branching
+# and the branched seeds as the reference: one trajectory against them (their halves as the floor)
+$PY -m benchmarks.statistics --catalogs runs/branch/branched.h5 runs/branch/long.h5 runs/tolerance/ark4-1e-5.h5 \
+  --label branched "one trajectory" "independent seeds" --rerun runs/tolerance/reference.h5 --name branched_reference
