@@ -60,7 +60,7 @@ def _validate(args):
     print(cfg.to_toml())
     tasks = task_list(cfg)
     print(f"# {len(tasks)} tasks")
-    print("\n".join("# " + line for line in [*describe(tasks), *stack]))
+    print("\n".join("# " + line for line in [*describe(tasks, cfg), *stack]))
     return 0
 
 

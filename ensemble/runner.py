@@ -454,6 +454,9 @@ def _run_locked(cfg, path, comm, mode, spins, log, say, rerun, lock):
     for line in environment.stack():
         say(line)
     say(f"writing {partial} with {n_ranks} rank(s): {Writer.label(n_ranks)}")
+    if spins:
+        say(f"branching: {len(spins)} spin-up(s) of {cfg.run.transient} events first (counted among the tasks "
+            f"of the progress line), then the tasks")
     t_start = time.perf_counter()
     if mode == "new":
         # rank 0's text on every rank: under mpio the catalog's attributes are written collectively

@@ -82,8 +82,14 @@ def perturb(force, perturbation, rng):
     return force - perturbation * rng.random(len(force))
 
 
-def describe(tasks):
-    """One line per task for `validate`."""
-    return [f"task {t.index}: point {t.point} seed {t.seed_index} "
-            + " ".join(f"{f.name}={getattr(t.model, f.name)}" for f in dataclasses.fields(t.model))
-            for t in tasks]
+def describe(tasks, cfg=None):
+    """One line per task for `validate`, then one per spin-up (cfg given, run.branch)."""
+    lines = [f"task {t.index}: point {t.point} seed {t.seed_index} "
+             + " ".join(f"{f.name}={getattr(t.model, f.name)}" for f in dataclasses.fields(t.model))
+             for t in tasks]
+    for spin in spinups(cfg, tasks) if cfg is not None else []:
+        mine = [t.index for t in tasks if t.point == spin.point]
+        lines.append(f"spin-up of point {spin.point}: {cfg.run.transient} events from task {spin.index}'s initial "
+                     f"state; tasks {mine[0]}-{mine[-1]} start from it, forces lowered by up to "
+                     f"{cfg.run.perturbation:g}, and discard {cfg.run.decorrelation} events")
+    return lines

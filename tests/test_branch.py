@@ -179,6 +179,16 @@ def test_a_failed_spin_up_fails_its_points_tasks_and_a_rerun_completes_them(bran
     assert all("rtol = 1e-05" in text for text in tasks["integrator"][:SEEDS])
 
 
+def test_validate_and_the_run_log_name_the_spin_ups(branched, tmp_path):
+    d, cfg = branched
+    res = run_cli("validate", cfg)
+    assert res.returncode == 0, res.stderr
+    assert (f"# spin-up of point 1: {SPINUP} events from task {SEEDS}'s initial state; tasks {SEEDS}-{2 * SEEDS - 1} "
+            f"start from it, forces lowered by up to 1e-06, and discard {DECORRELATE} events") in res.stdout
+    res = run_cli("run", cfg, "-o", tmp_path / "log.h5")
+    assert res.returncode == 0 and "branching: 2 spin-up(s) of 120 events first" in res.stdout
+
+
 def test_branch_keys_are_validated_by_name():
     with pytest.raises(ConfigError, match=r"run\.branch must be true or false"):
         loads("[run]\nbranch = 1\n")
