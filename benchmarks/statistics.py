@@ -297,6 +297,10 @@ def short(value):
     return f"{value:g}" if isinstance(value, float) else str(value)
 
 
+# [integrator] keys only the adaptive methods read (config.Integrator)
+ADAPTIVE_ONLY = ("rtol", "atol", "max_step")
+
+
 def integrator_label(texts):
     """Tasks' stored [integrator] TOML -> a setting label: the method, its step or tolerance
     (rk4: dt; adaptive: rtol), and any other key off its default ("ark4:rtol=1e-3")."""
@@ -305,8 +309,11 @@ def integrator_label(texts):
     for text in dict.fromkeys(t for t in texts if t):
         fields = tomllib.loads(text)
         method = fields.pop("method")
-        main_key = "rtol" if INTEGRATORS[method].adaptive else "dt"
-        keys = [main_key] + [k for k, v in fields.items() if k != main_key and v != defaults.get(k)]
+        adaptive = INTEGRATORS[method].adaptive
+        main_key = "rtol" if adaptive else "dt"
+        unused = () if adaptive else ADAPTIVE_ONLY      # what RK4 ignores, whatever its value
+        keys = [main_key] + [k for k, v in fields.items()
+                             if k != main_key and k not in unused and v != defaults.get(k)]
         labels.append(f"{method}:" + ",".join(f"{k}={short(fields[k])}" for k in keys))
     return "+".join(labels) or "unknown"
 
