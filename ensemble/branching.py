@@ -1,6 +1,6 @@
 """Branching (run.branch): which spin-ups a run needs, and the state a branch starts from.
 
-Each parameter point is spun up once (tasks.spinup_task: from its seed 0's initial state, run.transient
+Each parameter point is spun up once (tasks.spinups: from its seed 0's initial state, run.transient
 events); its tasks then start from that state, each perturbed by its own stream (tasks.perturb,
 tasks.branch_rng). The runner (runner.py) runs the spin-ups first, then the tasks.
 """
@@ -9,14 +9,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from .catalog import FAILED, OPEN, Checkpoint
-from .tasks import Task, branch_rng, perturb, spinups
+from .tasks import Task, branch_rng, perturb, point_tasks, spinups
 
 
 @dataclass(frozen=True)
 class Spin:
     """A point's spin-up to run (or read) before its tasks branch (run.branch)."""
     point: int
-    task: Task      # whose initial state it starts from (tasks.spinup_task)
+    task: Task      # whose initial state it starts from (tasks.spinups)
     rerun: bool     # its point's tasks all failed: a spin-up not finished failed, rerun it with `rerun`
 
 
@@ -27,7 +27,7 @@ def spins_needed(cfg, tasks, stored=None, rerun=None):
     """
     needed = []
     for spin in spinups(cfg, tasks):
-        mine = [t.index for t in tasks if t.point == spin.point]
+        mine = [t.index for t in point_tasks(cfg, tasks, spin.point)]
         if stored is None:
             needed.append(Spin(spin.point, spin, False))
             continue

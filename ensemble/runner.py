@@ -22,7 +22,7 @@ from .model.workspace import (D_DURATION, D_FIRST, D_LAST, D_NSLIP, D_SLIP, NDIA
                               STATUS_TEXT, UNLIMITED, Workspace)
 from .parallel import Coordinator
 from .branching import branch_start, spins_needed
-from .tasks import initial_state, task_list
+from .tasks import initial_state, point_tasks, task_list
 
 EXIT_INTERRUPTED = 75   # checkpointed after a signal; continue with --resume (EX_TEMPFAIL)
 EXIT_FAILED = 1         # some tasks failed (recorded in the catalog); the others finished
@@ -257,10 +257,9 @@ class TaskRunner:
                 return None
         except SimulationError as err:
             message = str(err)
-            for task in tasks:
-                if task.point == spin.point:
-                    self.writer.fail(task.index, message)
-                    self.failed.append((task.index, message))
+            for task in point_tasks(cfg, tasks, spin.point):
+                self.writer.fail(task.index, message)
+                self.failed.append((task.index, message))
             print(f"error: rank {self.coord.rank}: {message}; the tasks of point {spin.point} are recorded "
                   f"as failed, the others go on", file=sys.stderr, flush=True)
             self.coord.task_done()

@@ -53,19 +53,17 @@ def initial_state(cfg, task):
 BRANCH_STREAM = 1
 
 
-def spinup_task(tasks, point):
-    """The task whose initial state the spin-up of `point` starts from: the point's seed 0, so that
-    an unperturbed branch records exactly what that task records without branching."""
-    return next(t for t in tasks if t.point == point and t.seed_index == 0)
+def point_tasks(cfg, tasks, point):
+    """The tasks of one point (task_list is point-major: task = point * run.seeds + seed_index)."""
+    return tasks[point * cfg.run.seeds:(point + 1) * cfg.run.seeds]
 
 
 def spinups(cfg, tasks):
     """The spin-ups of a run, one per point in point order, each named by the task whose initial
-    state it starts from (spinup_task); none without run.branch. Spin-up p is catalog record
+    state it starts from: the point's seed 0, so that an unperturbed branch records exactly what that
+    task records without branching; none without run.branch. Spin-up p is catalog record
     len(tasks) + p (after the tasks' records)."""
-    if not cfg.run.branch:
-        return []
-    return [spinup_task(tasks, p) for p in range(max(t.point for t in tasks) + 1)]
+    return list(tasks[::cfg.run.seeds]) if cfg.run.branch else []
 
 
 def branch_rng(cfg, task):
@@ -88,7 +86,7 @@ def describe(tasks, cfg=None):
              + " ".join(f"{f.name}={getattr(t.model, f.name)}" for f in dataclasses.fields(t.model))
              for t in tasks]
     for spin in spinups(cfg, tasks) if cfg is not None else []:
-        mine = [t.index for t in tasks if t.point == spin.point]
+        mine = [t.index for t in point_tasks(cfg, tasks, spin.point)]
         lines.append(f"spin-up of point {spin.point}: {cfg.run.transient} events from task {spin.index}'s initial "
                      f"state; tasks {mine[0]}-{mine[-1]} start from it, forces lowered by up to "
                      f"{cfg.run.perturbation:g}, and discard {cfg.run.decorrelation} events")

@@ -8,18 +8,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 RANKS=${1:-1}
-PY=.venv/bin/python
-export NUMBA_CACHE_DIR=${NUMBA_CACHE_DIR:-$PWD/.numba_cache} OMP_NUM_THREADS=1 NUMBA_NUM_THREADS=1
-mkdir -p runs/branch
+. examples/run_or_resume.sh
 for name in branched long; do
-  out=runs/branch/$name.h5
-  if [ -f "$out" ]; then
-    echo "$name: complete"
-  elif [ -f "$out.partial" ]; then
-    mpiexec -n "$RANKS" $PY -m ensemble resume "$out" 2>&1 | tee -a "runs/branch/$name.log"
-  else
-    mpiexec -n "$RANKS" $PY -m ensemble run "examples/branch/$name.toml" -o "$out" 2>&1 | tee -a "runs/branch/$name.log"
-  fi
+  run_or_resume "runs/branch/$name.h5" "examples/branch/$name.toml"
 done
 if [ ! -f runs/tolerance/ark4-1e-5.h5 ] || [ ! -f runs/tolerance/reference.h5 ]; then
   echo "runs/tolerance/{ark4-1e-5,reference}.h5 missing: they come from bash examples/tolerance/run.sh" >&2
