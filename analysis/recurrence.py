@@ -11,6 +11,8 @@ so at most N / window + 1 of them exist whatever the catalog length.
 import numba as nb
 import numpy as np
 
+import ensemble.model  # noqa: F401  (first: numba caches scan in the package's cache, ensemble/kernel_cache.py)
+
 
 @nb.njit(cache=True)
 def scan(t, epicenter, mu, boundary, mu_c, window, offset, pending_t, pending_epi, pending_int,

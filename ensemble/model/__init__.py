@@ -6,25 +6,14 @@ config objects, files, MPI or HDF5 (see ensemble.runner for the wrapper).
 Numba's on-disk cache only notices changes to the file of the cached function
 itself, not to the kernels it calls from other files; a stale cache would run
 old physics silently. The cache therefore lives in a directory named after a
-hash of all kernel sources: $NUMBA_CACHE_DIR/bk-<hash> (default
-~/.cache/bk-ensemble/numba/bk-<hash>).
+hash of all kernel sources, under the one cache root of every entry point:
+<root>/bk-<hash> (ensemble/kernel_cache.py: $NUMBA_CACHE_DIR, else the
+checkout's .numba_cache, else ~/.cache/bk-ensemble/numba).
 """
-import hashlib
-import os
 from pathlib import Path
 
 import numba
 
+from .. import kernel_cache
 
-def _cache_dir():
-    digest = hashlib.sha256()
-    here = Path(__file__).parent
-    for src in sorted(here.rglob("*.py")):
-        digest.update(str(src.relative_to(here)).encode())
-        digest.update(src.read_bytes())
-    base = os.environ.get("NUMBA_CACHE_DIR") or os.path.join(
-        os.path.expanduser("~"), ".cache", "bk-ensemble", "numba")
-    return os.path.join(base, "bk-" + digest.hexdigest()[:16])
-
-
-numba.config.CACHE_DIR = _cache_dir()
+numba.config.CACHE_DIR = kernel_cache.directory(Path(__file__).parent)
