@@ -1,4 +1,4 @@
-"""python -m analysis reduce|plot|report|export|compare ...
+"""python -m analysis reduce|plot|report|paper|export|compare ...
 
 reduce streams one or more catalogs into per-task histograms (ranks split the tasks of all
 catalogs under mpirun and rank 0 merges them), pools the tasks of equal parameters (N, l, nu and
@@ -7,8 +7,9 @@ merged densities and summary numbers with bootstrap intervals and writes a summa
 large-event magnitude default to the friction law's scale (Law.scales). The same trajectory (random
 stream and parameters) in two catalogs is refused; so is an unfinished run (a *.partial
 catalog, unfinished tasks) unless --partial is given. plot overlays the points of one or more
-summaries; report prints a summary's numbers; export writes a catalog's or a summary's tables;
-compare sets the points of catalogs of several friction laws side by side (analysis/compare.py).
+summaries; report prints a summary's numbers; paper sets the paper's claims beside them; export
+writes a catalog's or a summary's tables; compare sets the points of catalogs of several friction
+laws side by side (analysis/compare.py).
 
 Exit codes: 0 done, 1 file error (missing, damaged or of the wrong kind: a summary or a
 config given for a catalog, an unfinished run without --partial, ...), 2 bad options (and the
@@ -65,6 +66,10 @@ def _parser():
     pl.add_argument("--title", default=None)
     rp = sub.add_parser("report", help="print the summary numbers as a table")
     rp.add_argument("summary")
+    pa = sub.add_parser("paper", help="the paper's claims beside the numbers of one or more summaries, "
+                                      "labelled full size or reduced (analysis/paper.py)")
+    pa.add_argument("summaries", nargs="+", metavar="summary",
+                    help="each claim reads the summary with the most of the points it needs (the first of equals)")
     from .export import FORMATS
     ex = sub.add_parser("export", help="catalog (events, tasks) or summary (curves, numbers, peaks) -> "
                                        "tables for other tools (docs/running.md)")
@@ -223,6 +228,12 @@ def _report(args):
     return 0
 
 
+def _paper(args):
+    from .paper import text
+    print(text([summary.read(path) for path in args.summaries], args.summaries))
+    return 0
+
+
 def _export(args):
     from .export import write
     for path in write(args.source, args.output, args.format, force=args.force):
@@ -234,7 +245,7 @@ def main(argv=None):
     args = _parser().parse_args(argv)
     try:
         return {"reduce": _reduce, "plot": _plot, "report": _report, "export": _export,
-                "compare": _compare}[args.command](args)
+                "compare": _compare, "paper": _paper}[args.command](args)
     except BrokenPipeError:
         raise   # the reader of stdout went away: not a file error; __main__ ends quietly
     except (CatalogError, summary.SummaryError, ValueError, OSError) as err:

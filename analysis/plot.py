@@ -1,6 +1,11 @@
 """Figures from one or more summaries: R(mu) of every point overlaid, with bootstrap bands;
-recurrence-time distributions, one panel per point. Points of several summaries are labelled by
-the parameters that differ between all the plotted points (legend_labels)."""
+recurrence-time distributions, one panel per point, each with its main peak enlarged in an inset.
+Points of several summaries are labelled by the parameters that differ between all the plotted
+points (legend_labels).
+
+Nothing drawn covers data: legends sit outside the axes, and an inset goes where the panel's
+curves and bands stay below it over its whole width (place_inset; tests/test_figures.py checks
+every figure in display coordinates). No text is smaller than FONT points."""
 import math
 import os
 
@@ -9,20 +14,44 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
+from matplotlib.ticker import MaxNLocator  # noqa: E402
+from matplotlib.transforms import Bbox  # noqa: E402
 
 from .reduce import PARAMS  # noqa: E402
-from .report import level_text, partial_text  # noqa: E402
+from .report import level_text, partial_text, size_text  # noqa: E402
 from .stats import centers  # noqa: E402
 
+FONT = 8            # the smallest text of a figure, points
+INSET = (0.36, 0.34)    # an inset's width and height, fractions of its panel's axes
+GAP = 4.0           # points between an inset (with its labels) and the data or the axes' frame
+OPEN = "v"          # marker of an interval reaching 0 on a log axis: its upper end
+OPEN_NOTE = "interval reaching 0: its upper end"
+DPI = 120
 
-def _band(ax, x, y, lo, hi, label, color, log=False, style="-"):
+
+def _band(ax, x, y, lo, hi, label, color, log=False, style="-", open_ends=False):
+    """The curve y(x) and its interval band [lo, hi]. On a log axis a lower bound of 0 has no
+    place: with open_ends, such intervals are drawn as their upper end (marker OPEN) and the
+    band is filled only where lo > 0; without, the band runs down to the axis' bottom.
+    Returns whether any upper end was marked."""
     ok = np.isfinite(y) & ((y > 0) if log else True)
     ax.plot(x[ok], y[ok], style, color=color, label=label, lw=1.4)
-    okb = ok & np.isfinite(lo) & np.isfinite(hi)
+    okb = np.isfinite(lo) & np.isfinite(hi) & (True if open_ends else ok)
+    if log and open_ends:
+        closed = okb & (lo > 0)
+        opened = okb & ~(lo > 0) & (hi > 0)
+        if closed.any():
+            ax.fill_between(x, np.where(closed, lo, np.nan), np.where(closed, hi, np.nan), where=closed,
+                            color=color, alpha=0.25, lw=0)
+        if opened.any():
+            ax.plot(x[opened], hi[opened], OPEN, color=color, ms=4, mew=0.8, mfc="none", ls="none")
+        return bool(opened.any())
     if okb.any():
         # on a log axis a lower bound of 0 is drawn down to the axis' bottom
         low = np.where(lo > 0, lo, 1e-300) if log else lo
         ax.fill_between(x[okb], low[okb], hi[okb], color=color, alpha=0.25, lw=0)
+    return False
 
 
 def summary_name(path):
@@ -71,11 +100,16 @@ def _colors(n):
     return [plt.cm.viridis(i / (n - 1)) for i in range(n)]
 
 
+def _legend_columns(n):
+    return math.ceil(n / 16)
+
+
 def magnitude(summaries, ax, keys, labels):
     points = _points(summaries)
+    opened = False
     for (s, i), label, color in zip(points, labels, _colors(len(points))):
-        _band(ax, centers(s["bins/mu"]), s["points/mu_density"][i], s["points/mu_lo"][i],
-              s["points/mu_hi"][i], label, color, log=True)
+        opened |= _band(ax, centers(s["bins/mu"]), s["points/mu_density"][i], s["points/mu_lo"][i],
+                        s["points/mu_hi"][i], label, color, log=True, open_ends=True)
     ax.set_yscale("log")
     density = np.concatenate([s["points/mu_density"].ravel() for s in summaries])
     positive = density[density > 0]
@@ -83,7 +117,13 @@ def magnitude(summaries, ax, keys, labels):
         ax.set_ylim(positive.min() / 3, positive.max() * 3)
     ax.set_xlabel(r"magnitude $\mu$")
     ax.set_ylabel(r"$R(\mu)$")
-    ax.legend(title="varying " + ", ".join(keys), fontsize=8, ncol=math.ceil(len(points) / 12))
+    handles, texts = ax.get_legend_handles_labels()
+    if opened:
+        handles.append(Line2D([], [], marker=OPEN, color="0.3", mfc="none", ls="none"))
+        texts.append(OPEN_NOTE)
+    # outside the axes: a legend never covers a curve
+    ax.legend(handles, texts, title="varying " + ", ".join(keys), fontsize=FONT, title_fontsize=FONT + 1,
+              loc="upper left", bbox_to_anchor=(1.01, 1.0), ncol=_legend_columns(len(points)))
 
 
 def _grid(n):
@@ -92,7 +132,80 @@ def _grid(n):
     return math.ceil(n / cols), cols
 
 
+def _data_paths(ax):
+    """The curves and bands drawn in `ax` (not its insets): (path in display coordinates, filled)."""
+    paths = [(line.get_transform().transform_path(line.get_path()), False) for line in ax.lines]
+    for coll in ax.collections:   # bands: filled areas
+        paths += [(coll.get_transform().transform_path(p), True) for p in coll.get_paths()]
+    return paths
+
+
+def _clear(paths, box):
+    return not any(p.intersects_bbox(box, filled=filled) for p, filled in paths)
+
+
+def place_inset(ax, draw, renderer):
+    """Add an inset (drawn by draw(inset)) where the data of `ax` stay below it: the inset with
+    its tick labels and title, widened by GAP, and everything above it up to the axes' top
+    must not meet a curve or band. Tries the top of the panel from right to left, keeps the
+    position in the middle of the widest clear stretch; if none is clear, raises the y axis
+    (the data shrink downwards) up to three times, then draws no inset. Returns the inset or None."""
+    w, h = INSET
+    probe = ax.inset_axes([1 - w, 1 - h, w, h])
+    draw(probe)
+    frame, tight = probe.get_window_extent(renderer), probe.get_tightbbox(renderer)
+    probe.remove()
+    gap = GAP * ax.figure.dpi / 72
+    left, right = frame.x0 - tight.x0 + gap, tight.x1 - frame.x1 + gap
+    below, above = frame.y0 - tight.y0 + gap, tight.y1 - frame.y1 + gap
+    for _ in range(4):
+        box = ax.get_window_extent(renderer)
+        top = box.y1 - above                              # the inset's frame reaches up to here
+        y0 = top - h * box.height
+        starts = np.linspace(box.x0 + left, box.x1 - right - w * box.width, 41)
+        paths = _data_paths(ax)
+        clear = [_clear(paths, Bbox([[x - left, y0 - below], [x + w * box.width + right, box.y1]]))
+                 for x in starts]
+        if any(clear):
+            # the widest run of clear positions; the inset in its middle
+            runs, start = [], None
+            for k, ok in enumerate(clear + [False]):
+                if ok and start is None:
+                    start = k
+                if not ok and start is not None:
+                    runs.append((k - start, start, k - 1))
+                    start = None
+            _, first, last = max(runs, key=lambda r: (r[0], r[2]))
+            x = starts[(first + last) // 2]
+            to_axes = ax.transAxes.inverted()
+            (ax0, ay0), = to_axes.transform([(x, y0)])
+            inset = ax.inset_axes([ax0, ay0, w, h])
+            draw(inset)
+            return inset
+        lo, hi = ax.get_ylim()
+        ax.set_ylim(lo, lo + 1.3 * (hi - lo))
+    return None
+
+
+def _zoom(s, i, x, peak):
+    """A drawing function: point i's curves within 6 bins of `peak`."""
+    def draw(inset):
+        w = 6 * (x[1] - x[0])
+        near = (x > peak - w) & (x < peak + w)
+        _band(inset, x[near], s["points/tnu_density"][i][near], s["points/tnu_lo"][i][near],
+              s["points/tnu_hi"][i][near], None, "C0")
+        _band(inset, x[near], s["points/tnu_interior_density"][i][near],
+              s["points/tnu_interior_lo"][i][near], s["points/tnu_interior_hi"][i][near],
+              None, "C3", style="--")
+        inset.tick_params(labelsize=FONT)
+        inset.xaxis.set_major_locator(MaxNLocator(4))
+        inset.yaxis.set_major_locator(MaxNLocator(3))
+        inset.set_title(f"main peak, T$\\nu$ = {peak:g}", fontsize=FONT)
+    return draw
+
+
 def recurrence(summaries, fig, labels):
+    """The panels (their insets come after the layout: place_insets)."""
     points = _points(summaries)
     rows, cols = _grid(len(points))
     for k, ((s, i), label) in enumerate(zip(points, labels)):
@@ -101,58 +214,84 @@ def recurrence(summaries, fig, labels):
         _band(ax, x, s["points/tnu_density"][i], s["points/tnu_lo"][i], s["points/tnu_hi"][i],
               "all large events", "C0")
         _band(ax, x, s["points/tnu_interior_density"][i], s["points/tnu_interior_lo"][i],
-              s["points/tnu_interior_hi"][i], "interior events", "C3", style="--")
-        ax.set_title(label, fontsize=9)
+              s["points/tnu_interior_hi"][i], "interior events (the rupture reaches neither end)", "C3", style="--")
+        ax.set_title(label, fontsize=FONT + 1)
         ax.set_xlabel(r"$T\nu$")
         ax.set_ylabel(r"$P(T\nu)$")
-        ax.legend(fontsize=7, loc="upper right")
+        ax.set_xlim(s["bins/tnu"][0], s["bins/tnu"][-1])
+        ax.set_ylim(0, ax.get_ylim()[1])
+    handles, texts = fig.axes[0].get_legend_handles_labels()
+    fig.legend(handles, texts, loc="lower center", ncol=2, fontsize=FONT + 1, frameon=False)
+
+
+def place_insets(summaries, fig):
+    """Each panel's main peak (the highest significant one) enlarged, where the data are low."""
+    renderer = fig.canvas.get_renderer()
+    for ax, (s, i) in zip(fig.axes, _points(summaries)):
         peak = s["points/peaks"][i][0][0]
         if np.isfinite(peak):
-            inset = ax.inset_axes([0.55, 0.35, 0.4, 0.35])
-            w = 6 * (x[1] - x[0])
-            near = (x > peak - w) & (x < peak + w)
-            _band(inset, x[near], s["points/tnu_density"][i][near], s["points/tnu_lo"][i][near],
-                  s["points/tnu_hi"][i][near], None, "C0")
-            _band(inset, x[near], s["points/tnu_interior_density"][i][near],
-                  s["points/tnu_interior_lo"][i][near], s["points/tnu_interior_hi"][i][near],
-                  None, "C3", style="--")
-            inset.tick_params(labelsize=6)
-            inset.set_title("main peak", fontsize=6)
+            place_inset(ax, _zoom(s, i, centers(s["bins/tnu"]), peak), renderer)
+
+
+def _values(values, fmt="{}"):
+    """Distinct values, " / " between them."""
+    return " / ".join(dict.fromkeys(fmt.format(v) for v in values))
+
+
+def _units(s):
+    """What a summary's bands resample: "20 stretches of each trajectory", "4 seeds" (or a range)."""
+    words = {"blocks": "stretches of each trajectory", "seeds": "seeds"}
+    return " / ".join(dict.fromkeys(
+        f"{min(n)}-{max(n)} {words[m]}" if min(n) != max(n) else f"{n[0]} {words[m]}"
+        for m in dict.fromkeys(s["points/method"])
+        for n in [[int(u) for u, k in zip(s["points/units"], s["points/method"]) if k == m]]))
 
 
 def title_text(summaries, names, title=None):
-    """The figure's title: `title` or the sources and the band level; then one line for each
-    partial reduction (events reduced of expected), whatever the title."""
+    """The figure's title: `title` (then the description below) or by default the description
+    alone: events per point, mu_c, window and the bands (never the file names); then one line
+    for each partial reduction (events reduced of expected), whatever the title."""
     levels = " / ".join(dict.fromkeys(level_text(s["attrs"]["level"]) for s in summaries))
-    if title is None:
-        source = (summaries[0]["attrs"]["catalog"] if len(summaries) == 1
-                  else ", ".join(names))
-        title = f"{source}  (bands: {levels} bootstrap)"
-    lines = [title]
+    description = (f"{_values(size_text(s) for s in summaries)}, "
+                   f"mu_c = {_values((s['attrs']['mu_c'] for s in summaries), '{:g}')}, "
+                   f"window = {_values((s['attrs']['window'] for s in summaries), '{:g}')} blocks; "
+                   f"bands: {levels} bootstrap over {_values(_units(s) for s in summaries)}")
+    partials = []
     for s, name in zip(summaries, names):
         partial = partial_text(s).split(";")[0]
         if partial:
-            lines.append(partial if len(summaries) == 1 else f"{name}: {partial}")
-    return "\n".join(lines)
+            partials.append(partial if len(summaries) == 1 else f"{name}: {partial}")
+    return "\n".join(([description] + partials) if title is None else ([title] + partials + [description]))
 
 
-def plot(summaries, figure, path, title=None, names=None):
-    """Draw `figure` ("magnitude" or "recurrence") of the points of one summary (a dict from
-    summary.read) or several (a list), into `path`. names: the summaries' paths or names."""
+def figure(summaries, kind, title=None, names=None):
+    """The figure `kind` ("magnitude" or "recurrence") of the points of one summary (a dict from
+    summary.read) or several (a list), laid out and ready to save. names: the summaries' paths
+    or names (to tell points of equal parameters apart)."""
     if isinstance(summaries, dict):
         summaries = [summaries]
     names = ([summary_name(n) for n in names] if names is not None
              else [f"summary {j + 1}" for j in range(len(summaries))])
     keys, labels = legend_labels(summaries, names)
     n = len(labels)
-    if figure == "magnitude":
-        fig, ax = plt.subplots(figsize=(6 + 2 * (math.ceil(n / 12) - 1), 4.5))
+    text = title_text(summaries, names, title)
+    if kind == "magnitude":
+        fig, ax = plt.subplots(figsize=(8 + 1.6 * (_legend_columns(n) - 1), 4.8), dpi=DPI)
         magnitude(summaries, ax, keys, labels)
+        fig.suptitle(text, fontsize=FONT + 1)
+        fig.tight_layout()
     else:
         rows, cols = _grid(n)
-        fig = plt.figure(figsize=(5.5 * cols, 4 * rows))
+        fig = plt.figure(figsize=(5.5 * cols, 4 * rows + 0.4), dpi=DPI)
         recurrence(summaries, fig, labels)
-    fig.suptitle(title_text(summaries, names, title), fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
+        fig.suptitle(text, fontsize=FONT + 1)
+        fig.tight_layout(rect=(0, 0.35 / fig.get_figheight(), 1, 1))
+        place_insets(summaries, fig)
+    return fig
+
+
+def plot(summaries, figure_kind, path, title=None, names=None):
+    """Draw figure(summaries, figure_kind, title, names) into `path`."""
+    fig = figure(summaries, figure_kind, title, names)
+    fig.savefig(path, dpi=DPI)
     plt.close(fig)

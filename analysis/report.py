@@ -3,6 +3,7 @@ import numpy as np
 
 from . import reduce
 from .reduce import NUMBERS, PARAMS
+from .stats import N_EVENTS
 
 LABELS = {
     "n_events": "events", "n_large": "large", "fraction_large": "frac(mu>=mu_c)",
@@ -39,6 +40,39 @@ def _fmt(est, lo, hi):
     if np.isfinite(lo):
         return f"{est:.4g} [{lo:.4g}, {hi:.4g}]"
     return f"{est:.4g}"
+
+
+def count_text(n):
+    """An event count as it is read: 8000, 2e5, 1.2e4 (exact, else all digits)."""
+    n = int(n)
+    mantissa, exponent = f"{n:.1e}".split("e")
+    if n >= 10000 and float(mantissa) * 10 ** int(exponent) == n:
+        return f"{float(mantissa):g}e{int(exponent)}"
+    return str(n)
+
+
+def events_per_task(s):
+    """Events each task of the summary contributed (reduced, not discarded), (tasks,)."""
+    return s["per_task/numbers"][:, :, N_EVENTS].sum(axis=1).astype(np.int64)
+
+
+def events_per_point(s):
+    """Events each point rests on, (points,)."""
+    return np.bincount(s["tasks/point"], weights=events_per_task(s), minlength=len(s["points/N"])).astype(np.int64)
+
+
+def size_text(s):
+    """The events behind each point: "2e5 events per point", "8000 events per point (4 seeds x
+    2000)", or their range when the points differ: "2000-8000 events per point"."""
+    per_point = events_per_point(s)
+    per_task = events_per_task(s)
+    seeds = np.bincount(s["tasks/point"], minlength=len(per_point))
+    if len(set(per_point)) > 1:
+        return f"{count_text(per_point.min())}-{count_text(per_point.max())} events per point"
+    text = f"{count_text(per_point[0])} events per point"
+    if len(set(seeds)) == 1 and len(set(per_task)) == 1 and seeds[0] > 1:
+        text += f" ({seeds[0]} seeds x {count_text(per_task[0])})"
+    return text
 
 
 def partial_text(s):

@@ -1,0 +1,277 @@
+"""Did this run reproduce the paper? The claims of Ohmura & Kawamura (EPL 77, 69001, 2007) beside
+the numbers of one or more summaries (`python -m analysis paper SUMMARY [SUMMARY ...]`).
+
+Each claim (CLAIMS) names the points it needs: which parameter values (`where`) and which parameter
+it runs over (`vary`, with at least `least` values of it). It takes them from the one summary that
+has the most values of `vary` among its points that match (the first of equals), so that given
+the five panels' summaries in the order of docs/paper.md each claim reads its own panel; a claim no
+summary allows says what it needs. Numbers the report prints (fraction of large events, GR b, KS
+distance, recurrence peaks) are the summary's, with its intervals; the shape of R(mu) (the
+large-magnitude peak, the dip below it, their ratio, the spread of a flat R(mu)) is computed here
+from the per-stretch histograms, with percentile intervals from RESAMPLES resamples of the same
+units (stats.bootstrap, seed 0). A number that cannot be computed says why instead of printing nan.
+
+The output is labelled "full size" when every point rests on at least PAPER_EVENTS events (the
+paper's one trajectory per point), else "reduced"; a run that discarded fewer events than the
+longest transient measured is warned about.
+"""
+import tomllib
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from ensemble.config import TRANSIENT_PER_BLOCK
+
+from . import stats
+from .reduce import PARAMS
+from .report import count_text, events_per_point, level_text, partial_text, point_label, size_text
+
+PAPER_EVENTS = 200_000      # events the paper recorded per point (one trajectory, N = 800) ...
+PAPER_TRANSIENT = 10_000    # ... after discarding these
+# the longest transient measured from the random start, events per block (b = 50, N = 800: 1000
+# events; benchmarks/results/transient.txt, docs/benchmarks.md); the default run.transient is
+# TRANSIENT_PER_BLOCK = 8x this
+MEASURED_TRANSIENT_PER_BLOCK = 1.25
+
+RESAMPLES = 1000
+PEAK_FROM = 3.5            # the large-magnitude peak: the maximum of R(mu) for mu >= PEAK_FROM
+DIP_FROM = 2.5             # the dip: the minimum of R(mu) between DIP_FROM and the peak
+FLAT = (3.0, 5.5)          # a flat R(mu): max / min of R over this range (above the few-block events)
+SHAPES = ("peak_mu", "peak_r", "dip_mu", "dip_r", "peak_over_dip", "flat_spread")
+
+
+def fmt(v, digits=3):
+    return f"{v:.{digits}g}"
+
+
+def with_interval(triple, digits=3):
+    """"est [lo, hi]"; an estimate that is not finite, or no interval, said in words."""
+    est, lo, hi = triple[:3]
+    if not np.isfinite(est):
+        return "not computable from these events"
+    if not (np.isfinite(lo) and np.isfinite(hi)):
+        return f"{fmt(est, digits)} (no interval: too few resampling units)"
+    return f"{fmt(est, digits)} [{fmt(lo, digits)}, {fmt(hi, digits)}]"
+
+
+def number(s, i, name, digits=3):
+    return with_interval(s[f"points/numbers/{name}"][i], digits)
+
+
+def _shape(row, edges, c):
+    """SHAPES of one histogram row (bin counts, then the events in and out of range)."""
+    r = stats.density(row[:-1], edges, row[-1])
+    big = np.flatnonzero(c >= PEAK_FROM)
+    k = big[np.argmax(r[big])]
+    below = np.flatnonzero((c >= DIP_FROM) & (c <= c[k]))
+    j = below[np.argmin(r[below])]
+    flat = np.flatnonzero((c >= FLAT[0]) & (c <= FLAT[1]))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.array([c[k], r[k], c[j], r[j], r[k] / r[j], r[flat].max() / r[flat].min()])
+
+
+def shape_statistics(s, i, level=None):
+    """R(mu) shape numbers of point i with bootstrap intervals over its units (stretches or seeds):
+    {name: (estimate, lo, hi, share of resamples where it is infinite)}; a ratio over an empty
+    bin is infinite."""
+    level = s["attrs"]["level"] if level is None else level
+    edges = s["bins/mu"]
+    c = stats.centers(edges)
+    tasks = np.flatnonzero(s["tasks/point"] == i)
+    units = s["per_task/mu"][tasks].reshape(-1, len(c))
+    total_events = s["per_task/numbers"][tasks].reshape(-1, s["per_task/numbers"].shape[-1])[:, stats.N_EVENTS]
+    rows = np.concatenate([units, total_events[:, None]], axis=1)
+    est = _shape(rows.sum(axis=0), edges, c)
+    samples = stats.bootstrap(rows, lambda row: _shape(row, edges, c), RESAMPLES, np.random.default_rng(0))
+    lo, hi = stats.percentile_interval(samples, level)
+    infinite = np.mean(np.isinf(samples), axis=0)
+    return {k: (est[n], lo[n], hi[n], infinite[n]) for n, k in enumerate(SHAPES)}
+
+
+def ratio(quad, empty):
+    """A ratio with its interval; over an empty bin (`empty` names it) infinite, said in words."""
+    est, lo, hi, infinite = quad
+    if not np.isfinite(est):
+        return f"unbounded ({empty} holds no events: more events needed)"
+    if not np.isfinite(hi):
+        return (f"{fmt(est)} [{fmt(lo)}, unbounded: {empty} is empty in {100 * infinite:.0f}% of the "
+                "resamples]")
+    return with_interval(quad)
+
+
+def peaks(s, i):
+    rows = s["points/peaks"][i]
+    rows = rows[np.isfinite(rows[:, 0])]
+    return "; ".join(with_interval(r, 4) for r in sorted(rows, key=lambda r: r[0])) or "no significant peak"
+
+
+def listing(s, rows, value, label):
+    """'v1, v2, ... (label = x1, x2, ...)' over the points `rows` of summary s; when other
+    parameters differ between them too, each point is named in full."""
+    keys = [k for k in PARAMS
+            if len({float(s[f"points/{k}"][i]) for i in rows if np.isfinite(s[f"points/{k}"][i])}) > 1]
+    if keys in ([], [label]):
+        return (", ".join(value(i) for i in rows) + f" ({label} = "
+                + ", ".join(f"{s[f'points/{label}'][i]:g}" for i in rows) + ")")
+    return ", ".join(f"{value(i)} ({point_label(s, i, keys)})" for i in rows)
+
+
+def _peak_and_dip(s, rows):
+    def one(i):
+        sh = shape_statistics(s, i)
+        return (f"peak at mu = {with_interval(sh['peak_mu'])}, "
+                f"{ratio(sh['peak_over_dip'], 'the dip bin')} times R at the dip below it "
+                f"(mu = {with_interval(sh['dip_mu'])})")
+    return "; ".join(one(i) + (f" ({point_label(s, i)})" if len(rows) > 1 else "") for i in rows)
+
+
+def _flat(s, rows):
+    spread = lambda i: ratio(shape_statistics(s, i)["flat_spread"], "the lowest bin")  # noqa: E731
+    text = (f"max / min of R over {FLAT[0]:g} <= mu <= {FLAT[1]:g}: " + listing(s, rows, spread, "b"))
+    twenty = [i for i in range(len(s["points/b"])) if s["points/b"][i] == 20.0]
+    if len(twenty) == 1:
+        text += f"; {spread(twenty[0])} for b = 20"
+    return text
+
+
+def _ks(s, rows):
+    return (f"KS distance of R(mu) to the fitted power law (GR b above mu = {s['attrs']['b_cut']:g}): "
+            + listing(s, rows, lambda i: number(s, i, "ks_gr"), "b"))
+
+
+def _large(vary):
+    def text(s, rows):
+        return (f"fraction of events with mu >= {s['attrs']['mu_c']:g}: "
+                + listing(s, rows, lambda i: number(s, i, "fraction_large"), vary))
+    return text
+
+
+WORDS = {2: "two", 3: "three", 4: "four", 5: "five"}
+
+
+def _c(s, rows):
+    text = _large("c")(s, rows) + "; c drops out of the equations exactly (a shift of u)"
+    if all(len({float(s[f"points/{k}"][i]) for i in rows}) == 1 for k in ("N", "l", "nu", "a", "b")):
+        text += f": one model, {WORDS.get(len(rows), len(rows))} trajectories"
+    return text
+
+
+def _recurrence(s, rows):
+    return "T nu at the peaks: " + listing(s, rows, lambda i: peaks(s, i), "N")
+
+
+def _large_b(s, rows):
+    spread = lambda i: ratio(shape_statistics(s, i)["flat_spread"], "the lowest bin")  # noqa: E731
+    return (_large("b")(s, rows) + "; KS distance to GR: " + listing(s, rows, lambda i: number(s, i, "ks_gr"), "b")
+            + f"; max / min of R over {FLAT[0]:g}..{FLAT[1]:g}: " + listing(s, rows, spread, "b"))
+
+
+@dataclass(frozen=True)
+class Claim:
+    statement: str                 # the paper's, as we read its text and figures
+    where: dict                    # parameter -> the values a point may have
+    vary: str                      # the parameter the claim runs over
+    least: int                     # values of `vary` it needs
+    numbers: Callable              # (summary, its points) -> the numbers that test it, as text
+
+
+CLAIMS = (
+    Claim("b = 20: R(mu) has a characteristic peak at large magnitude", {"b": (20.0,)}, "b", 1, _peak_and_dip),
+    Claim("b = 30..50: a flatter R(mu), no deep dip", {"b": (30.0, 40.0, 50.0)}, "b", 1, _flat),
+    Claim("R(mu) is not a Gutenberg-Richter power law", {"b": (20.0, 30.0, 40.0, 50.0)}, "b", 1, _ks),
+    Claim("little dependence on a (b = 50)", {"b": (50.0,)}, "a", 2, _large("a")),
+    Claim("little dependence on c (b = 20)", {"b": (20.0,)}, "c", 2, _c),
+    Claim("b = 20: a sharp recurrence peak near T nu ~ 500", {"b": (20.0,)}, "N", 1, _recurrence),
+    Claim("b = 40: two recurrence peaks", {"b": (40.0,)}, "N", 1, _recurrence),
+    Claim("larger b (60, 80, 100): a preliminary study", {"b": (60.0, 80.0, 100.0)}, "b", 1, _large_b),
+)
+
+
+def _matching(s, claim):
+    rows = [i for i in range(len(s["points/N"]))
+            if all(s[f"points/{k}"][i] in values for k, values in claim.where.items())]
+    return rows, len({float(s[f"points/{claim.vary}"][i]) for i in rows})
+
+
+def points_for(claim, summaries):
+    """(summary, its points) that test `claim`: the summary with the most values of claim.vary
+    among its matching points (the first of equals), or None if none has claim.least."""
+    best = None
+    for s in summaries:
+        rows, values = _matching(s, claim)
+        if values >= claim.least and (best is None or values > best[2]):
+            best = (s, rows, values)
+    return None if best is None else best[:2]
+
+
+def _needs(claim):
+    where = " or ".join(f"{v:g}" for v in next(iter(claim.where.values())))
+    key = next(iter(claim.where))
+    more = f" with {WORDS.get(claim.least, claim.least)} or more values of {claim.vary}" if claim.least > 1 else ""
+    return f"not computed: needs points with {key} = {where}{more}"
+
+
+def is_full_size(summaries):
+    return all((events_per_point(s) >= PAPER_EVENTS).all() for s in summaries)
+
+
+def claims_table(summaries):
+    """The paper's claims and this run's numbers as a Markdown table (the README's, on the five
+    full-size panels)."""
+    level = " / ".join(dict.fromkeys(level_text(s["attrs"]["level"]) for s in summaries))
+    size = "full size" if is_full_size(summaries) else "reduced"
+    out = [f"| the paper (Ohmura & Kawamura 2007) | {size}, this code ({level} intervals) |", "|---|---|"]
+    for claim in CLAIMS:
+        found = points_for(claim, summaries)
+        out.append(f"| {claim.statement} | {claim.numbers(*found) if found else _needs(claim)} |")
+    return "\n".join(out)
+
+
+def transients(s, name):
+    """Warnings (and notes) on the transients the catalogs of summary s discarded, one line each."""
+    lines = []
+    configs = [tomllib.loads(c) for c in s["attrs"]["configs"]]
+    for k, path in enumerate(s["attrs"]["catalogs"]):
+        tasks = np.flatnonzero(s["tasks/catalog"] == k)
+        if not len(tasks):
+            continue
+        transient = int(configs[k]["run"]["transient"])
+        n_blocks = int(s["tasks/N"][tasks].max())
+        measured = MEASURED_TRANSIENT_PER_BLOCK * n_blocks
+        if transient < measured:
+            lines.append(f"warning: {path}: run.transient = {transient} events at N = {n_blocks}, shorter than "
+                         f"the longest transient measured ({measured:g} events, {MEASURED_TRANSIENT_PER_BLOCK:g} per "
+                         "block: docs/benchmarks.md): its statistics include the random start")
+        elif transient < TRANSIENT_PER_BLOCK * n_blocks:
+            lines.append(f"note: {path}: run.transient = {transient} events at N = {n_blocks}, no shorter than the "
+                         f"longest transient measured ({measured:g}) but without the default's margin "
+                         f"({TRANSIENT_PER_BLOCK} N = {TRANSIENT_PER_BLOCK * n_blocks} events, "
+                         f"{TRANSIENT_PER_BLOCK / MEASURED_TRANSIENT_PER_BLOCK:g}x the measured)")
+    return lines
+
+
+def size_lines(summaries, names):
+    """The full size / reduced statement, one line per summary."""
+    lines = []
+    for s, name in zip(summaries, names):
+        if (events_per_point(s) >= PAPER_EVENTS).all():
+            lines.append(f"{name}: full size, {size_text(s)} (the paper: {count_text(PAPER_EVENTS)} per point "
+                         f"after {count_text(PAPER_TRANSIENT)} discarded)")
+        else:
+            lines.append(f"{name}: reduced, {size_text(s)} (the paper: {count_text(PAPER_EVENTS)} per point after "
+                         f"{count_text(PAPER_TRANSIENT)} discarded): wider intervals, and the numbers can differ "
+                         "from the full size's beyond them where the transient or the bootstrap's few units tell")
+    return lines
+
+
+def text(summaries, names):
+    """Everything `analysis paper` prints."""
+    lines = ["The paper's claims (Ohmura & Kawamura, EPL 77, 69001, 2007) beside this code's numbers", ""]
+    lines += size_lines(summaries, names)
+    for s, name in zip(summaries, names):
+        if partial_text(s):
+            lines.append(f"warning: {name}: {partial_text(s)}")
+        lines += transients(s, name)
+    lines += ["", claims_table(summaries)]
+    return "\n".join(lines)
