@@ -239,8 +239,8 @@ def _values(values, fmt="{}"):
 
 
 def _units(s):
-    """What a summary's bands resample: "20 stretches of each trajectory", "4 seeds" (or a range)."""
-    words = {"blocks": "stretches of each trajectory", "seeds": "seeds"}
+    """What a summary's bands resample: "20 stretches", "4 seeds" (or a range of counts)."""
+    words = {"blocks": "stretches", "seeds": "seeds"}
     return " / ".join(dict.fromkeys(
         f"{min(n)}-{max(n)} {words[m]}" if min(n) != max(n) else f"{n[0]} {words[m]}"
         for m in dict.fromkeys(s["points/method"])
@@ -278,13 +278,13 @@ def figure(summaries, kind, title=None, names=None):
     if kind == "magnitude":
         fig, ax = plt.subplots(figsize=(8 + 1.6 * (_legend_columns(n) - 1), 4.8), dpi=DPI)
         magnitude(summaries, ax, keys, labels)
-        fig.suptitle(text, fontsize=FONT + 1)
+        fig.suptitle(text, fontsize=FONT + 1, wrap=True)
         fig.tight_layout()
     else:
         rows, cols = _grid(n)
         fig = plt.figure(figsize=(5.5 * cols, 4 * rows + 0.4), dpi=DPI)
         recurrence(summaries, fig, labels)
-        fig.suptitle(text, fontsize=FONT + 1)
+        fig.suptitle(text, fontsize=FONT + 1, wrap=True)
         fig.tight_layout(rect=(0, 0.35 / fig.get_figheight(), 1, 1))
         place_insets(summaries, fig)
     return fig

@@ -2,8 +2,8 @@
 # Reduce, report and plot the full-size paper runs (runs/paper/*.h5 from run_full.sh) into docs/paper/.
 #   bash examples/paper/reduce_full.sh [RANKS]      (default 2; a few minutes)
 # Per panel: docs/paper/PANEL.summary.h5, the report PANEL.txt and the figure PANEL.png (fig2 also
-# fig2_magnitude.png); a panel whose catalog is not complete is skipped. When every panel is
-# there, all.summary.h5 / all.txt reduce them together (points that panels share pool: b = 20 from
+# fig2_magnitude.png; examples/paper/figures.sh); a panel whose catalog is not complete is skipped.
+# When every panel is there, all.summary.h5 / all.txt reduce them together (points that panels share pool: b = 20 from
 # fig1_b, fig1_c and fig2, b = 50 from fig1_b and fig1_a). tables.md (examples/paper/tables.py):
 # each run's tasks with events, wall time and events/s, and the paper's claims beside the numbers.
 set -euo pipefail
@@ -12,12 +12,6 @@ RANKS=${1:-2}
 PY=.venv/bin/python
 export NUMBA_CACHE_DIR=${NUMBA_CACHE_DIR:-$PWD/.numba_cache} OMP_NUM_THREADS=1 NUMBA_NUM_THREADS=1
 PANELS="fig1_b fig1_a fig1_c fig2 large_b"
-declare -A TITLE=(
-  [fig1_b]="Fig. 1 top: R(mu) for b = 20..50 (a = 0, c = 1e3)"
-  [fig1_a]="Fig. 1 middle: R(mu) for a = 0..30 (b = 50, c = 1e3)"
-  [fig1_c]="Fig. 1 bottom: R(mu) for c = 1e2..1e4 (a = 0, b = 20)"
-  [fig2]="Fig. 2: local recurrence times of mu >= 4 events, window 10 blocks"
-  [large_b]="larger b: R(mu) for b = 60, 80, 100 (a = 0, c = 1e3)")
 mkdir -p docs/paper
 done_panels=()
 for name in $PANELS; do
@@ -30,15 +24,8 @@ for name in $PANELS; do
   out=docs/paper/$name
   mpiexec -n "$RANKS" $PY -m analysis reduce "$cat" -o "$out.summary.h5" --force
   $PY -m analysis report "$out.summary.h5" > "$out.txt"
-  full=$'\n''full size: 2e5 events per point, 95% bootstrap bands over 20 stretches of each'
-  if [ "$name" = fig2 ]; then
-    $PY -m analysis plot "$out.summary.h5" --figure recurrence -o "$out.png" --title "${TITLE[$name]}$full"
-    $PY -m analysis plot "$out.summary.h5" --figure magnitude -o "${out}_magnitude.png" \
-      --title "Fig. 2 points: R(mu)$full"
-  else
-    $PY -m analysis plot "$out.summary.h5" --figure magnitude -o "$out.png" --title "${TITLE[$name]}$full"
-  fi
 done
+PY=$PY bash examples/paper/figures.sh docs/paper
 if [ ${#done_panels[@]} -eq 5 ]; then
   mpiexec -n "$RANKS" $PY -m analysis reduce "${done_panels[@]}" -o docs/paper/all.summary.h5 --force
   $PY -m analysis report docs/paper/all.summary.h5 > docs/paper/all.txt
