@@ -3,13 +3,17 @@
 # the system's Python, a PATH that shows only what the case puts there.
 #
 #   bash tests/install_paths.sh wheels    # no MPI on the machine: `make run` falls back to wheels
-#   bash tests/install_paths.sh modules   # an MPI and a parallel HDF5 as `module load` gives them
+#   bash tests/install_paths.sh found     # an MPI and a parallel HDF5 as `module load` gives them:
+#                                         # `make run` still takes the wheels, naming the stack found
+#   bash tests/install_paths.sh modules   # the same machine, STACK=parallel: built against them
 #
-# Run as root (it creates the user ensemble-user); CI runs both (.ci/run). Each case runs the
-# README's run command (`make run`), then the same config on 2 ranks with the environment
-# activated (`mpirun -n 2 python -m ensemble run ...`), checks the writer each used and that the
-# two catalogs hold the same events, and prints how long each step took. `wheels` also runs
-# tests/test_mpi.py on its stack.
+# Run as root (it creates the user ensemble-user); CI runs both (.ci/run). Each case sets up
+# (`wheels`: `make setup`, the default a new .venv gets; `modules`: `make setup STACK=parallel`),
+# runs the README's run command (`make run`), the Quick start's first run (which must compile
+# nothing: one numba cache), then the same config on 2 ranks with the environment activated
+# (`mpirun -n 2 python -m ensemble run ...`), checks the writer each used and that the catalogs
+# hold the same events, and prints how long each step took (the README's and docs/install.md's
+# setup times). `wheels` also runs tests/test_mpi.py on its stack.
 #
 # The user's PATH is one directory of links to /usr/bin's programs less every MPI and HDF5 wrapper
 # (mpicc, mpiexec, h5pcc, ...) and pkg-config, whatever this machine has installed. `modules` adds
@@ -18,7 +22,7 @@
 # root installs them).
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
-CASE=${1:?usage: bash tests/install_paths.sh wheels|modules}
+CASE=${1:?usage: bash tests/install_paths.sh wheels|found|modules}
 USER_NAME=ensemble-user
 say() { echo "install_paths $CASE: $*"; }
 [ "$(id -u)" = 0 ] || { say "run this as root: it creates the user $USER_NAME" >&2; exit 2; }
@@ -44,9 +48,10 @@ case $CASE in
   wheels)
     expect_stack=wheels
     expect_writer="serial HDF5 on rank 0"
-    tests="ENSEMBLE_TEST_STACK=wheels NUMBA_CACHE_DIR=\$PWD/.numba_cache OMP_NUM_THREADS=1 python -m pytest -q -rs tests/test_mpi.py"
+    stack_arg=
+    tests="ENSEMBLE_TEST_STACK=wheels OMP_NUM_THREADS=1 python -m pytest -q -rs tests/test_mpi.py"
     ;;
-  modules)
+  modules|found)
     hdf5=/usr/lib/x86_64-linux-gnu/hdf5/mpich
     [ -x /usr/bin/mpicc.mpich ] && [ -r "$hdf5/include/H5pubconf.h" ] \
       || { say "needs Debian's mpich, libmpich-dev and libhdf5-mpich-dev" >&2; exit 2; }
@@ -57,10 +62,16 @@ case $CASE in
     path=$module:$bin
     extra=(HDF5_DIR="$hdf5")
     expect_stack=parallel
+    stack_arg=STACK=parallel
     expect_writer="parallel HDF5 (mpio)"
     tests=true
+    if [ "$CASE" = found ]; then
+      expect_stack=wheels
+      stack_arg=
+      expect_writer="serial HDF5 on rank 0"
+    fi
     ;;
-  *) say "unknown case (wheels or modules)" >&2; exit 2 ;;
+  *) say "unknown case (wheels, found or modules)" >&2; exit 2 ;;
 esac
 git clone -q "$ROOT" "$work/repo"
 chown -R "$USER_NAME": "$work"
@@ -76,17 +87,23 @@ runuser -u "$USER_NAME" -- env -i HOME="$home" PATH="$path" LANG=C.UTF-8 PIP_CAC
   since() { python3 -c \"import sys; print(f'{float(sys.argv[2]) - float(sys.argv[1]):.0f} s')\" \"\$1\" \"\$(now)\"; }
   absent() { for c in \"\$@\"; do if command -v \$c; then say \"\$c is on PATH\"; exit 1; fi; done; }
   absent pkg-config h5pcc
-  [ $CASE = modules ] || absent mpicc mpiexec mpirun
+  [ $CASE = wheels ] && absent mpicc mpiexec mpirun
   t0=\$(now)
-  make setup 2>&1 | tee setup.log
+  make setup $stack_arg 2>&1 | tee setup.log
   test \"\$(cat .venv/ensemble-stack)\" = $expect_stack
-  [ $CASE = modules ] || grep -q 'falling back to the wheel stack' setup.log
-  [ $CASE = wheels ] || grep -q 'building mpi4py against $module/mpicc and h5py against HDF5_DIR=' setup.log
+  [ $CASE = wheels ] && grep -q 'falling back to the wheel stack' setup.log
+  [ $CASE = found ] && grep -q 'a parallel HDF5 stack is on this machine ($module/mpicc, HDF5_DIR=' setup.log
+  [ $CASE = modules ] && grep -q 'building mpi4py against $module/mpicc' setup.log
+  [ $CASE = modules ] && grep -q 'building h5py against HDF5_DIR=' setup.log
   say \"setup from a fresh clone: \$(since \$t0)\"
   t1=\$(now)
   make run 2>&1 | tee run.log
   say \"the serial run (make run; numba compiles the kernels first): \$(since \$t1)\"
   say \"fresh clone to the end of make run: \$(since \$t0)\"
+  t3=\$(now)
+  .venv/bin/python -m ensemble run examples/small.toml -o my.h5 2>&1 | tee quick.log
+  if grep -q 'compiling kernels' quick.log; then say 'the Quick start run compiled the kernels again'; exit 1; fi
+  say \"the Quick start's run after make run (no compiling): \$(since \$t3)\"
   . .venv/bin/activate
   [ $CASE = modules ] || test \"\$(command -v mpirun)\" = \"\$PWD/.venv/bin/mpirun\"
   t2=\$(now)

@@ -1,20 +1,28 @@
-"""scripts/stack.py finds an MPI compiler and a parallel HDF5 where clusters put them, and
-scripts/setup.sh refuses STACK=parallel without them before it changes anything.
+"""scripts/stack.py finds an MPI compiler and a parallel HDF5 where clusters put them;
+scripts/setup.sh refuses STACK=parallel without them before it changes anything, chooses the
+stack a new .venv gets, and says what it does while it does it; and every entry point takes the
+one numba cache of the package (ensemble/kernel_cache.py), so the kernels compile once.
 
 The machine's own stack is not used: each case builds the places a module system, Spack or a
 virtual environment would (executables, include/H5pubconf.h, .pc files) in a temporary directory,
-and runs the detection with a PATH of only those and the few programs it needs. The installs
-themselves (the wheel stack as a non-root user, the parallel stack from Debian) are run by
-tests/install_paths.sh (wheels, modules) and `make test` in CI.
+and runs the detection with a PATH of only those and the few programs it needs. setup.sh's choices
+and messages are checked against a stand-in for .venv's python (FAKE_PYTHON), which installs
+nothing. The installs themselves (the wheel stack as a non-root user, the parallel stack from
+Debian) are run by tests/install_paths.sh (wheels, modules) and `make test` in CI.
 """
 import os
+import re
 import shutil
 import subprocess
 import sys
 
 import pytest
 
-from .processes import ROOT
+from ensemble import kernel_cache
+from ensemble.slurm import JobOptions, render
+
+from .conftest import write_config
+from .processes import ROOT, child_env, run_bounded
 
 sys.path.insert(0, str(ROOT / "scripts"))
 import stack  # noqa: E402  (scripts/ is not a package: setup.sh runs it before .venv exists)
@@ -146,3 +154,132 @@ def test_an_unknown_stack_is_an_error_naming_it(tmp_path):
     res = run_setup(setup_copy(tmp_path), [tools(tmp_path, "dirname")], STACK="conda")
     assert res.returncode == 1
     assert res.stderr.strip() == "setup: error: STACK=conda: must be auto, parallel or wheels"
+
+
+# -- what setup.sh says, and which stack it takes -----------------------------------------------
+
+# .venv's python as setup.sh calls it, installing nothing: `pip install -e` (the project) takes
+# FAKE_PIP_SECONDS, other pip installs none; every import works; h5py has MPI only with FAKE_MPI_H5PY.
+FAKE_PYTHON = """#!/bin/sh
+case "$*" in
+  "-m pip install"*" -e "*) sleep "${FAKE_PIP_SECONDS:-0}" ;;
+  *"get_config().mpi"*) [ -n "$FAKE_MPI_H5PY" ] ;;
+esac
+"""
+SETUP_TOOLS = ("dirname", "id", "cat", "rm", "sleep", "tail", "sed", "touch", "mktemp", "timeout", "env")
+
+
+def fake_setup(tmp_path, *path, timeout=120, **variables):
+    """setup.sh in a copy whose .venv holds FAKE_PYTHON, run with PATH = path + a few tools."""
+    repo = tmp_path / "repo"
+    if not repo.exists():     # the first run of a test
+        setup_copy(tmp_path)
+        executable(repo / ".venv" / "bin" / "python", FAKE_PYTHON)
+        tools(tmp_path, *SETUP_TOOLS)
+    env = {"PATH": os.pathsep.join(map(str, [*path, tmp_path / "tools"])), "HOME": str(repo),
+           "PYTHON": sys.executable, **variables}
+    res = run_bounded([shutil.which("bash"), repo / "scripts" / "setup.sh"], timeout, env=env)
+    assert res.returncode == 0, res.stdout + res.stderr
+    return repo, res.stdout.splitlines()
+
+
+def test_setup_numbers_its_stages_with_the_time_and_beats_during_a_long_step(tmp_path):
+    _, lines = fake_setup(tmp_path, STACK="wheels", SETUP_HEARTBEAT="1", FAKE_PIP_SECONDS="4")
+    stages = [line for line in lines if re.fullmatch(r"setup: \[\d/\d\] .* \(elapsed \d+:\d\d\)", line)]
+    assert [line[:12] for line in stages] == ["setup: [1/3]", "setup: [2/3]", "setup: [3/3]"], lines
+    assert "installing the project" in stages[2]
+    # the 4 s step is not silent: a line every second, after its stage line
+    beats = [i for i, line in enumerate(lines)
+             if re.fullmatch(r"setup:   \.\.\. still installing the project, \d+:\d\d elapsed", line)]
+    assert beats and min(beats) > lines.index(stages[2]), lines
+    assert re.fullmatch(r"setup: ok: stack wheels \(\d+:\d\d\)", lines[-1]), lines
+
+
+def test_the_heartbeat_ends_with_its_step_and_holds_no_pipe_open(tmp_path):
+    """A beat every 10 minutes: if its sleep outlived the step with setup's stdout, the pipe this
+    test reads (as `make setup | tee log` does) would stay open until the deadline, failing it."""
+    _, lines = fake_setup(tmp_path, timeout=60, STACK="wheels", SETUP_HEARTBEAT="600", FAKE_PIP_SECONDS="1")
+    assert lines[-1].startswith("setup: ok: stack wheels"), lines
+    assert not any("still" in line for line in lines), lines
+
+
+def test_auto_gives_a_new_venv_the_wheels_and_names_the_parallel_stack_it_could_build(tmp_path):
+    mpicc = executable(tmp_path / "mpi" / "bin" / "mpicc")
+    prefix = hdf5_prefix(tmp_path / "hdf5-mpi", PARALLEL_HEADER)
+    repo, lines = fake_setup(tmp_path, mpicc.parent, HDF5_DIR=prefix)
+    text = "\n".join(lines)
+    assert f"a parallel HDF5 stack is on this machine ({mpicc}, HDF5_DIR={prefix})" in text
+    assert "make setup STACK=parallel" in text and "building" not in text
+    assert lines[-1].startswith("setup: ok: stack wheels") and (repo / ".venv" / "ensemble-stack").read_text() == "wheels\n"
+    # a parallel .venv that no longer imports (here: its h5py has no MPI) is rebuilt, falling back to wheels
+    (repo / ".venv" / "ensemble-stack").write_text("parallel\n")
+    _, lines = fake_setup(tmp_path, mpicc.parent, HDF5_DIR=prefix)
+    text = "\n".join(lines)
+    assert re.search(r"setup: \[2/5\] building mpi4py against .*mpicc \(elapsed", text), text
+    assert "h5py was built but has no MPI support" in text and lines[-1].startswith("setup: ok: stack wheels")
+    # STACK=parallel builds it (make test)
+    _, lines = fake_setup(tmp_path, mpicc.parent, HDF5_DIR=prefix, STACK="parallel", FAKE_MPI_H5PY="1")
+    assert lines[-1].startswith("setup: ok: stack parallel"), lines
+
+
+# -- one numba cache for every entry point ------------------------------------------------------
+
+# where the chain kernels and the reduction's scan kernel are cached, imported in this order (the
+# reduction first, as `python -m analysis` imports it)
+CACHE_PROBE = ("import analysis.recurrence as r, ensemble.model.chain as c; "
+               "print(c.simulate._cache._cache_path); print(r.scan._cache._cache_path)")
+
+
+def without_cache_variable():
+    return {k: v for k, v in child_env().items() if k != "NUMBA_CACHE_DIR"}
+
+
+def test_every_entry_point_takes_the_packages_kernel_cache(tmp_path, monkeypatch):
+    env = without_cache_variable()
+    probe = tmp_path / "probe.py"
+    probe.write_text(CACHE_PROBE.replace("; ", "\n"))
+    base = kernel_cache.base(env)
+    assert base == str(ROOT / ".numba_cache")     # an editable install: the checkout's
+    seen = {}
+    for target in ("run", "quick"):     # the Makefile's environment (-o setup: not set up again)
+        res = run_bounded(["make", "-s", "-C", ROOT, "-o", "setup", target, f"PY={sys.executable} {probe}"], 300,
+                          env=env)
+        assert res.returncode == 0, res.stdout + res.stderr
+        seen[f"make {target}"] = res.stdout.split()
+    # python -m ensemble / -m analysis from a user's directory
+    res = run_bounded([sys.executable, "-c", CACHE_PROBE], 300, cwd=tmp_path, env=env)
+    assert res.returncode == 0, res.stderr
+    seen["python"] = res.stdout.split()
+    for where, (chain, scan) in seen.items():
+        assert chain.startswith(base + os.sep) and scan.startswith(base + os.sep), (where, chain, scan)
+    assert len({tuple(paths) for paths in seen.values()}) == 1, seen
+    # the commands the tests start, and the Slurm jobs (they set no cache of their own by default)
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    assert child_env()["NUMBA_CACHE_DIR"] == base
+    cfg = write_config(tmp_path / "tiny.toml")
+    from ensemble.config import load
+    job = render(load(cfg), JobOptions(), tmp_path / "job")
+    for script in (job.run_script, job.reduce_script):
+        assert "export NUMBA_CACHE_DIR" not in script.read_text(), script
+
+
+def test_after_make_run_the_quick_start_run_compiles_nothing(tmp_path):
+    """In a copy of the checkout with an empty cache: `make run` compiles the kernels; the Quick
+    start's `python -m ensemble run` after it must find them (one cache, not two)."""
+    repo = tmp_path / "checkout"
+    for name in ("ensemble", "analysis"):
+        shutil.copytree(ROOT / name, repo / name, ignore=shutil.ignore_patterns("__pycache__"))
+    for name in ("Makefile", "pyproject.toml", "setup.cfg"):
+        shutil.copy(ROOT / name, repo / name)
+    (repo / ".venv").symlink_to(ROOT / ".venv")
+    (repo / "examples").mkdir()
+    write_config(repo / "examples" / "small.toml", model={"N": 20}, run={"events": 20, "transient": 5, "seeds": 1})
+    env = without_cache_variable()
+    res = run_bounded(["make", "-s", "-o", "setup", "run"], 600, cwd=repo, env=env)
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert "compiling kernels" in res.stdout, res.stdout        # the copy's own, empty cache
+    assert (repo / ".numba_cache").is_dir()
+    res = run_bounded([sys.executable, "-m", "ensemble", "run", "examples/small.toml", "-o", "x.h5"], 600,
+                      cwd=repo, env=env)
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert "compiling kernels" not in res.stdout, res.stdout
