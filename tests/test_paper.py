@@ -1,0 +1,121 @@
+"""`python -m analysis paper`: on the committed full-size summaries it prints the README's claims
+table, labelled full size; on a reduced Fig. 1 top run (a real catalog, small) the same claims
+with intervals, labelled reduced, with a warning on its short transient; a claim its points do not
+allow, or a number that cannot be computed, is said in words, never nan."""
+import re
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from analysis import paper, summary
+
+from .conftest import run_cli
+from .processes import run_bounded
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs/paper"
+PANELS = ("fig1_b", "fig1_a", "fig1_c", "fig2", "large_b")   # the order of docs/paper.md
+
+
+def run_analysis(*args):
+    return run_bounded([sys.executable, "-m", "analysis", *map(str, args)], 300, cwd=ROOT)
+
+
+def readme_claims():
+    text = (ROOT / "README.md").read_text()
+    start = text.index("| the paper (Ohmura")
+    return text[start:text.index("\n\n", start)]
+
+
+def test_full_size_summaries_give_the_readme_table():
+    res = run_analysis("paper", *(DOCS / f"{p}.summary.h5" for p in PANELS))
+    assert res.returncode == 0, res.stderr
+    claims = readme_claims()
+    assert len(claims.splitlines()) == 10           # header, rule, eight claims
+    assert claims in res.stdout
+    assert "full size, this code (95% intervals)" in claims
+    for p in PANELS:
+        assert f"{DOCS / p}.summary.h5: full size, 2e5 events per point" in res.stdout
+    assert "warning" not in res.stdout and "reduced" not in res.stdout
+
+
+@pytest.mark.parametrize("name", PANELS + ("all",))
+def test_each_summary_alone_says_what_it_cannot_compute(name):
+    s = summary.read(DOCS / f"{name}.summary.h5")
+    out = paper.text([s], [name])
+    assert not re.search(r"\bnan\b", out, re.IGNORECASE), out
+    rows = out[out.index("|---|---|"):].splitlines()[1:]
+    assert len(rows) == len(paper.CLAIMS)
+    for claim, row in zip(paper.CLAIMS, rows):
+        found = paper.points_for(claim, [s])
+        assert ("not computed: needs points" in row) == (found is None), row
+        assert (found is None) or "[" in row, row       # every computed claim with its intervals
+
+
+def test_claims_read_their_own_panel():
+    """Given all five, each claim takes the summary with the most values of what it varies."""
+    panels = [summary.read(DOCS / f"{p}.summary.h5") for p in PANELS]
+    chosen = [PANELS[next(k for k, s in enumerate(panels) if s is paper.points_for(c, panels)[0])]
+              for c in paper.CLAIMS]
+    assert chosen == ["fig1_b", "fig1_b", "fig1_b", "fig1_a", "fig1_c", "fig2", "fig2", "large_b"]
+
+
+def test_measured_transient_is_the_benchmarks():
+    """MEASURED_TRANSIENT_PER_BLOCK is the longest transient of benchmarks/results/transient.txt."""
+    rows = [line.split("|") for line in (ROOT / "benchmarks/results/transient.txt").read_text().splitlines()
+            if line.startswith("| N =")]
+    assert max(float(r[6]) for r in rows) == paper.MEASURED_TRANSIENT_PER_BLOCK
+
+
+def test_ratio_over_an_empty_bin_is_said_in_words():
+    assert paper.ratio((82.3, 70.6, 105.0, 0.0), "the dip bin") == "82.3 [70.6, 105]"
+    assert paper.ratio((346.0, 160.0, np.nan, 0.47), "the dip bin") == \
+        "346 [160, unbounded: the dip bin is empty in 47% of the resamples]"
+    assert paper.ratio((np.inf, np.nan, np.nan, 1.0), "the dip bin").startswith("unbounded (the dip bin holds no")
+    assert paper.with_interval((np.nan, np.nan, np.nan)) == "not computable from these events"
+
+
+@pytest.fixture(scope="module")
+def reduced(tmp_path_factory):
+    """Fig. 1 top's reduced config, smaller still: b = 20..50, 2 seeds x 300 events after 100."""
+    d = tmp_path_factory.mktemp("paper")
+    res = run_cli("run", ROOT / "examples/paper/fig1_b_reduced.toml", "-o", d / "cat.h5",
+                  "--set", "run.seeds=2", "--set", "run.events=300", "--set", "run.transient=100")
+    assert res.returncode == 0, res.stderr
+    res = run_analysis("reduce", d / "cat.h5", "-o", d / "sum.h5", "--bootstrap", "200")
+    assert res.returncode == 0, res.stderr
+    return d
+
+
+def test_reduced_run_is_labelled_and_warned(reduced):
+    res = run_analysis("paper", reduced / "sum.h5")
+    assert res.returncode == 0, res.stderr
+    out = res.stdout
+    assert f"{reduced / 'sum.h5'}: reduced, 600 events per point (2 seeds x 300)" in out
+    assert "| reduced, this code (95% intervals) |" in out and ": full size" not in out
+    assert (f"warning: {reduced / 'cat.h5'}: run.transient = 100 events at N = 800, shorter than the longest "
+            "transient measured (1000 events") in out
+    assert not re.search(r"\bnan\b", out, re.IGNORECASE), out
+    rows = dict(line.strip(" |").split(" | ", 1) for line in out.splitlines()[out.splitlines().index("|---|---|") + 1:])
+    assert list(rows) == [claim.statement for claim in paper.CLAIMS]
+    # the b = 20..50 claims are computed; 600 events leave bins of R(mu) empty and peaks unresolved,
+    # which each number says in words where it has no interval
+    for claim in paper.CLAIMS[:3] + paper.CLAIMS[5:7]:
+        row = rows[claim.statement]
+        assert "not computed" not in row, row
+        assert "[" in row or "unbounded (" in row or "no significant peak" in row, row
+    ks = rows[paper.CLAIMS[2].statement]
+    assert len(re.findall(r"\d \[0\.\d+, 0\.\d+\]", ks)) == 4, ks     # four KS distances with intervals
+    for claim in (paper.CLAIMS[3], paper.CLAIMS[4], paper.CLAIMS[7]):
+        assert rows[claim.statement].startswith("not computed: needs points with b = "), rows[claim.statement]
+
+
+def test_bad_input_is_one_line_naming_the_file(reduced, tmp_path):
+    for path, words in ((tmp_path / "missing.summary.h5", "missing.summary.h5"),
+                        (reduced / "cat.h5", "cat.h5")):
+        res = run_analysis("paper", path)
+        assert res.returncode == 1 and not res.stdout, res
+        lines = res.stderr.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith("error: ") and words in lines[0], res.stderr
