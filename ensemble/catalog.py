@@ -38,8 +38,6 @@ CRC-32 checksums (integrity.py), verified with range checks on resume and on rea
 a corrupt catalog fails naming the task and what is wrong, never resumes or reduces
 silently wrong.
 """
-import ctypes
-import errno
 import os
 from dataclasses import dataclass
 
@@ -47,12 +45,14 @@ import h5py
 import numpy as np
 
 from . import __version__
-from .config import LAW_KEYS, ConfigError
+from . import space, tables
+from .config import LAW_KEYS, ConfigError, loads
 from .model import laws
-from .tasks import spinups as spinup_points
+from .tasks import spinups as spinup_points, task_list
 from .integrity import EventCrc, commit_crc, crc, event_problems
+from .tables import FAILED, FINISHED, OPEN, STATUS_NAMES
 
-FORMAT = "bk-catalog-3"
+FORMAT = "bk-catalog-4"
 
 EVENT_FIELDS = {
     "task": np.int64, "t": np.float64, "epicenter": np.int64, "mu": np.float64,
@@ -111,6 +111,8 @@ DATASETS = {
     "tasks/error": ("text", _TASK_ROWS, f"why a failed task failed, empty otherwise (UTF-8, {TEXT_BYTES} bytes at most)"),
     "tasks/integrator": ("text", _TASK_ROWS, "the task's [integrator] as TOML (a failed task may be rerun "
                                              f"with another; UTF-8, {TEXT_BYTES} bytes at most)"),
+    "tasks/record_crc": ("CRC-32", _TASK_ROWS, "CRC of the task's record (status, error, integrator, provenance; "
+                                              "ensemble/tables.py), rewritten with it"),
     "tasks/branch_of": ("index", _TASK_ROWS, "the spin-up (row of /spinup, = its point) whose state the task "
                                              "started from, perturbed (run.branch); -1: its own initial state"),
     "spinup/point": ("index", "(points,)", "parameter point of the spin-up (run.branch only)"),
@@ -152,8 +154,6 @@ def schema(table=None):
 if __doc__:    # (None under python -OO)
     __doc__ += "\nDatasets (DATASETS):\n\n" + schema() + "\n"
 
-OPEN, FINISHED, FAILED = 0, 1, 2      # /tasks/status
-STATUS_NAMES = {OPEN: "open", FINISHED: "finished", FAILED: "failed"}
 _FILL = {np.int64: -1, np.float64: np.nan, np.bool_: False}
 # fields of a commit row (/checkpoint/commit[task, slot])
 C_SEQ, C_DONE, C_WRITTEN, C_STATE_CRC, C_EVENTS_CRC, C_ROW_CRC = range(6)
@@ -237,6 +237,7 @@ class TaskRecord:
     status: int = OPEN
     integrator: str = ""            # its [integrator] as TOML text
     error: str = ""
+    damaged: str = ""               # what is wrong with its record (tables.py): rerun it from its start
 
 
 class _Layout:
@@ -277,6 +278,7 @@ class _Layout:
             raise CatalogError(f"{self.path}: damaged catalog (its datasets do not fit together)")
         self.n_tasks = n_tasks
         self.n_records = n_records
+        self._verify_tables()
         self._crc = {}    # task -> EventCrc of its rows written so far (on the writing process)
         self._head = {}   # task -> Head in use (on the writing process)
 
@@ -332,12 +334,54 @@ class _Layout:
         cp.create_dataset("commit", data=np.zeros((len(sizes), 2, NCOMMIT), dtype=np.int64))
         # metadata, written once here like the rest of the layout; under mpio every rank runs
         # this with the same values in the same order, as attribute writes are collective
+        columns = {name: tg[name][...] for name in tables.RECORD}
+        tg.create_dataset("record_crc", data=np.array(
+            [tables.record_crc(k, {name: col[k] for name, col in columns.items()}) for k in range(len(tasks))],
+            dtype=np.int64))
         for name, entry in DATASETS.items():
             if name in h5:    # /spinup only with run.branch
                 h5[name].attrs["description"] = description(entry)
+        h5.attrs["tables_crc"] = _fixed_digest(h5)
 
     def _fail(self, task, what):
         return CatalogError(f"{self.path}: task {task}: {what} (corrupt catalog)")
+
+    def _verify_tables(self):
+        """The tables fixed at creation against their checksum, and against the stored config."""
+        stored = self.h5.attrs.get("tables_crc")
+        if stored is None or int(stored) != _fixed_digest(self.h5):
+            raise CatalogError(f"{self.path}: damaged catalog: its parameter tables or stored config fail "
+                               f"their checksum (tables_crc); its events cannot be attributed, rerun")
+        try:
+            cfg = loads(self.h5.attrs["config"])
+        except ConfigError as err:
+            raise CatalogError(f"{self.path}: damaged catalog: its stored config is invalid ({err})") from None
+        tasks = task_list(cfg)
+        spinups = spinup_points(cfg, tasks)
+        wrong = tables.config_problems({name: ds[...] for name, ds in self.tasks.items()},
+                                       tables.expected_parameters(tasks, spinups, LAW_KEYS))
+        if (self.per_task, self.transient, self.spinup_events) != (
+                cfg.run.events, cfg.run.discarded, cfg.run.transient if spinups else 0):
+            wrong.append("the root attributes events_per_task, transient, spinup")
+        if wrong:
+            raise CatalogError(f"{self.path}: damaged catalog: {', '.join(wrong)} disagree with its stored config")
+        self.run_seed = cfg.run.seed
+
+    def record_row(self, task):
+        """Task `task`'s record columns (tables.RECORD), its record_crc and events_written mirror."""
+        return {name: self.tasks[name][task] for name in (*tables.RECORD, "record_crc", "events_written")}
+
+    def record_problem(self, task, row=None):
+        """What is wrong with a task's record (tables.record_problems), '' if nothing."""
+        head = self.head(task)
+        written = [] if head is None else [head.written] + [
+            int(self.commit[task, slot, C_WRITTEN]) for slot in (1 - head.slot,) if any(self.commit[task, slot])]
+        return tables.record_problems(task, self.record_row(task) if row is None else row, written,
+                                      self.per_task, self.run_seed)
+
+    def _seal(self, task):
+        """The record's CRC, after every write of a record column (the last write of each)."""
+        self.tasks["record_crc"][task] = tables.record_crc(task, self.record_row(task))
 
     # -- reading and verifying -------------------------------------------------------------
 
@@ -425,9 +469,9 @@ class _Layout:
             rec = TaskRecord(status=int(self.tasks["status"][task]),
                              integrator=self.tasks["integrator"][task].decode(errors="replace"),
                              error=self.tasks["error"][task].decode(errors="replace"))
-        if rec.status not in STATUS_NAMES:
-            raise self._fail(task, f"status {rec.status} out of range")
-        if head is None or restart:
+            if not restart:
+                rec.damaged = self.record_problem(task)
+        if head is None or restart or rec.damaged:
             self._crc[task] = EventCrc(EVENT_FIELDS)
             return rec
         self._crc[task] = self.verify_events(task, head.written)
@@ -480,12 +524,14 @@ class _Layout:
             for name, value in values.items():
                 self.tasks[name][task] = value
             self.tasks["status"][task] = FINISHED
+            self._seal(task)
         self._write(task, "provenance", write)
 
     def write_failure(self, task, message):
         def write():
             self.tasks["error"][task] = _text(message)
             self.tasks["status"][task] = FAILED
+            self._seal(task)
         self._write(task, "failure record", write)
 
     def write_start(self, task, integrator_text):
@@ -494,6 +540,7 @@ class _Layout:
             self.tasks["integrator"][task] = _text(integrator_text)
             self.tasks["error"][task] = _text("")
             self.tasks["status"][task] = OPEN
+            self._seal(task)
         self._write(task, "start record", write)
 
 
@@ -514,6 +561,17 @@ class writing:
                            broken=True) from None
 
 
+def _fixed_digest(h5):
+    """CRC of everything fixed at a catalog's creation (tables.py): the parameter tables, /spinup,
+    /checkpoint/offset and the root attributes."""
+    fixed = (*TASK_FIELDS, "law", "branch_of")
+    named = {f"tasks/{name}": h5["tasks"][name][...] for name in fixed if name in h5["tasks"]}
+    named.update({f"spinup/{name}": ds[...] for name, ds in h5["spinup"].items()} if "spinup" in h5 else {})
+    named["checkpoint/offset"] = h5["checkpoint"]["offset"][...]
+    named.update({f"@{name}": h5.attrs[name] for name in tables.FIXED_ATTRS if name in h5.attrs})
+    return tables.digest(named)
+
+
 def _early_allocation():
     """Dataset creation properties: file space allocated at creation, so the file's layout
     (and its metadata) never changes afterwards (serial HDF5 would allocate at the first write)."""
@@ -523,52 +581,60 @@ def _early_allocation():
 
 
 def _reserve_space(path):
-    """Reserve the file's disk blocks now where the file system does that at once (fallocate).
-
-    Then a full disk stops a run at its start, not hours later; where fallocate is not
-    supported (some network file systems) nothing is reserved and a write that fails
-    later ends the run with a clear error instead.
-    """
-    libc = ctypes.CDLL(None, use_errno=True)
-    fallocate = getattr(libc, "fallocate", None)
-    if fallocate is None:
-        return
-    fallocate.argtypes = (ctypes.c_int, ctypes.c_int, ctypes.c_int64, ctypes.c_int64)
+    """Reserve the file's disk blocks now (space.py), so that a full disk stops a run at its start,
+    not hours later; where the file system cannot reserve, a write that fails later ends the run
+    with a clear error instead."""
     fd = os.open(path, os.O_RDWR)
     try:
-        size = os.fstat(fd).st_size
-        if size and fallocate(fd, 0, 0, size) != 0:
-            err = ctypes.get_errno()
-            if err in (errno.ENOSPC, errno.EDQUOT, errno.EFBIG):
-                raise OSError(err, f"{os.strerror(err)}: the catalog needs {size / 2**20:.1f} MiB")
+        space.reserve(fd, os.fstat(fd).st_size, "the catalog")
     finally:
         os.close(fd)
 
 
-def _create_file(path, open_file, cfg, tasks, integrator_text, software, reserve=True):
-    """Create a catalog; on failure remove what was made (we hold the run's lock) and raise CatalogError.
+def estimate_bytes(cfg, tasks):
+    """An upper bound of the size of the catalog of `tasks` (what space.check_fits asks for)."""
+    records = list(tasks) + spinup_points(cfg, tasks)
+    data = (len(tasks) * cfg.run.events * sum(np.dtype(t).itemsize for t in EVENT_FIELDS.values())
+            + 8 * sum(2 * _state_size(t.model.N) for t in records)            # checkpoint slots
+            + len(records) * 8 * (2 * NCOMMIT + 1)                            # commit rows, offsets
+            + len(tasks) * (8 * (len(TASK_FIELDS) + len(PROVENANCE_FIELDS) + 5) + 2 * TEXT_BYTES + LAW_BYTES))
+    metadata = 4096 * (len(DATASETS) + 4) + 2 * len(cfg.to_toml()) + 64 * 1024
+    return int(data * 1.01) + metadata
 
-    reserve: this process reserves the disk space (one rank of a parallel create).
+
+def _discard(path):
+    try:
+        os.remove(path)
+    except OSError:
+        pass
+
+
+# files whose HDF5 write failed: kept referenced until the process ends (os._exit, or MPI_Abort), as
+# freeing one makes h5py close it, which fails again (a traceback per object) or crashes
+_BROKEN = []
+
+
+def _create_file(path, open_file, cfg, tasks, integrator_text, software):
+    """Create a catalog's layout and flush it; on failure remove the file (we hold the run's lock) and raise
+    CatalogError.
+
+    A failed HDF5 write leaves the open file in a state where anything more, closing included, may
+    crash HDF5 or (under mpio) wait for ranks that are elsewhere: then the file is removed, not closed,
+    and the error is `broken` (the process ends at once; under MPI all ranks abort). space.check_fits
+    has made that rare: it runs before, with plain files.
     """
-    h5 = None
     try:
         h5 = open_file(path, "w")
+    except (OSError, ValueError, RuntimeError) as err:
+        raise CatalogError(f"{path}: cannot create catalog ({_reason(err)})") from None
+    try:
         _Layout.create(h5, cfg, tasks, integrator_text, software)
         h5.flush()
-        if reserve:
-            _reserve_space(path)
         return h5
     except (OSError, ValueError, RuntimeError) as err:
-        if h5 is not None:
-            try:
-                h5.close()
-            except Exception:  # noqa: BLE001 - already failing; the first error is the one to report
-                pass
-        try:
-            os.remove(path)
-        except OSError:
-            pass
-        raise CatalogError(f"{path}: cannot create catalog ({err})") from None
+        _BROKEN.append(h5)
+        _discard(path)
+        raise CatalogError(f"{path}: cannot create catalog ({_reason(err)})", broken=True) from None
 
 
 def _open_file(path, open_file):
@@ -603,12 +669,11 @@ class ParallelWriter(_Writer):
 
         def open_file(p, mode):
             return h5py.File(p, mode, driver="mpio", comm=comm)
+        if cfg is not None:
+            self._create(path, open_file, cfg, tasks, integrator_text, software)
         error = None
         try:
-            if cfg is not None:
-                self.h5 = _create_file(path, open_file, cfg, tasks, integrator_text, software,
-                                       reserve=comm.Get_rank() == 0)
-            else:
+            if cfg is None:
                 self.h5 = _open_file(path, open_file)
             self.layout = _Layout(self.h5)
         except CatalogError as err:
@@ -616,6 +681,37 @@ class ParallelWriter(_Writer):
         errors = [e for e in comm.allgather(error) if e]
         if errors:
             raise CatalogError(errors[0], collective=True)
+
+    def _create(self, path, open_file, cfg, tasks, integrator_text, software):
+        """Collective create. Every step either succeeds on every rank or ends them all alike: an open that
+        fails everywhere is one error; a failure inside HDF5's collective calls (which may have left the
+        other ranks waiting in one) is `broken` and aborts all ranks; the blocks are reserved by rank 0
+        after every rank has flushed, and its outcome broadcast, so a full disk closes the file on
+        every rank together and removes it."""
+        comm = self.comm
+        error = None
+        try:
+            self.h5 = _create_file(path, open_file, cfg, tasks, integrator_text, software)
+        except CatalogError as err:
+            if err.broken:
+                raise
+            error = str(err)
+        errors = comm.allgather(error)
+        if any(errors):
+            if not all(errors):     # open on some ranks only: a collective close would hang
+                raise CatalogError(next(e for e in errors if e), broken=True)
+            raise CatalogError(errors[0], collective=True)
+        if comm.Get_rank() == 0:
+            try:
+                _reserve_space(path)
+            except OSError as err:
+                error = f"{path}: cannot create catalog ({err})"
+        error = comm.bcast(error, root=0)
+        if error:
+            self.h5.close()
+            if comm.Get_rank() == 0:
+                _discard(path)
+            raise CatalogError(error, collective=True)
 
     def commit(self, task, start, batch, checkpoint):
         if batch is not None:
@@ -662,19 +758,26 @@ class Rank0Writer(_Writer):
         self.rank = comm.Get_rank()
         self.layout = None
         self.finished_ranks = 0
-        error = None
+        error = broken = None
         if self.rank == 0:
             try:
                 if cfg is not None:
                     self.h5 = _create_file(path, h5py.File, cfg, tasks, integrator_text, software)
+                    try:
+                        _reserve_space(path)
+                    except OSError as err:
+                        self.h5.close()     # (no HDF5 call failed: closing is safe)
+                        _discard(path)
+                        raise CatalogError(f"{path}: cannot create catalog ({err})") from None
                 else:
                     self.h5 = _open_file(path, h5py.File)
                 self.layout = _Layout(self.h5, barrier=self._flush)
             except CatalogError as err:
-                error = str(err)
+                error, broken = str(err), err.broken
         error = comm.bcast(error, root=0)
         if error:
-            raise CatalogError(error, collective=True)
+            # only rank 0 touched the file: a broken one ends rank 0 at once, the others return alike
+            raise CatalogError(error, broken=bool(broken), collective=True)
 
     def _call(self, kind, *args):
         """Do `kind` here (rank 0) or ask rank 0 to."""
@@ -825,8 +928,11 @@ class Reader:
                 ...
     """
 
-    def __init__(self, path):
+    def __init__(self, path, damaged_ok=False):
+        """damaged_ok: a task whose record is damaged (tables.py) is listed in `damaged` {task: what}
+        instead of refused (a resume reruns it)."""
         self.path = str(path)
+        self.damaged_ok = damaged_ok
         self.h5 = _open_for_reading(self.path)
         try:
             self._read_tasks()
@@ -843,11 +949,23 @@ class Reader:
             self.tasks = {name: ds[...] for name, ds in self.layout.tasks.items()}
             heads = [self.layout.head(k) for k in range(self.layout.n_tasks)]
             spun = [self.layout.head(k) for k in range(self.layout.n_tasks, self.layout.n_records)]
+            # each task's record (tables.py); a resume reruns a damaged one, anything else refuses it
+            self.damaged = {}
+            for k in range(self.layout.n_tasks):
+                problem = self.layout.record_problem(k, {name: self.tasks[name][k] for name in (
+                    *tables.RECORD, "record_crc", "events_written")})
+                if problem and not self.damaged_ok:
+                    raise self.layout._fail(k, problem)
+                if problem:
+                    self.damaged[k] = problem
+                    self.tasks["status"][k] = OPEN     # to be rerun
         # run.branch: each point's spin-up, its events done (of attrs["spinup"])
         self.spinups = {**self.layout.spinup,
                         "events_done": np.array([0 if h is None else h.done for h in spun], dtype=np.int64)}
         self.tasks["events_written"] = np.array([0 if h is None else h.written for h in heads], dtype=np.int64)
         self.tasks["events_done"] = np.array([0 if h is None else h.done for h in heads], dtype=np.int64)
+        for k in self.damaged:       # (damaged_ok) to be rerun from its start
+            self.tasks["events_written"][k] = self.tasks["events_done"][k] = 0
         n = self.layout.n_tasks
         # catalogs written before there was a choice of law ran the aging law (a, b, c only)
         self.tasks.setdefault("law", np.full(n, b"aging"))
@@ -878,12 +996,13 @@ class Reader:
         self.close()
 
 
-def read_tasks(path):
+def read_tasks(path, damaged_ok=False):
     """Catalog -> (rows per task, tasks: dict of arrays, attrs: dict), without the events.
 
     tasks["events_written"] is each task's committed event count (from its commit row).
+    damaged_ok: tasks whose record is damaged are not refused (Reader); a resume reruns them.
     """
-    with Reader(path) as cat:
+    with Reader(path, damaged_ok) as cat:
         return cat.per_task, cat.tasks, cat.attrs
 
 

@@ -80,7 +80,7 @@ def _resume_config(args):
     partial = partial_path(path)
     if not os.path.exists(partial):
         return None, path, None
-    _, _, attrs = read_tasks(partial)
+    _, _, attrs = read_tasks(partial, damaged_ok=True)
     rerun = False
     for text in args.set:
         section, key, _ = parse_override(text)

@@ -12,7 +12,7 @@ import tomllib
 
 import numpy as np
 
-from . import catalog, environment
+from . import catalog, environment, space
 from .catalog import FAILED, FINISHED, Checkpoint, CatalogError
 from .config import ConfigError, from_dict, loads, section_lines
 from .integrators import kernel_params
@@ -196,6 +196,11 @@ class TaskRunner:
         if cfg.run.branch and task.point in self.spin_failed:
             return None     # recorded as failed (and counted) by the rank that spun its point up
         rec = self.writer.record(task.index)
+        if rec.damaged:     # (tables.py) a damaged byte, or a run killed while writing the record
+            print(f"note: rank {self.coord.rank}: task {task.index}: {rec.damaged}; it is rerun from its start",
+                  file=sys.stderr, flush=True)
+            self.writer.start(task.index, integrator_text(cfg.integrator))
+            return Trajectory(cfg, task, self._start(task)), 0
         if rec.status == FAILED:
             if self.rerun is None or (cfg.run.branch and task.point not in self.spun):
                 self.failed.append((task.index, rec.error))
@@ -370,7 +375,7 @@ def _prepare(cfg, path, resume, force, rerun=None):
                                       f"the catalog is complete")
                 return "complete", f"{final} is complete; nothing to resume", []
             raise Refused(f"{partial}: no interrupted run to resume")
-        _, tasks, attrs = catalog.read_tasks(partial)
+        _, tasks, attrs = catalog.read_tasks(partial, damaged_ok=True)
         diffs = config_differences(attrs["config"], cfg, ("model", "run") if rerun else
                                    ("model", "run", "integrator"))
         if diffs:
@@ -378,13 +383,24 @@ def _prepare(cfg, path, resume, force, rerun=None):
         if rerun is not None and not np.any(tasks["status"] == FAILED):
             raise ConfigError(f"{partial}: no failed task to rerun (a changed [integrator] applies to "
                               f"failed tasks only)")
+        _fits(partial, lambda: space.reserve_file(partial))
         return "resume", None, spins_needed(cfg, task_list(cfg), tasks, rerun)
     if os.path.exists(final) and not force:
         raise Refused(f"{final}: catalog exists (use --force to overwrite it)")
     if os.path.exists(partial) and not force:
         raise Refused(f"{partial}: an interrupted run exists (use --resume to continue it, "
                       f"--force to start over)")
-    return "new", None, spins_needed(cfg, task_list(cfg))
+    tasks = task_list(cfg)
+    _fits(partial, lambda: space.check_fits(partial, catalog.estimate_bytes(cfg, tasks)))
+    return "new", None, spins_needed(cfg, tasks)
+
+
+def _fits(partial, check):
+    """Run a space check (space.py) before any HDF5 call; a catalog that does not fit is refused on every rank alike."""
+    try:
+        check()
+    except OSError as err:
+        raise CatalogError(f"{partial}: the catalog does not fit ({err.strerror or err})", collective=True) from None
 
 
 def _kernels_cached():

@@ -315,8 +315,10 @@ def test_a_full_disk_stops_the_run_with_one_line_and_nothing_lost(small, small_d
     res = cli("run", cfg, "-o", small_disk / "a.h5", *big)
     assert res.returncode == 1 and "No space left on device" in res.stderr
     assert len(res.stderr.strip().splitlines()) == 1 and not any(small_disk.iterdir())
-    # in the middle (a file system without fallocate: nothing reserved): one line, a readable catalog
-    res = injected("from ensemble import catalog; catalog._reserve_space = lambda path: None",
+    # in the middle (a file system without fallocate, whose space another process takes while the run
+    # goes on: nothing reserved, the check before creation passed): one line, a readable catalog
+    res = injected("from ensemble import catalog, space; catalog._reserve_space = lambda path: None; "
+                   "space.check_fits = lambda path, nbytes: None",
                    "run", cfg, "-o", small_disk / "b.h5", *big)
     assert res.returncode == 1 and "No space left on device" in res.stderr, res.stderr
     assert len(res.stderr.strip().splitlines()) == 1
