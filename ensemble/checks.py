@@ -1,0 +1,90 @@
+"""The checks every command makes of its numeric options and its output paths: one place for each.
+
+    checks.number("--mu-c", args.mu_c, lo=-20, hi=20)        # finite, in range, else UsageError naming it
+    checks.count("--bootstrap", args.bootstrap, lo=1, hi=10**6)
+    checks.output(path, inputs=[catalog], force=args.force)   # before any work
+
+Both raise UsageError (a ValueError): a one-line message naming the option or the path, exit code 2
+in every command. An output is refused when its name is not UTF-8 (HDF5 and the lock need it), when
+it is one of the command's inputs (also with --force), when it is a directory where a file goes (or
+the reverse), when its directory is missing or not writable, and when it exists without --force.
+"""
+import math
+import os
+
+
+class UsageError(ValueError):
+    """A bad option or output path, found before any work (exit code 2)."""
+
+
+def number(name, value, lo=-math.inf, hi=math.inf):
+    """A real option: finite and within [lo, hi]; returns it as a float."""
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise UsageError(f"{name} must be a number, not {value!r}") from None
+    if not math.isfinite(x):
+        raise UsageError(f"{name} must be finite, not {value!r}")
+    if not lo <= x <= hi:
+        raise UsageError(f"{name} = {value!r} is out of range [{lo:g}, {hi:g}]")
+    return x
+
+
+def count(name, value, lo=0, hi=10 ** 9):
+    """An integer option within [lo, hi]; returns it as an int."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, str)):
+        raise UsageError(f"{name} must be an integer, not {value!r}")
+    try:
+        n = int(value)
+    except (TypeError, ValueError):
+        raise UsageError(f"{name} must be an integer, not {value!r}") from None
+    if isinstance(value, float) and n != value:
+        raise UsageError(f"{name} must be an integer, not {value!r}")
+    if not lo <= n <= hi:
+        raise UsageError(f"{name} = {value!r} is out of range [{lo}, {hi}]")
+    return n
+
+
+def shown(path):
+    """A path as it can be printed, whatever its bytes."""
+    return os.fsencode(str(path)).decode("utf-8", errors="backslashreplace")
+
+
+def output(path, inputs=(), force=False, directory=False, what="output"):
+    """Refuse, before any work, an output that cannot be written or would destroy something.
+
+    inputs: the command's input files (never overwritten, --force or not); directory: the output is a
+    directory (made if missing) rather than a file; what: how the message names it ("catalog", ...).
+    """
+    text = str(path)
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        raise UsageError(f"{shown(path)}: the {what} path is not valid UTF-8 (HDF5 and the run's lock need "
+                         f"UTF-8 names); choose another name") from None
+    if not text:
+        raise UsageError(f"the {what} path is empty")
+    for source in inputs:
+        if os.path.exists(text) and os.path.exists(source) and os.path.samefile(text, source):
+            raise UsageError(f"{text}: the {what} would overwrite the command's input {source}")
+    if directory:
+        if os.path.exists(text) and not os.path.isdir(text):
+            raise UsageError(f"{text}: exists and is not a directory")
+    elif os.path.isdir(text):
+        raise UsageError(f"{text}: is a directory; give the {what} a file name")
+    parent = os.path.dirname(os.path.abspath(text))
+    if directory and not os.path.exists(text):
+        parent = _existing_ancestor(parent)
+    if not os.path.isdir(parent):
+        raise UsageError(f"{text}: directory {parent} does not exist")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise UsageError(f"{text}: cannot write in {parent}")
+    if not directory and os.path.exists(text) and not force:
+        raise UsageError(f"{text}: {what} exists (use --force to overwrite it)")
+    return text
+
+
+def _existing_ancestor(path):
+    while not os.path.exists(path) and os.path.dirname(path) != path:
+        path = os.path.dirname(path)
+    return path
