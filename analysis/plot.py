@@ -278,16 +278,29 @@ def figure(summaries, kind, title=None, names=None):
     if kind == "magnitude":
         fig, ax = plt.subplots(figsize=(8 + 1.6 * (_legend_columns(n) - 1), 4.8), dpi=DPI)
         magnitude(summaries, ax, keys, labels)
-        fig.suptitle(text, fontsize=FONT + 1, wrap=True)
-        fig.tight_layout()
+        _layout(fig, text, 0.0)
     else:
         rows, cols = _grid(n)
         fig = plt.figure(figsize=(5.5 * cols, 4 * rows + 0.4), dpi=DPI)
         recurrence(summaries, fig, labels)
-        fig.suptitle(text, fontsize=FONT + 1, wrap=True)
-        fig.tight_layout(rect=(0, 0.35 / fig.get_figheight(), 1, 1))
+        _layout(fig, text, 0.35)      # the figure legend below the panels
         place_insets(summaries, fig)
     return fig
+
+
+def _layout(fig, text, bottom):
+    """The title at the top, the panels below it and `bottom` inches free at the bottom.
+    tight_layout leaves room for the title, but not always enough (by a few pixels in a tall
+    grid): the panels are then lowered until their titles clear it."""
+    title = fig.suptitle(text, fontsize=FONT + 1, wrap=True)
+    fig.tight_layout(rect=(0, bottom / fig.get_figheight(), 1, 1))
+    renderer = fig.canvas.get_renderer()
+    for _ in range(3):
+        top = max(ax.get_tightbbox(renderer).y1 for ax in fig.axes)
+        short = top + GAP * fig.dpi / 72 - title.get_window_extent(renderer).y0
+        if short <= 0:
+            break
+        fig.subplots_adjust(top=fig.subplotpars.top - short / fig.bbox.height)
 
 
 def plot(summaries, figure_kind, path, title=None, names=None):

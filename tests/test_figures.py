@@ -64,6 +64,16 @@ def covered(fig):
     return found
 
 
+def crowded(fig):
+    """The title or a figure legend over a panel (its labels and title included)."""
+    renderer = fig.canvas.get_renderer()
+    children = {child for a in fig.axes for child in a.child_axes}
+    panels = [ax.get_tightbbox(renderer) for ax in fig.axes if ax not in children]
+    boxes = [("title", fig._suptitle.get_window_extent(renderer))]
+    boxes += [("legend", legend.get_window_extent(renderer)) for legend in fig.legends]
+    return [(what, k) for what, box in boxes for k, panel in enumerate(panels) if box.overlaps(panel)]
+
+
 def small_text(fig):
     fig.canvas.draw()
     return [(t.get_text(), t.get_fontsize()) for t in fig.findobj(Text)
@@ -118,6 +128,7 @@ SYNTHETIC = {
 def _check(fig):
     assert covered(fig) == []
     assert small_text(fig) == []
+    assert crowded(fig) == []
 
 
 @pytest.mark.parametrize("kind", KINDS)

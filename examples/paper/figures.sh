@@ -21,6 +21,8 @@ for name in fig1_b fig1_a fig1_c fig2 large_b; do
     echo "$name: $s not there: skipped"
     continue
   fi
+  # regenerated: the old figures go first (plot keeps an existing file without --force)
+  rm -f "$D/$name.png" "$D/${name}_magnitude.png"
   if [ "$name" = fig2 ]; then
     $PY -m analysis plot "$s" --figure recurrence -o "$D/fig2.png" --title "${TITLE[$name]}"
     $PY -m analysis plot "$s" --figure magnitude -o "$D/fig2_magnitude.png" --title "Fig. 2 points: R(mu)"
