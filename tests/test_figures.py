@@ -148,6 +148,18 @@ def test_committed_figures_cover_no_data(name, kind):
         plot.plt.close(fig)
 
 
+@pytest.mark.parametrize("kind", KINDS)
+def test_overlaid_summaries_cover_no_data(kind):
+    """Several summaries in one figure (their points together; 7 recurrence panels on a 3 x 3 grid)."""
+    names = ["fig1_b.summary.h5", "large_b.summary.h5"]
+    fig = plot.figure([load("fig1_b"), load("large_b")], kind, names=names)
+    try:
+        _check(fig)
+        assert fig._suptitle.get_text().startswith("2e5 events per point, mu_c = 4, window = 10 blocks")
+    finally:
+        plot.plt.close(fig)
+
+
 @pytest.mark.parametrize("case", sorted(SYNTHETIC))
 @pytest.mark.parametrize("n_points", (1, 4))
 def test_synthetic_figures_cover_no_data(case, n_points):
