@@ -63,6 +63,8 @@ def _shape(row, edges, c):
     """SHAPES of one histogram row (bin counts, then the events in and out of range)."""
     r = stats.density(row[:-1], edges, row[-1])
     big = np.flatnonzero(c >= PEAK_FROM)
+    if not big.size or not np.isfinite(r).all():      # bins below the peak's range, or no events
+        return np.full(len(SHAPES), np.nan)
     k = big[np.argmax(r[big])]
     below = np.flatnonzero((c >= DIP_FROM) & (c <= c[k]))
     j = below[np.argmin(r[below])]
@@ -72,16 +74,18 @@ def _shape(row, edges, c):
 
 
 def shape_statistics(s, i, level=None):
-    """R(mu) shape numbers of point i with bootstrap intervals over its units (stretches or seeds):
+    """R(mu) shape numbers of point i with bootstrap intervals over its units (the summary's:
+    seeds, or the stretches of every trajectory):
     {name: (estimate, lo, hi, share of resamples where it is infinite)}; a ratio over an empty
     bin is infinite."""
     level = s["attrs"]["level"] if level is None else level
     edges = s["bins/mu"]
     c = stats.centers(edges)
     tasks = np.flatnonzero(s["tasks/point"] == i)
-    units = s["per_task/mu"][tasks].reshape(-1, len(c))
-    total_events = s["per_task/numbers"][tasks].reshape(-1, s["per_task/numbers"].shape[-1])[:, stats.N_EVENTS]
-    rows = np.concatenate([units, total_events[:, None]], axis=1)
+    counts, events = s["per_task/mu"][tasks], s["per_task/numbers"][tasks][:, :, stats.N_EVENTS]
+    if s["points/method"][i] == "seeds":     # the summary's own units: seeds, else every stretch
+        counts, events = counts.sum(axis=1, keepdims=True), events.sum(axis=1, keepdims=True)
+    rows = np.concatenate([counts.reshape(-1, len(c)), events.reshape(-1, 1)], axis=1)
     est = _shape(rows.sum(axis=0), edges, c)
     samples = stats.bootstrap(rows, lambda row: _shape(row, edges, c), RESAMPLES, np.random.default_rng(0))
     lo, hi = stats.percentile_interval(samples, level)
@@ -92,6 +96,8 @@ def shape_statistics(s, i, level=None):
 def ratio(quad, empty):
     """A ratio with its interval; over an empty bin (`empty` names it) infinite, said in words."""
     est, lo, hi, infinite = quad
+    if np.isnan(est):
+        return with_interval(quad)
     if not np.isfinite(est):
         return f"unbounded ({empty} holds no events: more events needed)"
     if not np.isfinite(hi):

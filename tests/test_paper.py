@@ -119,3 +119,15 @@ def test_bad_input_is_one_line_naming_the_file(reduced, tmp_path):
         assert res.returncode == 1 and not res.stdout, res
         lines = res.stderr.strip().splitlines()
         assert len(lines) == 1 and lines[0].startswith("error: ") and words in lines[0], res.stderr
+
+
+def test_shape_intervals_resample_the_summarys_units():
+    """The R(mu) shape numbers resample what the summary's intervals resample: the stretches of
+    fig1_b's one trajectory per point (the README's 82.3 [70.6, 105]); were its units seeds, the
+    one seed would leave no spread at all."""
+    s = summary.read(DOCS / "fig1_b.summary.h5")
+    i = int(np.flatnonzero(s["points/b"] == 20.0)[0])
+    assert paper.with_interval(paper.shape_statistics(s, i)["peak_over_dip"]) == "82.3 [70.6, 105]"
+    s["points/method"] = np.array(["seeds"] * len(s["points/method"]))
+    est, lo, hi, _ = paper.shape_statistics(s, i)["peak_over_dip"]
+    assert lo == est == hi
