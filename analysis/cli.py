@@ -11,24 +11,64 @@ summaries; report prints a summary's numbers; paper sets the paper's claims besi
 writes a catalog's or a summary's tables; compare sets the points of catalogs of several friction
 laws side by side (analysis/compare.py).
 
+Every numeric option is checked before any file is read (NUMERIC below: finite, in its range,
+sizes this machine can hold), and every output path before any work (ensemble/checks.py: not
+UTF-8, one of the inputs, a missing or read-only folder, an existing file without --force; reduce's
+--force replaces only a reduction summary).
+
 Exit codes: 0 done, 1 file error (missing, damaged or of the wrong kind: a summary or a
-config given for a catalog, an unfinished run without --partial, ...), 2 bad options (and the
-same trajectory given twice). Under mpirun an error on one rank aborts all.
+config given for a catalog, an unfinished run without --partial, ...), 2 bad options or output
+paths (an existing output without --force, as in `python -m ensemble run`; and the same
+trajectory given twice). Under mpirun an error on one rank aborts all.
 """
 import argparse
 import os
 import sys
 
-from ensemble import filekind
+from ensemble import checks, filekind
 from ensemble.catalog import CatalogError
 
 from . import merge, summary
-from .reduce import Options, parse_bins
+from .reduce import NUMBERS, Options, parse_bins
+from .stats import N_STATS
 
 # errors that reduce's rank 0 finds before the work starts and every rank then raises alike
 # (ensemble.abort.on_root), with their exit codes; any other error on any rank aborts them all
 # (merge.MergeError is a ValueError: exit 2)
 COLLECTIVE = {ValueError: 2, CatalogError: 1, summary.SummaryError: 1, OSError: 1}
+
+# Every numeric option of every command (argparse dest -> its check), applied to the options a
+# command has before it reads a file: argparse hands them over as text, so that "nan", "inf" and
+# "1e400" reach one check that names the option (checks.UsageError, exit 2). Magnitudes are
+# log10 of a float64 slip; a million bootstrap resamples or stretches per task is more than any
+# interval needs (and what they allocate together is checked by _memory once the tasks are known).
+MAGNITUDE = (-330.0, 310.0)
+NUMERIC = {
+    "mu_c": lambda v: checks.number("--mu-c", v, *MAGNITUDE),
+    "b_cut": lambda v: checks.number("--b-cut", v, *MAGNITUDE),
+    "mu_bins": lambda v: _bins("--mu-bins", v),
+    "tnu_bins": lambda v: _bins("--tnu-bins", v),
+    "window": lambda v: checks.count("--window", v, lo=0, hi=10 ** 9),
+    "bootstrap": lambda v: checks.count("--bootstrap", v, lo=1, hi=10 ** 6),
+    "level": lambda v: checks.number("--level", v, 0.0, 1.0, exclusive=True),
+    "blocks": lambda v: checks.count("--blocks", v, lo=1, hi=10 ** 6),
+    "seed": lambda v: checks.count("--seed", v, lo=0, hi=2 ** 63 - 1),   # stored as an HDF5 int64
+    "n_large": lambda v: checks.count("--n-large", v, lo=2, hi=10 ** 9),
+    "n_min": lambda v: checks.count("--n-min", v, lo=1, hi=10 ** 9),
+}
+
+
+def _bins(option, text):
+    parse_bins(text, option)   # lo:hi:n, finite, at most reduce.MAX_BINS bins; kept as text
+    return text
+
+
+def check_numbers(args):
+    """Every numeric option of the command given (not None) replaced by its checked value."""
+    for dest, check in NUMERIC.items():
+        if getattr(args, dest, None) is not None:
+            setattr(args, dest, check(getattr(args, dest)))
+    return args
 
 
 def _parser():
@@ -46,14 +86,14 @@ def _parser():
     # being the paper's axes; catalogs of several laws need them given
     r.add_argument("--mu-bins", help="magnitude bins lo:hi:n (default: the law's; aging 0:7:70)")
     r.add_argument("--tnu-bins", help="T*nu bins lo:hi:n (default: the law's; aging 0:2000:80)")
-    r.add_argument("--mu-c", type=float, help="large-event magnitude (default: the law's; aging 4)")
-    r.add_argument("--window", type=int, default=10, help="epicenter window in blocks (default 10)")
-    r.add_argument("--b-cut", type=float, help="magnitude cut of the GR b fit (default: the law's; aging 3)")
-    r.add_argument("--bootstrap", type=int, default=1000, help="bootstrap resamples (default 1000)")
-    r.add_argument("--level", type=float, default=0.95, help="interval coverage (default 0.95)")
-    r.add_argument("--blocks", type=int, default=20,
+    r.add_argument("--mu-c", help="large-event magnitude (default: the law's; aging 4)")
+    r.add_argument("--window", default=10, help="epicenter window in blocks (default 10)")
+    r.add_argument("--b-cut", help="magnitude cut of the GR b fit (default: the law's; aging 3)")
+    r.add_argument("--bootstrap", default=1000, help="bootstrap resamples (default 1000)")
+    r.add_argument("--level", default=0.95, help="interval coverage (default 0.95)")
+    r.add_argument("--blocks", default=20,
                    help="stretches per task, resampled when a point has one seed (default 20)")
-    r.add_argument("--seed", type=int, default=0,
+    r.add_argument("--seed", default=0,
                    help="seed of the bootstrap; a point's resamples are drawn from it and the "
                         "point's parameters (default 0)")
     r.add_argument("--force", action="store_true", help="overwrite an existing summary")
@@ -64,6 +104,7 @@ def _parser():
     pl.add_argument("--figure", choices=("magnitude", "recurrence"), required=True)
     pl.add_argument("-o", "--output", required=True, help="FILE.png or FILE.pdf")
     pl.add_argument("--title", default=None)
+    pl.add_argument("--force", action="store_true", help="overwrite an existing figure")
     rp = sub.add_parser("report", help="print the summary numbers as a table")
     rp.add_argument("summary")
     pa = sub.add_parser("paper", help="the paper's claims beside the numbers of one or more summaries, "
@@ -77,30 +118,34 @@ def _parser():
     ex.add_argument("--format", choices=sorted(FORMATS), default="csv", help="file format (default csv)")
     ex.add_argument("-o", "--output", required=True, help="directory of the tables (made if missing)")
     ex.add_argument("--force", action="store_true", help="overwrite tables already in the directory")
+    ex.add_argument("--partial", action="store_true",
+                    help="export an unfinished run as far as written (every table's header says so)")
     cp = sub.add_parser("compare", help="catalogs of several friction laws -> table and figures on a "
                                          "law-independent size axis (docs/laws.md)")
     cp.add_argument("catalogs", nargs="+", metavar="catalog")
     cp.add_argument("-o", "--output", required=True, help="directory of comparison.md, .json and the figures")
-    cp.add_argument("--n-large", type=int, default=50, help="large event: at least this many blocks slip (default 50)")
-    cp.add_argument("--n-min", type=int, default=1, help="smallest n of the power-law fit (default 1)")
-    cp.add_argument("--window", type=int, default=10, help="epicenter window in blocks (default 10)")
-    cp.add_argument("--bootstrap", type=int, default=1000, help="bootstrap resamples (default 1000)")
-    cp.add_argument("--level", type=float, default=0.95, help="interval coverage (default 0.95)")
-    cp.add_argument("--blocks", type=int, default=20, help="stretches per task when a point has fewer "
+    cp.add_argument("--n-large", default=50, help="large event: at least this many blocks slip (default 50)")
+    cp.add_argument("--n-min", default=1, help="smallest n of the power-law fit (default 1)")
+    cp.add_argument("--window", default=10, help="epicenter window in blocks (default 10)")
+    cp.add_argument("--bootstrap", default=1000, help="bootstrap resamples (default 1000)")
+    cp.add_argument("--level", default=0.95, help="interval coverage (default 0.95)")
+    cp.add_argument("--blocks", default=20, help="stretches per task when a point has fewer "
                                                            "than 10 seeds (default 20)")
-    cp.add_argument("--seed", type=int, default=0, help="bootstrap seed (default 0)")
+    cp.add_argument("--seed", default=0, help="bootstrap seed (default 0)")
     cp.add_argument("--force", action="store_true", help="overwrite an existing comparison")
     return p
 
 
 def _compare(args):
     from .compare import Options, check_output, compare, write
+    check_numbers(args)
     opt = Options(args.n_large, args.n_min, args.window, args.bootstrap, args.level, args.blocks, args.seed)
     command = "python -m analysis compare " + " ".join(
         [str(c) for c in args.catalogs] + ["-o", args.output]
         + [f"--{k.replace('_', '-')} {v}" for k, v in opt.__dict__.items() if v != getattr(Options, k)])
-    check_output(args.output, args.force)   # before the work
-    for path in write(compare(args.catalogs, opt), opt, args.output, command, force=args.force):
+    check_output(args.output, args.force, args.catalogs)   # before the work
+    for path in write(compare(args.catalogs, opt), opt, args.output, command, force=args.force,
+                      inputs=args.catalogs):
         print(f"wrote {path}")
     return 0
 
@@ -144,26 +189,35 @@ def _scales(args, inputs):
             for name in SCALE_OPTIONS}
 
 
+def check_summary_output(out, catalogs, force):
+    """The summary's path (checks.output: before any file is read); --force replaces a summary,
+    never anything else (a catalog, a config)."""
+    checks.output(out, inputs=catalogs, force=force, what="summary")
+    if os.path.exists(out) and filekind.identify(out)[0] != "summary":
+        raise checks.UsageError(f"{out} {filekind.describe(out)}; --force replaces only a reduction summary")
+    return out
+
+
+def _memory(opt, n_tasks):
+    """Refuse options whose arrays this machine cannot hold: rank 0 gathers every task's
+    (stretches, bins) counts and stacks them for the summary; a point's bootstrap keeps every
+    resample's curves and T nu counts."""
+    n_mu, n_tnu = len(opt.mu_edges) - 1, len(opt.tnu_edges) - 1
+    per_task = opt.blocks * (n_mu + 2 * n_tnu + N_STATS)
+    resamples = opt.bootstrap * (n_mu + 3 * n_tnu + len(NUMBERS) + n_tasks * opt.blocks)
+    checks.memory(f"--blocks {opt.blocks}, --bootstrap {opt.bootstrap} and {n_mu} + 2 x {n_tnu} bins over "
+                  f"{n_tasks} tasks", 8 * (2 * n_tasks * per_task + resamples))
+
+
 def _prepare(args):
     """Options, output path, and the catalogs' task table (merge.Inputs); every check before the work."""
-    if not (0 < args.level < 1) or args.bootstrap < 1 or args.blocks < 1 or args.window < 0:
-        raise ValueError("--level must be in (0, 1); --bootstrap, --blocks >= 1; --window >= 0")
-    for name in ("mu_bins", "tnu_bins"):
-        if getattr(args, name) is not None:
-            parse_bins(getattr(args, name))      # a malformed option before any file is read
-    out = args.output or _default_output(args.catalogs)
+    check_numbers(args)                      # every option before any file is read
+    out = check_summary_output(args.output or _default_output(args.catalogs), args.catalogs, args.force)
     inputs = merge.read(args.catalogs, allow_partial=args.partial)   # checks each file's kind first
     scale = _scales(args, inputs)
-    opt = Options(parse_bins(scale["mu_bins"]), parse_bins(scale["tnu_bins"]), scale["mu_c"], args.window,
-                  scale["b_cut"], args.bootstrap, args.level, args.blocks, args.seed)
-    if os.path.exists(out):
-        # checked now, not after the work; and --force replaces a summary, never anything else
-        if not args.force:
-            raise summary.SummaryError(f"{out}: summary exists (use --force to overwrite it)")
-        if (any(os.path.samefile(out, path) for path in args.catalogs)
-                or filekind.identify(out)[0] != "summary"):
-            raise summary.SummaryError(f"{out} {filekind.describe(out)}; --force replaces only "
-                                       "a reduction summary")
+    opt = Options(parse_bins(scale["mu_bins"], "--mu-bins"), parse_bins(scale["tnu_bins"], "--tnu-bins"),
+                  scale["mu_c"], args.window, scale["b_cut"], args.bootstrap, args.level, args.blocks, args.seed)
+    _memory(opt, len(inputs.tasks["point"]))
     return opt, out, inputs
 
 
@@ -216,6 +270,7 @@ def _reduce_on(comm, args):
 
 def _plot(args):
     from .plot import plot
+    checks.output(args.output, inputs=args.summaries, force=args.force, what="figure")   # before the work
     plot([summary.read(path) for path in args.summaries], args.figure, args.output, args.title,
          names=args.summaries)
     print(f"wrote {args.output}")
@@ -236,7 +291,7 @@ def _paper(args):
 
 def _export(args):
     from .export import write
-    for path in write(args.source, args.output, args.format, force=args.force):
+    for path in write(args.source, args.output, args.format, force=args.force, partial=args.partial):
         print(f"wrote {path}")
     return 0
 

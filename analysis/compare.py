@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ensemble import catalog, filekind
+from ensemble import catalog, checks, filekind
 
 from . import merge, stats
 from .recurrence import RecurrenceScanner
@@ -222,10 +222,14 @@ def label(law, params):
 def compare(paths, opt):
     """Every point of the catalogs compared: a list of dicts (compare_point's, with law, params, label)."""
     if opt.n_large < 2 or opt.n_min < 1 or opt.n_min >= opt.n_large - 1:
-        raise ValueError("--n-min must be >= 1 and --n-large at least n-min + 2")
+        raise checks.UsageError("--n-min must be >= 1 and --n-large at least n-min + 2")
     if not (0 < opt.level < 1) or opt.bootstrap < 1 or opt.blocks < 1 or opt.window < 0:
-        raise ValueError("--level must be in (0, 1); --bootstrap, --blocks >= 1; --window >= 0")
+        raise checks.UsageError("--level must be in (0, 1); --bootstrap, --blocks >= 1; --window >= 0")
     inputs = merge.read(paths)
+    for params, rows in inputs.points:   # a point's (units, N + 1) counts per n and its resamples' picks
+        checks.memory(f"--blocks {opt.blocks} and --bootstrap {opt.bootstrap} over {len(rows)} tasks of "
+                      f"{int(params['N'])} blocks", 8 * len(rows) * opt.blocks * (int(params["N"]) + 1 + len(MU_EDGES))
+                      + 8 * opt.bootstrap * (len(rows) * opt.blocks + len(MU_EDGES) + 2 * int(params["N"])))
     out = []
     for params, rows in inputs.points:
         law = inputs.tasks["law"][rows[0]]
@@ -269,17 +273,19 @@ def table(points, opt, command):
 OUTPUTS = ("comparison.md", "comparison.json", "size.png", "magnitude.png", "recurrence.png")
 
 
-def check_output(out_dir, force):
-    """Refuse to overwrite a comparison in out_dir unless forced (before the work, and when writing)."""
-    taken = [n for n in OUTPUTS if os.path.exists(os.path.join(out_dir, n))]
-    if taken and not force:
-        raise FileExistsError(f"{os.path.join(out_dir, taken[0])} exists (use --force to overwrite the comparison)")
+def check_output(out_dir, force, inputs=()):
+    """Refuse (checks.UsageError) a comparison directory that cannot be made or written, that is
+    one of the inputs, or that holds a comparison without force (before the work, and when writing)."""
+    checks.output(out_dir, inputs=inputs, force=force, directory=True, what="comparison directory")
+    if os.path.isdir(out_dir):
+        for name in OUTPUTS:
+            checks.output(os.path.join(out_dir, name), inputs=inputs, force=force, what="comparison file")
 
 
-def write(points, opt, out_dir, command, force=False):
+def write(points, opt, out_dir, command, force=False, inputs=()):
     """comparison.md, comparison.json, size.png, magnitude.png, recurrence.png in out_dir."""
     from .compare_plot import figures
-    check_output(out_dir, force)
+    check_output(out_dir, force, inputs)
     os.makedirs(out_dir, exist_ok=True)
     with open(os.path.join(out_dir, "comparison.md"), "w") as f:
         f.write(table(points, opt, command))

@@ -30,6 +30,12 @@ a comma, a quote or a '#'; only a task's error (free text, the last column of ta
 does, and genfromtxt, which knows no quotes, is told to leave that column out (usecols). An empty
 text reads as "" with numpy and as NaN with pandas.
 
+An unfinished run (a *.partial catalog, or tasks unfinished) is exported only when asked
+(write(partial=True), `--partial`), as reduce reduces it; then every table's header states it in
+one line, "PARTIAL export of an unfinished run (...): events written of expected" (a format
+without comment lines would carry that line in its metadata), as the tables of a --partial
+reduction carry the summary's statement.
+
 A catalog is streamed in chunks of catalog.READ_CHUNK rows, each verified as it is read (ranges,
 and each task's checksum after its last chunk); the files of an export are written beside their
 names and renamed into place only when all are complete, so an export that fails writes nothing.
@@ -40,10 +46,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ensemble import __version__, catalog, filekind
+from ensemble import __version__, catalog, checks, filekind
 from ensemble.config import LAW_KEYS
 
-from . import summary
+from . import merge, summary
 
 TITLES = {   # table -> what its rows are (said in its file's header)
     "events": "one row per committed event",
@@ -312,16 +318,39 @@ def source_kind(path):
     return "catalog"
 
 
-def _tables(path, names, chunk=catalog.READ_CHUNK):
-    """({name: Table}, a line of the reduction's settings or "") of a catalog's or a summary's tables."""
+def _unfinished_run(path):
+    """("", "") for a finished run, else (why, statement): why it is unfinished, worded as reduce's
+    refusal (analysis/merge.py, which counts its tasks the same way: not finished, or with fewer
+    events than events_per_task; or a run's *.partial), and the line every table's header states."""
+    with filekind.reading(path, "the event catalog", catalog.CatalogError):
+        per_task, tasks, _ = catalog.read_tasks(path)
+    n_open, named = merge._unfinished(path, tasks, per_task)
+    if not (n_open or named):
+        return "", ""
+    n_tasks = len(tasks["point"])
+    written, expected = int(tasks["events_written"].sum()), n_tasks * int(per_task)
+    share = f" ({100 * written / expected:.1f}%)" if expected else ""
+    why = f"{n_open} of {n_tasks} tasks unfinished" if n_open else "named *.partial"
+    return why, f"PARTIAL export of an unfinished run ({why}): {written} of {expected} events{share}"
+
+
+def _tables(path, names, chunk=catalog.READ_CHUNK, partial=True):
+    """({name: Table}, a line of the reduction's settings, or of what an unfinished run lacks, or "")
+    of a catalog's or a summary's tables; an unfinished run is refused unless partial."""
     kind = source_kind(path)
     wanted = CATALOG_TABLES if kind == "catalog" else SUMMARY_TABLES
     for name in names:
         if name not in wanted:
             raise ValueError(f"{path} is {filekind.NOUNS[kind]}: its tables are {', '.join(wanted)}, not {name}")
     if kind == "catalog":
+        why, statement = _unfinished_run(path)
+        if why and not partial:
+            path = str(path)
+            raise catalog.CatalogError(
+                f"{path} is an unfinished run ({why}); continue it with `python -m ensemble resume "
+                f"{path.removesuffix('.partial')}`, or export what it holds with --partial")
         build = {"events": lambda: _events(path, chunk), "tasks": lambda: _tasks(path)}
-        return {name: build[name]() for name in names}, ""
+        return {name: build[name]() for name in names}, statement
     s = summary.read(path)
     build = {"curves": lambda: _curves(s), "numbers": lambda: _numbers(s), "peaks": lambda: _peaks(s)}
     a = s["attrs"]
@@ -386,24 +415,25 @@ def write_csv(path, name, table, source, settings=""):
 FORMATS = {"csv": (".csv", write_csv)}   # format -> (file suffix, writer(path, name, table, source, settings))
 
 
-def write(source, directory, fmt="csv", force=False, chunk=catalog.READ_CHUNK):
+def write(source, directory, fmt="csv", force=False, chunk=catalog.READ_CHUNK, partial=False):
     """Every table of a catalog (events, tasks) or a summary (curves, numbers, peaks) into files
     DIRECTORY/<table><suffix>; returns their paths.
 
-    Refuses (FileExistsError naming the file, nothing written) when one exists, unless force.
-    Files are written beside their names and renamed into place when all are complete.
+    Refuses (checks.UsageError naming the path, nothing written) a directory that cannot be made
+    or written, the source as the directory or a table, and a table that exists unless force. An
+    unfinished run (a *.partial catalog, unfinished tasks) is refused (catalog.CatalogError, as
+    reduce refuses it) unless partial; then every table's header says what it lacks. Files are
+    written beside their names and renamed into place when all are complete.
     """
     suffix, writer = FORMATS[fmt]
+    checks.output(directory, inputs=[source], force=force, directory=True, what="export directory")
     kind = source_kind(source)
     names = CATALOG_TABLES if kind == "catalog" else SUMMARY_TABLES
     paths = [os.path.join(directory, name + suffix) for name in names]
-    if os.path.exists(directory) and not os.path.isdir(directory):
-        raise NotADirectoryError(f"{directory} is not a directory")
-    if not force:
-        for path in paths:
-            if os.path.lexists(path):
-                raise FileExistsError(f"{path} exists (use --force to overwrite it)")
-    tables, settings = _tables(source, names, chunk)
+    if os.path.isdir(directory):
+        for path in paths:   # not the source, not a directory, not there unless force
+            checks.output(path, inputs=[source], force=force, what="table")
+    tables, settings = _tables(source, names, chunk, partial)
     os.makedirs(directory, exist_ok=True)
     partial = [p + ".partial" for p in paths]
     try:

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ensemble import catalog, filekind
+from ensemble import catalog, checks, filekind
 from ensemble.config import LAW_KEYS
 
 from . import stats
@@ -37,16 +37,24 @@ class Options:
     chunk: int = 1 << 16
 
 
-def parse_bins(text):
-    """'lo:hi:n' -> n + 1 equally spaced edges."""
-    try:
-        lo, hi, n = text.split(":")
-        lo, hi, n = float(lo), float(hi), int(n)
-    except ValueError:
-        raise ValueError(f"bins must be lo:hi:n, got {text!r}") from None
-    if not (hi > lo and n >= 1):
-        raise ValueError(f"bins must have hi > lo and n >= 1, got {text!r}")
-    return np.linspace(lo, hi, n + 1)
+MAX_BINS = 10 ** 6   # bins of a histogram: beyond a million, (tasks, stretches, bins) counts outgrow memory
+
+
+def parse_bins(text, name="bins"):
+    """'lo:hi:n' -> n + 1 equally spaced edges, finite and strictly increasing (checks.UsageError
+    naming the option `name` otherwise, before any file is read)."""
+    parts = str(text).split(":")
+    if len(parts) != 3:
+        raise checks.UsageError(f"{name} must be lo:hi:n, got {text!r}")
+    lo, hi = (checks.number(f"{name} {end}", value) for end, value in zip(("lo", "hi"), parts))
+    n = checks.count(f"{name} n", parts[2], lo=1, hi=MAX_BINS)
+    if not hi > lo:
+        raise checks.UsageError(f"{name} must have hi > lo, got {text!r}")
+    with np.errstate(over="ignore", invalid="ignore"):
+        edges = np.linspace(lo, hi, n + 1)
+        if not (np.all(np.isfinite(edges)) and np.all(np.diff(edges) > 0)):
+            raise checks.UsageError(f"{name} {text!r}: its edges are not distinct finite float64 values")
+    return edges
 
 
 @dataclass

@@ -45,7 +45,7 @@ import os
 import h5py
 import numpy as np
 
-from ensemble import catalog, filekind
+from ensemble import catalog, checks, filekind
 
 from . import stats
 from .reduce import MIN_UNITS, NUMBERS, PARAMS
@@ -150,8 +150,7 @@ def _source_attrs(inputs):
 
 def write(path, inputs, per_task, points, opt, force=False):
     """inputs: analysis.merge.Inputs (the catalogs and their task table)."""
-    if os.path.exists(path) and not force:
-        raise SummaryError(f"{path}: summary exists (use --force to overwrite it)")
+    checks.output(path, force=force, what="summary")   # again: one could have appeared during the work
     n_mu, n_tnu = len(opt.mu_edges) - 1, len(opt.tnu_edges) - 1
     tmp = str(path) + ".partial"
     with h5py.File(tmp, "w") as h5:

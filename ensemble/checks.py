@@ -3,6 +3,7 @@
     checks.number("--mu-c", args.mu_c, lo=-20, hi=20)        # finite, in range, else UsageError naming it
     checks.count("--bootstrap", args.bootstrap, lo=1, hi=10**6)
     checks.output(path, inputs=[catalog], force=args.force)   # before any work
+    checks.memory("--blocks x bins x tasks", n_bytes)          # an allocation this machine cannot hold
 
 Both raise UsageError (a ValueError): a one-line message naming the option or the path, exit code 2
 in every command. An output is refused when its name is not UTF-8 (HDF5 and the lock need it), when
@@ -17,14 +18,16 @@ class UsageError(ValueError):
     """A bad option or output path, found before any work (exit code 2)."""
 
 
-def number(name, value, lo=-math.inf, hi=math.inf):
-    """A real option: finite and within [lo, hi]; returns it as a float."""
+def number(name, value, lo=-math.inf, hi=math.inf, exclusive=False):
+    """A real option: finite and within [lo, hi] (within (lo, hi) if exclusive); returns it as a float."""
     try:
         x = float(value)
     except (TypeError, ValueError):
         raise UsageError(f"{name} must be a number, not {value!r}") from None
     if not math.isfinite(x):
         raise UsageError(f"{name} must be finite, not {value!r}")
+    if exclusive and not lo < x < hi:
+        raise UsageError(f"{name} = {value!r} is out of range ({lo:g}, {hi:g})")
     if not lo <= x <= hi:
         raise UsageError(f"{name} = {value!r} is out of range [{lo:g}, {hi:g}]")
     return x
@@ -43,6 +46,24 @@ def count(name, value, lo=0, hi=10 ** 9):
     if not lo <= n <= hi:
         raise UsageError(f"{name} = {value!r} is out of range [{lo}, {hi}]")
     return n
+
+
+def physical_memory():
+    """Bytes of memory of this machine (inf where the system does not say)."""
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        return math.inf
+
+
+def memory(what, n_bytes, limit=None):
+    """Refuse options whose arrays need more than this machine's memory (or `limit` bytes):
+    an impossible size is a usage error before the work, not a MemoryError after minutes."""
+    limit = physical_memory() if limit is None else limit
+    if n_bytes > limit:
+        raise UsageError(f"{what} need about {n_bytes / 2**30:.3g} GiB of memory, more than this machine's "
+                         f"{limit / 2**30:.3g} GiB: choose smaller values")
+    return n_bytes
 
 
 def shown(path):
@@ -73,10 +94,11 @@ def output(path, inputs=(), force=False, directory=False, what="output"):
     elif os.path.isdir(text):
         raise UsageError(f"{text}: is a directory; give the {what} a file name")
     parent = os.path.dirname(os.path.abspath(text))
-    if directory and not os.path.exists(text):
-        parent = _existing_ancestor(parent)
+    if directory:   # an existing directory is written into; a missing one is made in its nearest ancestor
+        parent = os.path.abspath(text) if os.path.isdir(text) else _existing_ancestor(parent)
     if not os.path.isdir(parent):
-        raise UsageError(f"{text}: directory {parent} does not exist")
+        raise UsageError(f"{text}: directory {parent} does not exist" if not os.path.exists(parent)
+                         else f"{text}: {parent} is not a directory")
     if not os.access(parent, os.W_OK | os.X_OK):
         raise UsageError(f"{text}: cannot write in {parent}")
     if not directory and os.path.exists(text) and not force:

@@ -175,7 +175,7 @@ def test_report_and_figures(reduced):
         assert res.returncode == 0, res.stderr
         assert out.stat().st_size > 10000
     res = run_analysis("reduce", reduced / "cat.h5", "-o", reduced / "sum.h5")
-    assert res.returncode == 1 and "--force" in res.stderr
+    assert res.returncode == 2 and "--force" in res.stderr   # a usage error, as in `ensemble run`
     res = run_analysis("reduce", reduced / "cat.h5", "--mu-bins", "3:1:5", "-o", reduced / "x.h5")
     assert res.returncode == 2 and "bins" in res.stderr
 

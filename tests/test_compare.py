@@ -156,8 +156,8 @@ def test_compare_refuses_to_overwrite_and_bad_options(two_laws, tmp_path):
     assert analysis("compare", paths[0], "-o", out, "--bootstrap", "5", "--n-large", "5").returncode == 0
     before = (out / "comparison.md").read_text()
     res = analysis("compare", paths[1], "-o", out, "--bootstrap", "5", "--n-large", "5")
-    assert res.returncode == 1 and res.stderr.strip().count("\n") == 0
-    assert "comparison.md exists (use --force" in res.stderr
+    assert res.returncode == 2 and res.stderr.strip().count("\n") == 0   # a usage error, as in `ensemble run`
+    assert "comparison.md: comparison file exists (use --force" in res.stderr
     assert (out / "comparison.md").read_text() == before
     res = analysis("compare", paths[0], "-o", tmp_path / "x", "--n-large", "80")
     assert res.returncode == 2 and "--n-large 80 exceeds the chain of 50 blocks" in res.stderr

@@ -284,14 +284,16 @@ def test_reduce_does_not_trust_the_events_written_mirror(files, tmp_path):
 
 
 def test_reduce_force_replaces_only_a_summary(files, tmp_path):
+    """An output path is a usage error (exit 2, as `ensemble run` says of an existing catalog)."""
     victim = shutil.copy(files / "cat.h5", tmp_path / "victim.h5")
     before = victim.read_bytes()
-    for out in (victim, files / "cat.h5"):
-        line = one_error_line(run("analysis", "reduce", files / "cat.h5", "-o", out, "--force"), 1)
-        assert "--force replaces only a reduction summary" in line
+    line = one_error_line(run("analysis", "reduce", files / "cat.h5", "-o", victim, "--force"), 2)
+    assert "--force replaces only a reduction summary" in line
+    line = one_error_line(run("analysis", "reduce", files / "cat.h5", "-o", files / "cat.h5", "--force"), 2)
+    assert f"would overwrite the command's input {files / 'cat.h5'}" in line
     assert victim.read_bytes() == before
     res = run("analysis", "reduce", files / "cat.h5", "-o", files / "sum.h5")   # exists, no --force
-    assert "--force" in one_error_line(res, 1)
+    assert "--force" in one_error_line(res, 2)
 
 
 # -- 5. one failing rank aborts every rank --------------------------------------------------
