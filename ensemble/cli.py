@@ -79,6 +79,14 @@ def _resume_config(args):
     path = str(args.catalog).removesuffix(".partial")
     partial = partial_path(path)
     if not os.path.exists(partial):
+        if args.set and os.path.exists(path):
+            # a finished catalog: nothing to go on with, and nothing to change
+            _, _, attrs = read_tasks(path)
+            for text in args.set:
+                parse_override(text)
+            loads(attrs["config"], args.set, source=f"the config stored in {path}")
+            raise ConfigError(f"{path} is complete: resume has nothing to continue, and --set "
+                              f"{' --set '.join(args.set)} cannot apply (start a new run instead)")
         return None, path, None
     _, _, attrs = read_tasks(partial, damaged_ok=True)
     rerun = False
@@ -130,7 +138,7 @@ def _run(args):
             return run(cfg, path, comm, resume=True, rerun=rerun, command=command, log=_log)
         cfg = _config(args)
         return run(cfg, cfg.output.path, comm, resume=args.resume, force=args.force, command=command,
-                   log=_log)
+                   log=_log, inputs=[args.config])
     except (ConfigError, LockError, Refused) as err:
         # raised on every rank alike (decisions are made on rank 0 and broadcast)
         if rank == 0:

@@ -115,24 +115,37 @@ class Output:
     writer: str = "auto"         # "parallel" (mpio), "rank0" (messages to rank 0), "auto"
 
 
+# sizes beyond what any run can do: refused at once instead of allocating, or promising an ETA of
+# 1e14 minutes (1e12 events are decades of core time at the ~1000 events/s of N = 800)
+MAX_BLOCKS = 10 ** 6
+MAX_COUNT = 10 ** 12
+MAX_BATCH = 10 ** 7
+MAX_NU = 10.0
+
 _RULES = {
-    ("model", "N"): (lambda x: x >= 2, "an integer >= 2"),
+    # a rank holds about 500 bytes per block: 1e6 blocks are 0.5 GB (the paper: 800 and 1600)
+    ("model", "N"): (lambda x: 2 <= x <= MAX_BLOCKS, f"an integer in [2, {MAX_BLOCKS}] (a rank holds about 500 "
+                                                      f"bytes per block)"),
     ("model", "l"): (_positive, "> 0"),
-    ("model", "nu"): (_positive, "> 0"),
+    # the plate must be slow against slip, whose velocities are of order 1 in these units (the paper:
+    # 1e-8); faster loading is not this model, and from about 1e8 on the kernels' floats fail
+    ("model", "nu"): (lambda x: 0 < x <= MAX_NU, f"in (0, {MAX_NU:g}] (loading slow against slip; the paper: 1e-8)"),
     **{("model", name): (key.check, key.rule) for law in laws.LAWS.values() for name, key in law.keys.items()},
-    ("run", "seeds"): (lambda x: x >= 1, "an integer >= 1"),
-    ("run", "events"): (lambda x: x >= 1, "an integer >= 1"),
-    ("run", "transient"): (_nonneg, "an integer >= 0"),
+    ("run", "seeds"): (lambda x: 1 <= x <= MAX_COUNT, f"an integer in [1, {MAX_COUNT:.0e}]"),
+    ("run", "events"): (lambda x: 1 <= x <= MAX_COUNT, f"an integer in [1, {MAX_COUNT:.0e}]"),
+    ("run", "transient"): (lambda x: 0 <= x <= MAX_COUNT, f"an integer in [0, {MAX_COUNT:.0e}]"),
     ("run", "seed"): (_nonneg, "an integer >= 0"),
     ("run", "init_stress"): (_positive, "> 0"),
     ("run", "perturbation"): (_nonneg, ">= 0"),
-    ("run", "decorrelation"): (_nonneg, "an integer >= 0"),
+    ("run", "decorrelation"): (lambda x: 0 <= x <= MAX_COUNT, f"an integer in [0, {MAX_COUNT:.0e}]"),
     ("integrator", "dt"): (lambda x: 0 < x <= 1, "in (0, 1]"),
     ("integrator", "max_duration"): (_positive, "> 0"),
     ("integrator", "rtol"): (lambda x: 0 < x < 1, "in (0, 1)"),
     ("integrator", "atol"): (_positive, "> 0"),
     ("integrator", "max_step"): (_positive, "> 0"),
-    ("output", "batch"): (lambda x: x >= 1, "an integer >= 1"),
+    # a task buffers a batch in memory, 80 bytes per event
+    ("output", "batch"): (lambda x: 1 <= x <= MAX_BATCH, f"an integer in [1, {MAX_BATCH:.0e}] (80 bytes per event "
+                                                          f"in memory)"),
     ("output", "flush_seconds"): (_positive, "> 0"),
     ("output", "progress_seconds"): (_positive, "> 0"),
     ("output", "writer"): (lambda x: x in ("auto", "parallel", "rank0"), "one of auto, parallel, rank0"),
@@ -262,9 +275,13 @@ def _sweep(raw, overridden):
                 raise ConfigError(f"unknown key sweep.{key} (only [model] keys can be swept: "
                                   f"{', '.join(k for k in types if k != 'law')})")
             if not isinstance(values, list) or not values:
-                raise ConfigError(f"sweep.{key} must be a non-empty list of values")
-            out.append((key, tuple(_coerce("model", key, v, types[key], where=f"sweep.{key}")
-                                   for v in values)))
+                raise ConfigError(f"sweep.{key} must be a non-empty list of values, e.g. {key} = [20, 40] "
+                                  f"(on the command line: --set 'sweep.{key}=[20, 40]'), got {values!r}")
+            coerced = tuple(_coerce("model", key, v, types[key], where=f"sweep.{key}") for v in values)
+            repeated = [v for i, v in enumerate(coerced) if v in coerced[:i]]
+            if repeated:   # the points would be one point run twice, then pooled by the reduction
+                raise ConfigError(f"sweep.{key} lists {repeated[0]!r} more than once")
+            out.append((key, coerced))
     return tuple(out)
 
 
@@ -394,7 +411,8 @@ def _decode(data):
     if b"\0" in data:   # valid UTF-8 or not, NUL bytes mean binary data
         raise ConfigError("binary data (NUL bytes), not a TOML config")
     try:
-        return data.decode("utf-8")
+        # a byte-order mark (some editors write one) is not part of the TOML text
+        return data.decode("utf-8").removeprefix("\ufeff")
     except UnicodeDecodeError as err:
         raise ConfigError(f"not UTF-8 text (byte 0x{data[err.start]:02x} at offset {err.start}), "
                           "not a TOML config") from None
@@ -420,7 +438,19 @@ def load(path, overrides=()):
         filekind.require(path, "config", ConfigError)
     if len(data) > filekind.TOML_SIZE_LIMIT:
         raise ConfigError(f"{path} is larger than {filekind.TOML_SIZE_LIMIT >> 20} MiB, not a TOML config")
+    if _empty(data):
+        # (an empty file, or /dev/null, would otherwise start the paper's full run: 200000 events of 800 blocks)
+        raise ConfigError(f"{path}: empty config (no keys): give at least one section; every key has a default, "
+                          f"and examples/small.toml is a small run")
     return loads(data, overrides, source=path)
+
+
+def _empty(data):
+    """True if a config file's bytes hold no key (nothing, whitespace or comments only)."""
+    try:
+        return not tomllib.loads(_decode(data))
+    except (ConfigError, tomllib.TOMLDecodeError):
+        return False      # loads says what is wrong
 
 
 def replace(cfg, section, **changes):

@@ -12,7 +12,7 @@ import tomllib
 
 import numpy as np
 
-from . import catalog, environment, space
+from . import catalog, checks, environment, filekind, space
 from .catalog import FAILED, FINISHED, Checkpoint, CatalogError
 from .config import ConfigError, from_dict, loads, section_lines
 from .integrators import kernel_params
@@ -344,17 +344,15 @@ def config_differences(stored_text, cfg, sections=("model", "run", "integrator")
     return diffs
 
 
-def _check_output(path):
-    """Refuse, before any work, an output that cannot become a catalog."""
-    final, partial = str(path), catalog.partial_path(path)
-    for p in (final, partial):
-        if os.path.isdir(p):
-            raise Refused(f"{p}: is a directory; give the catalog a file name")
-    parent = os.path.dirname(os.path.abspath(final))
-    if not os.path.isdir(parent):
-        raise Refused(f"{final}: directory {parent} does not exist")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise Refused(f"{final}: cannot write in {parent}")
+def _check_output(path, inputs):
+    """Refuse, before the lock and any work, an output that cannot become a catalog (checks.output):
+    a name that is not UTF-8, one of the run's inputs (its config), a directory, a missing or read-only
+    folder. Whether the catalog exists is _prepare's to judge (--resume, --force)."""
+    try:
+        for p in (str(path), catalog.partial_path(path)):
+            checks.output(p, inputs=inputs, force=True, what="catalog")
+    except checks.UsageError as err:
+        raise Refused(str(err)) from None
 
 
 def _prepare(cfg, path, resume, force, rerun=None):
@@ -363,7 +361,6 @@ def _prepare(cfg, path, resume, force, rerun=None):
 
     rerun: the failed tasks are to be rerun with this [integrator] (which may differ from the stored one).
     """
-    _check_output(path)
     final, partial = str(path), catalog.partial_path(path)
     if resume:
         if not os.path.exists(partial):
@@ -384,9 +381,17 @@ def _prepare(cfg, path, resume, force, rerun=None):
             raise ConfigError(f"{partial}: no failed task to rerun (a changed [integrator] applies to "
                               f"failed tasks only)")
         _fits(partial, lambda: space.reserve_file(partial))
-        return "resume", None, spins_needed(cfg, task_list(cfg), tasks, rerun)
+        kept = (f"resuming {partial}: keeps {int(tasks['events_written'].sum())} of {len(tasks['point']) * cfg.run.events} "
+                f"events recorded, {int(np.sum(tasks['status'] == FINISHED))} of {len(tasks['point'])} tasks finished"
+                + (f", {int(np.sum(tasks['status'] == FAILED))} failed" if np.any(tasks["status"] == FAILED) else ""))
+        return "resume", kept, spins_needed(cfg, task_list(cfg), tasks, rerun)
     if os.path.exists(final) and not force:
         raise Refused(f"{final}: catalog exists (use --force to overwrite it)")
+    for p in (final, partial):
+        kind = filekind.identify(p)[0]
+        if force and kind not in ("missing", "catalog", "damaged", "empty"):
+            # (a config, a summary or any other file given as -o is never replaced)
+            raise Refused(f"{p} {filekind.describe(p)}; --force replaces only an event catalog")
     if os.path.exists(partial) and not force:
         raise Refused(f"{partial}: an interrupted run exists (use --resume to continue it, "
                       f"--force to start over)")
@@ -425,13 +430,14 @@ def _compile_kernels(cfg, task, coord, say):
         say(f"kernels ready in {time.perf_counter() - start:.0f} s")
 
 
-def run(cfg, path, comm, resume=False, force=False, log=print, rerun=None, command=""):
+def run(cfg, path, comm, resume=False, force=False, log=print, rerun=None, command="", inputs=()):
     """Run every task of cfg on the ranks of comm into the catalog at `path`.
 
     Rank 0 holds the run's lock (lock.py) from before anything is decided until
     the end. Writes to path + '.partial' and renames it to `path` when every task
     has finished, so a good catalog is never replaced by a half-written one.
     `rerun`: an [integrator] for the tasks that failed before (resume only).
+    `inputs`: the run's input files (its config), which the output must not be.
     Returns 0, EXIT_INTERRUPTED after a stop request (every rank checkpointed),
     or EXIT_FAILED if some tasks failed (the others finished; the catalog stays partial).
     """
@@ -442,6 +448,7 @@ def run(cfg, path, comm, resume=False, force=False, log=print, rerun=None, comma
     try:
         if rank == 0:
             try:
+                _check_output(path, inputs)
                 lock = RunLock(path, command).acquire()
                 if lock.note:
                     say(f"note: {lock.note}")
@@ -455,6 +462,8 @@ def run(cfg, path, comm, resume=False, force=False, log=print, rerun=None, comma
         if mode == "complete":
             say(message)
             return 0
+        if message:
+            say(message)
         return _run_locked(cfg, path, comm, mode, spins, log, say, rerun, lock)
     finally:
         if lock is not None:
