@@ -147,9 +147,10 @@ def _clear(paths, box):
 def place_inset(ax, draw, renderer):
     """Add an inset (drawn by draw(inset)) where the data of `ax` stay below it: the inset with
     its tick labels and title, widened by GAP, and everything above it up to the axes' top
-    must not meet a curve or band. Tries the top of the panel from right to left, keeps the
-    position in the middle of the widest clear stretch; if none is clear, raises the y axis
-    (the data shrink downwards) up to three times, then draws no inset. Returns the inset or None."""
+    must not meet a curve or band. Tries 41 positions along the top of the panel and keeps the
+    one in the middle of the widest clear stretch; if none is clear, raises the y axis (the data
+    shrink downwards) up to three times, then gives up: no inset, the y axis as it was. Returns
+    the inset or None."""
     w, h = INSET
     probe = ax.inset_axes([1 - w, 1 - h, w, h])
     draw(probe)
@@ -158,7 +159,10 @@ def place_inset(ax, draw, renderer):
     gap = GAP * ax.figure.dpi / 72
     left, right = frame.x0 - tight.x0 + gap, tight.x1 - frame.x1 + gap
     below, above = frame.y0 - tight.y0 + gap, tight.y1 - frame.y1 + gap
-    for _ in range(4):
+    ylim = ax.get_ylim()
+    for raised in range(4):
+        if raised:
+            ax.set_ylim(ylim[0], ylim[0] + 1.3 ** raised * (ylim[1] - ylim[0]))
         box = ax.get_window_extent(renderer)
         top = box.y1 - above                              # the inset's frame reaches up to here
         y0 = top - h * box.height
@@ -182,8 +186,7 @@ def place_inset(ax, draw, renderer):
             inset = ax.inset_axes([ax0, ay0, w, h])
             draw(inset)
             return inset
-        lo, hi = ax.get_ylim()
-        ax.set_ylim(lo, lo + 1.3 * (hi - lo))
+    ax.set_ylim(ylim)
     return None
 
 
