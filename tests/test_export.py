@@ -274,6 +274,43 @@ def test_tables_of_a_partial_reduction_say_so(files):
         assert sum(line.startswith("# reduced from ") and line.endswith("; " + partial) for line in lines) == 1
 
 
+def test_export_of_an_unfinished_run_needs_partial_as_reduce_does(files, tmp_path):
+    """Issue 26, item 11: an unfinished run exported with exit 0, and its headers did not say so.
+    Refused as reduce refuses it (its words with export's verb, exit 1), nothing written; a run's
+    *.partial too, even with every task finished (the run has not renamed it: it may go on)."""
+    red = analysis("reduce", files / "cat.h5", "-o", tmp_path / "s.h5")
+    res = analysis("export", files / "cat.h5", "-o", tmp_path / "out")
+    assert red.returncode == res.returncode == 1
+    assert res.stderr.strip().splitlines() == [red.stderr.strip().replace("reduce what it holds",
+                                                                          "export what it holds")]
+    assert "(5 of 8 tasks unfinished)" in res.stderr and not (tmp_path / "out").exists()
+    whole = tmp_path / "whole.h5"
+    write_catalog(whole, CONFIG.format(N=N_CHAIN, sweep="nu = [1.0]", seeds=2, seed=0), [400, 400], seed=2)
+    ok(analysis("export", whole, "-o", tmp_path / "whole_csv"))
+    assert "PARTIAL" not in (tmp_path / "whole_csv" / "tasks.csv").read_text()
+    running = whole.rename(tmp_path / "whole.h5.partial")
+    res = analysis("export", running, "-o", tmp_path / "out")
+    assert res.returncode == 1 and res.stderr.strip().splitlines() == [
+        f"error: {running} is an unfinished run (named *.partial); continue it with `python -m ensemble resume "
+        f"{whole}`, or export what it holds with --partial"]
+    ok(analysis("export", running, "-o", tmp_path / "out", "--partial"))
+    for table in ("events", "tasks"):
+        lines = (tmp_path / "out" / f"{table}.csv").read_text().splitlines()
+        assert "# PARTIAL export of an unfinished run (named *.partial): 800 of 800 events (100.0%)" in lines
+
+
+def test_tables_of_an_unfinished_run_say_so(files):
+    """With --partial, every table's header states the run unfinished: tasks, events of expected."""
+    _, tasks, _ = catalog.read(files / "cat.h5")
+    assert np.count_nonzero((tasks["status"] != catalog.FINISHED) | (tasks["events_written"] < 400)) == 5
+    line = (f"# PARTIAL export of an unfinished run (5 of 8 tasks unfinished): {sum(WRITTEN)} of {8 * 400} events "
+            f"({100 * sum(WRITTEN) / (8 * 400):.1f}%)")
+    for table in ("events", "tasks"):
+        lines = (files / "cat_csv" / f"{table}.csv").read_text(encoding="utf-8").splitlines()
+        count = int(re.search(r"skip_header=(\d+)", lines[0]).group(1))
+        assert lines[:count].count(line) == 1, table
+
+
 def test_export_refuses_to_overwrite(files, tmp_path):
     out = tmp_path / "out"
     out.mkdir()
