@@ -1,16 +1,20 @@
-# Two entry points: `make run` (set up, run the example) and `make test` (set up, run the tests).
-# STACK (scripts/setup.sh): auto (default: the machine's MPI and parallel HDF5 when found, else
-# wheels), parallel or wheels. `make test` tests the parallel writer, so it sets up the parallel
-# stack unless STACK=wheels is given (then the tests that need MPI-IO are skipped, saying so).
+# Two entry points: `make run` (set up, run the example) and `make test` (set up, run the tests),
+# and a quick tier, `make quick` (about two minutes of tests touching every module; docs/tests.md).
+# STACK (scripts/setup.sh): auto (default: the stack .venv has, else the wheel stack, ready in
+# about a minute), parallel (build mpi4py and h5py against the machine's MPI and parallel HDF5:
+# minutes) or wheels. `make test` tests the parallel writer, so it sets up the parallel stack
+# unless STACK=wheels is given (then the tests that need MPI-IO are skipped, saying so); `make run`
+# and `make quick` then keep it. Numba's cache is the package's own (ensemble/kernel_cache.py: the
+# checkout's .numba_cache unless NUMBA_CACHE_DIR is set), the same for make and a direct
+# `python -m ensemble`, so the kernels are compiled once.
 PY := .venv/bin/python
 STACK ?= auto
 TEST_STACK := $(if $(filter wheels,$(STACK)),wheels,parallel)
-export NUMBA_CACHE_DIR := $(CURDIR)/.numba_cache
 export OMP_NUM_THREADS := 1
 export NUMBA_NUM_THREADS := 1
 export OPENBLAS_NUM_THREADS := 1
 
-.PHONY: setup run test test-all mutations loaded
+.PHONY: setup run test quick test-all mutations loaded
 
 setup:
 	STACK=$(STACK) bash scripts/setup.sh
@@ -21,6 +25,10 @@ run: setup
 test:
 	STACK=$(TEST_STACK) bash scripts/setup.sh
 	ENSEMBLE_TEST_STACK=$(TEST_STACK) $(PY) -m pytest -q -m "not slow"
+
+# a tier of about two minutes that touches every module (the `quick` marker: tests/conftest.py)
+quick: setup
+	$(PY) -m pytest -q -m "quick and not slow"
 
 test-all:
 	STACK=$(TEST_STACK) bash scripts/setup.sh

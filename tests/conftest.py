@@ -28,7 +28,64 @@ _STDERR = pytest.StashKey[int]()
 os.environ["PATH"] = os.path.dirname(sys.executable) + os.pathsep + os.environ.get("PATH", "")
 
 
+# -- the quick tier (`make quick`, `pytest -m quick`) -------------------------------------------
+# About two minutes here (docs/tests.md) that touch every module of ensemble/ and analysis/: the
+# cheapest test, or few, of each layer. Named here rather than marked in each file, so that the tier
+# is one list to read. tests/test_quick_tier.py checks that every name exists and that every test
+# file is here or in NOT_QUICK, with the reason.
+QUICK = {
+    "test_install.py": ["test_an_unknown_stack_is_an_error_naming_it", "test_a_module_system_prefix_in_hdf5_dir",
+                        "test_every_entry_point_takes_the_packages_kernel_cache"],
+    "test_onset.py": ["test_lambert_root_on_upper_branch", "test_onset_delay_matches_brute_force",
+                      "test_fast_forward_lands_on_threshold_of_epicenter_only"],
+    "test_physics.py": ["test_single_block_instability_threshold", "test_energy_balance_per_event"],
+    "test_ark4.py": ["test_tableau_order_conditions", "test_kernel_arrays_are_the_tableau",
+                     "test_zero_step_keeps_the_state"],
+    "test_schedule.py": ["test_tree_finds_the_smallest_key_after_any_updates"],
+    "test_budget.py": ["test_between_events_state_of_a_paused_event"],
+    "test_laws.py": ["test_a_key_of_another_law_is_an_error_naming_it",
+                     "test_single_block_slip_is_the_linearised_oscillation"],
+    "test_nonfinite.py": ["test_tree_min_returns_a_block_whatever_the_keys"],
+    "test_cli.py": ["test_validate_prints_resolved_config_and_tasks", "test_bad_config_gives_one_line_error_naming_the_key",
+                    "test_catalog_schema_and_content", "test_status_summarises_a_finished_catalog"],
+    "test_input_errors.py": ["test_identify", "test_load_says_what_a_non_config_is", "test_run_guarded_codes_and_messages",
+                             "test_closed_pipe_exits_141_without_traceback"],
+    "test_faults.py": ["test_output_paths_are_checked_before_any_work", "test_a_stale_lock_of_a_dead_run_is_taken_over",
+                       "test_a_one_byte_flip_fails_resume_and_read_naming_the_task"],
+    "test_mpi.py": ["test_a_genuine_error_on_one_rank_aborts_the_job"],
+    "test_branch.py": ["test_branch_keys_are_validated_by_name", "test_validate_and_the_run_log_name_the_spin_ups"],
+    "test_analysis.py": ["test_recurrence_scan_matches_brute_force", "test_b_value_recovers_known_gutenberg_richter"],
+    "test_reduction.py": ["test_percentile_interval_leaves_the_documented_share_outside",
+                          "test_peak_finder_follows_its_documented_rule", "test_unfinished_runs_need_partial_and_say_so",
+                          "test_report_states_every_number_and_the_level"],
+    "test_figures.py": ["test_synthetic_figures_cover_no_data"],
+    "test_paper.py": ["test_bad_input_is_one_line_naming_the_file"],
+    "test_export.py": ["test_catalog_csv_round_trips_exactly", "test_export_of_a_wrong_file_is_one_line"],
+    "test_compare.py": ["test_power_law_fit_recovers_the_exponent", "test_dip_is_one_without_a_hump_and_the_ratio_with_one",
+                        "test_compare_numbers_are_the_catalogs"],
+    "test_paper_docs.py": ["test_readme_claims_table_is_the_generated_one", "test_tables_md_is_what_the_summaries_give"],
+    "test_convergence.py": ["test_clock_offset_does_not_change_events"],
+    "test_ark3.py": ["test_run_with_ark3"],
+    "test_processes.py": ["test_wait_for_fails_when_the_command_ends_first_or_time_runs_out",
+                          "test_the_ranks_of_mpiexec_are_killed_too"],
+    "test_slurm.py": ["test_time_limits_as_slurm_reads_them", "test_rendered_scripts_are_complete_and_valid_bash",
+                      "test_cli_renders_without_submitting"],
+    "test_benchmarks.py": ["test_distances_agree_with_scipy", "test_settings_are_validated"],
+    "test_time_to_statistics.py": ["test_schedule_replays_the_counter"],
+    "test_options.py": ["test_every_numeric_option_is_checked_and_attacked", "test_huge_bins_are_refused_before_any_file_is_read"],
+    "test_quick_tier.py": ["test_every_test_named_in_the_quick_tier_exists",
+                           "test_every_test_file_is_in_the_quick_tier_or_says_why_not"],
+}
+NOT_QUICK = {   # test files with no test in the quick tier, and why
+    "test_sequences.py": "every test needs a serial catalog and a full-chain reference (10 s and more)",
+    "test_hard_cases.py": "hard cases at their own sizes (N = 6400, t = 1e15): tens of seconds each",
+    "test_kernel_identity.py": "compiles the kernels of a reference commit first (about 15 s, more under load)",
+    "test_third_law.py": "compiles a copy of the package with a third law (about a minute)",
+}
+
+
 def pytest_configure(config):
+    config.addinivalue_line("markers", "quick: the quick tier, `make quick` (tests/conftest.py QUICK, docs/tests.md)")
     # stderr itself, kept for the watchdog: during a test fd 2 is pytest's capture file
     config.stash[_STDERR] = os.dup(sys.stderr.fileno())
     # `make test` sets up the parallel stack and says so: then no test may skip for want of MPI-IO
@@ -38,6 +95,9 @@ def pytest_configure(config):
 
 
 def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if item.originalname in QUICK.get(item.path.name, ()):
+            item.add_marker(pytest.mark.quick)
     if catalog.has_parallel_hdf5():
         return
     skip = pytest.mark.skip(reason="h5py without MPI (the wheel stack): the parallel writer is not "

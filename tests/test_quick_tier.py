@@ -1,0 +1,23 @@
+"""The quick tier (`make quick`): the tests tests/conftest.py names in QUICK exist, and every test
+file has tests in it or says in NOT_QUICK why not (so that the tier keeps touching every layer as
+files are added). Which source modules it touches, and how long it takes: docs/tests.md."""
+import importlib
+
+from .conftest import NOT_QUICK, QUICK
+from .processes import ROOT
+
+
+def test_every_test_named_in_the_quick_tier_exists():
+    for name, tests in QUICK.items():
+        module = importlib.import_module(f"tests.{name.removesuffix('.py')}")
+        missing = [t for t in tests if not callable(getattr(module, t, None))]
+        assert not missing, f"tests/{name} has no {', '.join(missing)}: rename it in QUICK (tests/conftest.py)"
+
+
+def test_every_test_file_is_in_the_quick_tier_or_says_why_not():
+    files = {p.name for p in (ROOT / "tests").glob("test_*.py")}
+    unlisted = sorted(files - set(QUICK) - set(NOT_QUICK))
+    assert not unlisted, (f"{', '.join(unlisted)}: add its cheapest test to QUICK in tests/conftest.py "
+                          f"(the quick tier touches every layer), or the file to NOT_QUICK with the reason")
+    assert not set(QUICK) & set(NOT_QUICK)
+    assert not (set(QUICK) | set(NOT_QUICK)) - files, "QUICK or NOT_QUICK names a file that is gone"
