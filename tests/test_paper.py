@@ -131,3 +131,16 @@ def test_shape_intervals_resample_the_summarys_units():
     s["points/method"] = np.array(["seeds"] * len(s["points/method"]))
     est, lo, hi, _ = paper.shape_statistics(s, i)["peak_over_dip"]
     assert lo == est == hi
+
+
+def test_tables_py_on_a_reduced_run_says_reduced(reduced, tmp_path):
+    """The reported case: examples/paper/tables.py on a reduced Fig. 1 top summary printed
+    "346 [160, nan]" under a heading saying full size. It is analysis paper's table now."""
+    import shutil
+    shutil.copy(reduced / "sum.h5", tmp_path / "fig1_b.summary.h5")
+    res = run_bounded([sys.executable, ROOT / "examples/paper/tables.py", tmp_path], 300, cwd=ROOT)
+    assert res.returncode == 0, res.stderr
+    assert "## The paper's claims in a reduced run" in res.stdout and "at full size" not in res.stdout
+    assert not re.search(r"\bnan\b", res.stdout, re.IGNORECASE), res.stdout
+    claims = res.stdout[res.stdout.index("| the paper (Ohmura"):res.stdout.index("\n\n## One model")]
+    assert claims == paper.claims_table([summary.read(tmp_path / "fig1_b.summary.h5")])
