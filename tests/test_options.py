@@ -18,7 +18,7 @@ import pytest
 from analysis import cli
 from ensemble import checks
 
-from .processes import child_env, run_bounded
+from .processes import ROOT, child_env, run_bounded
 from .test_reduction import CONFIG, N_CHAIN, write_catalog
 
 SWEEP = "nu = [1.0]"
@@ -40,6 +40,7 @@ BAD = {
                 "0:1e308:10000000000", "-1e308:1e308:10"],
     "tnu_bins": ["nan:2000:80", "0:inf:80", "0:2000:inf", "0:1e308:10000000000", "2000:0:80", "0:0:80"],
 }
+ENV = child_env(PYTHONPATH=str(ROOT))   # this checkout's packages, wherever the command runs
 OPTION = {dest: "--" + dest.replace("_", "-") for dest in BAD}
 
 
@@ -111,7 +112,7 @@ def test_reduce_mu_c_nan_is_refused_by_the_command_line(files, tmp_path):
     """Issue 26, item 9, as a user types it: `--mu-c nan` exited 0 with inconsistent numbers."""
     for option, value in (("--mu-c", "nan"), ("--mu-c", "inf"), ("--b-cut", "nan")):
         res = run_bounded([sys.executable, "-m", "analysis", "reduce", str(files / "cat.h5"), "-o",
-                           str(tmp_path / "s.h5"), option, value], 120, env=child_env())
+                           str(tmp_path / "s.h5"), option, value], 120, env=ENV)
         assert res.returncode == 2, res.stderr
         assert res.stderr.strip().splitlines() == [f"error: {option} must be finite, not '{value}'"]
         assert not (tmp_path / "s.h5").exists()
@@ -122,7 +123,7 @@ def test_huge_bins_are_refused_before_any_file_is_read(tmp_path):
     as out of range with exit 2, before the catalog is read (it need not even exist)."""
     start = time.monotonic()
     res = run_bounded([sys.executable, "-m", "analysis", "reduce", str(tmp_path / "no such catalog.h5"),
-                       "-o", str(tmp_path / "s.h5"), "--tnu-bins", "0:1e308:10000000000"], 120, env=child_env())
+                       "-o", str(tmp_path / "s.h5"), "--tnu-bins", "0:1e308:10000000000"], 120, env=ENV)
     assert res.returncode == 2, res.stderr
     assert res.stderr.strip().splitlines() == [
         "error: --tnu-bins n = '10000000000' is out of range [1, 1000000]"]
@@ -175,14 +176,16 @@ def existing_output(command, d):
 
 
 def bad_outputs(command, d):
-    """(case, the output path, extra options, what the line must name)."""
+    """(case, the output path, extra options, what the line must name, what it must say)."""
     source = d / ("sum.h5" if command == "plot" else "cat.h5")
-    cases = [("input", source, [], str(source)),
-             ("input, --force", source, ["--force"], str(source)),
-             ("not UTF-8", d / os.fsdecode(b"\xff-out"), [], checks.shown(d / os.fsdecode(b"\xff-out"))),
-             ("under a file", d / "cfg.toml" / "out", [], str(d / "cfg.toml"))]
+    odd = d / os.fsdecode(b"\xff-out")
+    cases = [("input", source, [], str(source), "would overwrite the command's input"),
+             ("input, --force", source, ["--force"], str(source), "would overwrite the command's input"),
+             ("not UTF-8", odd, [], checks.shown(odd), "is not valid UTF-8"),
+             ("under a file", d / "cfg.toml" / "out", [], str(d / "cfg.toml"), "is not a directory")]
     if command in ("reduce", "plot"):   # a file in a folder; export and compare make their folder
-        cases.append(("missing folder", d / "missing_dir" / "x.out", [], str(d / "missing_dir")))
+        cases.append(("missing folder", d / "missing_dir" / "x.out", [], f"directory {d / 'missing_dir'}",
+                      "does not exist"))
     return cases
 
 
@@ -191,10 +194,10 @@ def test_a_bad_output_path_is_one_line_exit_2_naming_it(files, tmp_path, capsys,
     d = tmp_path
     for name in ("cat.h5", "sum.h5", "cfg.toml"):
         shutil.copy(files / name, d / name)
-    for case, out, extra, named in bad_outputs(command, d):
+    for case, out, extra, named, words in bad_outputs(command, d):
         before = {p: p.read_bytes() for p in d.iterdir() if p.is_file()}
         line = refused(capsys, base_args(command, d, out) + extra)
-        assert named in line, (case, line)
+        assert named in line and words in line, (case, line)
         assert {p: p.read_bytes() for p in d.iterdir() if p.is_file()} == before, case
         assert not (d / "missing_dir").exists()
     # existing, without --force: refused, untouched; with it, replaced
@@ -238,7 +241,7 @@ def test_an_unwritable_folder_is_refused(files, tmp_path, capsys, command):
 def test_bad_output_paths_through_the_command_line(files, tmp_path, command, out):
     """As a user types them (issue 27: `-o missing_dir/x.h5` names the folder; issue 26, item 10)."""
     args = [str(a) for a in base_args(command, files, tmp_path / out)]
-    res = run_bounded([sys.executable, "-m", "analysis", *args], 120, env=child_env(), cwd=tmp_path)
+    res = run_bounded([sys.executable, "-m", "analysis", *args], 120, env=ENV, cwd=tmp_path)
     assert res.returncode == 2, res.stderr
     lines = res.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: "), res.stderr
