@@ -9,7 +9,12 @@ the original later does not change a queued run), the catalog(s), logs/ and resu
 Kinds of run job (KINDS): "single" (one MPI run), "requeue" (walltime-safe: checkpoint before
 the limit, requeue, resume), "array" (one walltime-safe element per parameter point). Each comes
 with reduce.sbatch, submitted with --dependency=afterok on the run job, which reduces the run's
-catalog (an array's per-point catalogs together) into one summary, its figures and report.
+catalog (an array's per-point catalogs together) into one summary, its figures and report; it has
+a time limit, partition and memory of its own (a reduction is short and needs one rank).
+
+A job directory that exists is not written over without force (its config snapshot is what a
+queued run reads). mpi4py and h5py are built against one MPI, which the nodes must have too: the
+scripts and the command's output name it (python_stack()).
 """
 import dataclasses
 import os
@@ -25,7 +30,8 @@ from .config import Config, load, replace
 TEMPLATES = Path(__file__).resolve().parents[1] / "jobs"
 PLACEHOLDER = re.compile(r"@([A-Z][A-Z0-9_]*)@")
 SAFE_PATH = re.compile(r"[\w./+,:=%-]+")   # nothing that #SBATCH lines or the shell would split
-DEFAULT_NUMBA_CACHE = "${TMPDIR:-/tmp}/bk-numba-$SLURM_JOB_ID"
+DEFAULT_REDUCE_TIME = "00:30:00"   # a reduction streams each catalog once (docs: jobs/README.md)
+MEMORY = re.compile(r"\d+[KMGT]?")   # Slurm's --mem: an integer, megabytes unless a unit follows
 
 PLACEHOLDERS = {
     "JOB_NAME": "job name (bk-<config file stem>)",
@@ -33,7 +39,8 @@ PLACEHOLDERS = {
     "ACCOUNT": "account to charge (line dropped when not given)",
     "NTASKS": "MPI ranks of the run job (of each array element)",
     "CPUS_PER_TASK": "cores per rank (1: the kernels are single-threaded)",
-    "TIME": "time limit of each job (each start of a requeued job)",
+    "TIME": "time limit of the run job (of each start of a requeued job)",
+    "MEM": "memory per node of the run job, Slurm's --mem (line dropped when not given)",
     "WORK_DIR": "the job directory (--chdir)",
     "LOG_DIR": "where Slurm writes the job logs",
     "EXTRA_SBATCH": "further #SBATCH lines (line dropped when none)",
@@ -43,7 +50,8 @@ PLACEHOLDERS = {
     "LAUNCHER": "srun, or mpiexec for an MPI without Slurm PMI support",
     "SRUN_MPI": "srun's --mpi plugin (pmi2, pmix, ...)",
     "SETUP": "shell lines run before anything else, e.g. module load (dropped when none)",
-    "NUMBA_CACHE_DIR": "numba's kernel cache (default job-local, on node-local disk)",
+    "NUMBA_CACHE_DIR": "numba's kernel cache (line dropped by default: the package's own, ensemble/kernel_cache.py)",
+    "MPI": "the MPI PYTHON's mpi4py was built against, found when rendering (comment; dropped when unknown)",
     "HDF5_USE_FILE_LOCKING": "FALSE on filesystems without locks (line dropped when not set)",
     "SIGNAL_SECONDS": "USR1 this long before the time limit",
     "STARTUP_SECONDS": "a USR1 earlier than this after launch is held back until then",
@@ -52,6 +60,9 @@ PLACEHOLDERS = {
     "ARRAY": "array index range, e.g. 0-9 or 0-9%4",
     "POINTS_DIR": "per-point configs and catalogs of an array job",
     "REDUCE_NTASKS": "ranks of the reduction job",
+    "REDUCE_TIME": "time limit of the reduction job",
+    "REDUCE_PARTITION": "partition of the reduction job (the run's unless given; line dropped when empty)",
+    "REDUCE_MEM": "memory per node of the reduction job, Slurm's --mem (line dropped when not given)",
     "CATALOGS": "catalogs the reduction job reduces together into one summary (space-separated)",
     "SUMMARY_DIR": "where the reduction writes the summary, figures and report",
     "RESULT_NAME": "name of the summary, figures and report (catalog stem; the config's for an array)",
@@ -84,11 +95,16 @@ class JobOptions:
     python: str = sys.executable
     setup: tuple = ()               # shell lines, e.g. "module load mpich"
     sbatch: tuple = ()              # further sbatch options, e.g. "--mem-per-cpu=2G"
-    numba_cache: str = DEFAULT_NUMBA_CACHE
+    numba_cache: str = ""           # "": the package's own cache (ensemble/kernel_cache.py)
+    mem: str = ""                   # Slurm's --mem of the run job (per node), e.g. 4G
     file_locking: bool = True       # False: HDF5_USE_FILE_LOCKING=FALSE
     array_limit: int = 0            # at most this many array elements at once (0: no limit)
     reduce_ntasks: int = 1
+    reduce_time: str = DEFAULT_REDUCE_TIME
+    reduce_partition: str | None = None   # None: the run's partition
+    reduce_mem: str = ""
     job_name: str = ""
+    mpi: str = ""                   # the MPI PYTHON was built against (python_stack()), for a comment
 
 
 @dataclass(frozen=True)
@@ -187,9 +203,16 @@ def _check(opt):
             raise SlurmError(f"--{name.replace('_', '-')} must be >= 1, got {getattr(opt, name)}")
     if opt.max_requeues < 0 or opt.array_limit < 0:
         raise SlurmError("--max-requeues and --array-limit must be >= 0")
-    for word in (opt.partition, opt.account, opt.job_name, opt.srun_mpi):
+    for word in (opt.partition, opt.reduce_partition, opt.account, opt.job_name, opt.srun_mpi):
         if word and not SAFE_PATH.fullmatch(word):
             raise SlurmError(f"{word!r}: not a valid Slurm name")
+    for name in ("mem", "reduce_mem"):
+        value = getattr(opt, name).strip()
+        if value and not MEMORY.fullmatch(value):
+            raise SlurmError(f"--{name.replace('_', '-')} must be a Slurm memory size like 4G, 500M or 2000, "
+                             f"got {value!r}")
+    if "\n" in opt.mpi:
+        raise SlurmError("the MPI description must be one line")
 
 
 def _single_configs(cfg, directory):
@@ -225,12 +248,22 @@ KINDS = {   # kind: (template, what it writes besides the scripts)
 }
 
 
-def render(cfg: Config, opt: JobOptions, directory, name="run", templates=TEMPLATES):
-    """Write the run script, reduce.sbatch, submit.sh and the configs into `directory`."""
+def render(cfg: Config, opt: JobOptions, directory, name="run", templates=TEMPLATES, force=False):
+    """Write the run script, reduce.sbatch, submit.sh and the configs into `directory`.
+
+    A `directory` that exists and is not empty is refused unless `force`: it is another job's (its
+    config snapshot is what its queued run reads); with force its scripts and configs are replaced
+    and any catalogs in it kept (describe() says what the jobs will make of them)."""
     _check(opt)
     limit = time_seconds(opt.time)
     signal, startup = _defaults(opt, limit)
+    time_seconds(opt.reduce_time)
     directory = Path(directory).resolve()
+    if not force and directory.is_dir() and any(directory.iterdir()):
+        raise SlurmError(f"{_rel(directory)}: a job directory exists (scripts, config snapshot, catalogs); "
+                         f"use --force to write over it, or -o another directory")
+    if directory.exists() and not directory.is_dir():
+        raise SlurmError(f"{_rel(directory)}: exists and is not a directory")
     template, configs = KINDS[opt.kind]
     for d in (directory, directory / "logs"):
         d.mkdir(parents=True, exist_ok=True)
@@ -244,6 +277,9 @@ def render(cfg: Config, opt: JobOptions, directory, name="run", templates=TEMPLA
     values.update({
         "JOB_NAME": opt.job_name or f"bk-{name}", "PARTITION": opt.partition, "ACCOUNT": opt.account,
         "NTASKS": opt.ntasks, "CPUS_PER_TASK": opt.cpus_per_task, "TIME": opt.time.strip(),
+        "MEM": opt.mem.strip(), "REDUCE_TIME": opt.reduce_time.strip(), "REDUCE_MEM": opt.reduce_mem.strip(),
+        "REDUCE_PARTITION": opt.partition if opt.reduce_partition is None else opt.reduce_partition,
+        "MPI": opt.mpi.strip(),
         "WORK_DIR": _check_path(directory), "LOG_DIR": _check_path(directory / "logs"),
         "EXTRA_SBATCH": "\n".join(f"#SBATCH {o}" for o in opt.sbatch),
         "PYTHON": _check_path(opt.python), "LAUNCHER": opt.launcher, "SRUN_MPI": opt.srun_mpi,
@@ -271,18 +307,55 @@ def render(cfg: Config, opt: JobOptions, directory, name="run", templates=TEMPLA
                     directory / "results" / f"{result_name}.summary.h5")
 
 
-def check_python(python):
-    """None if `python` imports what the jobs need when started outside the repository (as the
-    jobs are), else a warning."""
+# run by the jobs' python: the MPI library, the libmpi file mpi4py loaded (Linux), the mpich wheel if any
+_STACK_PROBE = """
+import importlib.metadata, os, mpi4py, ensemble, analysis, h5py
+from ensemble import environment
+try:
+    importlib.metadata.version("mpich")
+    wheel = "1"
+except importlib.metadata.PackageNotFoundError:
+    wheel = ""
+print(environment.mpi_line().removeprefix("mpi: "))
+try:
+    with open("/proc/self/maps") as maps:
+        paths = {line.split()[-1] for line in maps if "/" in line}
+    print(" ".join(sorted(p for p in paths if os.path.basename(p).startswith("libmpi"))))
+except OSError:
+    print()
+print(wheel)
+"""
+
+
+def python_stack(python):
+    """(problem, mpi) for the jobs' `python`, started outside the repository as the jobs are:
+    problem is None or a warning (not on this machine, cannot import what the jobs need); mpi
+    describes the MPI its mpi4py was built against ("" when unknown)."""
     if not os.path.exists(python):
-        return f"note: {python} is not on this machine; not checked that it has this package"
-    res = subprocess.run([python, "-c", "import ensemble, analysis, mpi4py, h5py"], cwd="/",
-                         capture_output=True, text=True, stdin=subprocess.DEVNULL)
+        return f"note: {python} is not on this machine; not checked that it has this package", ""
+    res = subprocess.run([python, "-c", _STACK_PROBE], cwd="/", capture_output=True, text=True,
+                         stdin=subprocess.DEVNULL, timeout=120)
     if res.returncode != 0:
         why = (res.stderr.strip().splitlines() or ["?"])[-1]
         return (f"warning: {python}, started outside the repository, cannot import what the jobs need "
-                f"({why}); install the package into it (pip install -e .)")
-    return None
+                f"({why}); install the package into it (pip install -e .)"), ""
+    library, files, wheel = (res.stdout.splitlines() + ["", "", ""])[:3]
+    if wheel:
+        return None, f"{library}, the mpich wheel inside the environment"
+    return None, f"{library}" + (f", {files}" if files else "")
+
+
+def mpi_note(opt):
+    """The command's line on the MPI the nodes need (opt.mpi from python_stack())."""
+    if not opt.mpi:
+        return ("note: the nodes need the MPI that mpi4py and h5py of the jobs' python were built against "
+                "(load it with --setup 'module load ...')")
+    if opt.mpi.endswith("the mpich wheel inside the environment"):
+        hint = ("" if opt.launcher == "mpiexec"
+                else "; start its ranks with --launcher mpiexec (docs/install.md: srun and PMI)")
+        return f"note: MPI: {opt.mpi}; the nodes need no MPI of their own{hint}"
+    return (f"note: the nodes need the MPI this environment was built against ({opt.mpi}): "
+            f"the same MPI on every node, loaded in the jobs (--setup 'module load ...') where it is a module")
 
 
 def _sbatch(*args):
@@ -310,13 +383,16 @@ def add_arguments(p):
                    help="override one config value (repeatable)")
     p.add_argument("--ntasks", type=int, required=True, help="MPI ranks (of each array element)")
     p.add_argument("--time", required=True,
-                   help="time limit, e.g. 02:00:00 (of each start of a requeued job)")
+                   help="time limit of the run job, e.g. 02:00:00 (of each start of a requeued job)")
     p.add_argument("--kind", choices=list(KINDS), default=d.kind,
                    help="single: one MPI run; requeue (default): checkpoint before the limit, requeue "
                         "and resume until done; array: one requeueing element per parameter point")
     p.add_argument("--partition", default="")
     p.add_argument("--account", default="")
+    p.add_argument("--mem", default="", help="memory per node of the run job (Slurm's --mem, e.g. 4G; "
+                   "default: the partition's)")
     p.add_argument("-o", "--output", help="job directory (default: slurm-<config stem>)")
+    p.add_argument("--force", action="store_true", help="write over an existing job directory")
     p.add_argument("--submit", action="store_true", help="submit the run and the reduction after it")
     p.add_argument("--signal-seconds", type=int, help="USR1 this long before the limit "
                    "(default 300, at most half the limit)")
@@ -331,11 +407,17 @@ def add_arguments(p):
     p.add_argument("--sbatch", action="append", default=[], metavar="OPTION",
                    help="further sbatch option, e.g. --sbatch=--mem-per-cpu=2G (repeatable)")
     p.add_argument("--cpus-per-task", type=int, default=d.cpus_per_task)
-    p.add_argument("--numba-cache", default=d.numba_cache, help="default: job-local %(default)s")
+    p.add_argument("--numba-cache", default=d.numba_cache,
+                   help="numba's cache (default: the package's own, as for every entry point)")
     p.add_argument("--no-file-locking", action="store_true",
                    help="set HDF5_USE_FILE_LOCKING=FALSE (filesystems without locks)")
     p.add_argument("--array-limit", type=int, default=0, help="array elements running at once (0: all)")
     p.add_argument("--reduce-ntasks", type=int, default=d.reduce_ntasks)
+    p.add_argument("--reduce-time", default=d.reduce_time, help="time limit of the reduction job "
+                   "(default %(default)s)")
+    p.add_argument("--reduce-partition", help="partition of the reduction job (default: the run's)")
+    p.add_argument("--reduce-mem", default="", help="memory per node of the reduction job (default: the "
+                   "partition's)")
     p.add_argument("--job-name", default="")
 
 
@@ -349,16 +431,20 @@ def command(args):
                      python=args.python, setup=tuple(args.setup), sbatch=tuple(args.sbatch),
                      numba_cache=args.numba_cache, file_locking=not args.no_file_locking,
                      array_limit=args.array_limit, reduce_ntasks=args.reduce_ntasks,
-                     job_name=args.job_name)
+                     reduce_time=args.reduce_time, reduce_partition=args.reduce_partition,
+                     mem=args.mem, reduce_mem=args.reduce_mem, job_name=args.job_name)
     name = Path(args.config).stem
     directory = Path(args.output or f"slurm-{name}")
     try:
-        out = render(cfg, opt, directory, name)
+        _check(opt)     # a bad option is refused before python_stack() starts the jobs' python
+        problem, mpi = python_stack(opt.python)
+        opt = dataclasses.replace(opt, mpi=mpi)
+        out = render(cfg, opt, directory, name, force=args.force)
     except SlurmError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
     print(describe(cfg, opt, out))
-    problem = check_python(opt.python)
+    print(mpi_note(opt))
     if problem:
         print(problem, file=sys.stderr)
     if not args.submit:
@@ -402,4 +488,14 @@ def describe(cfg, opt, out):
     lines.append(f"  catalog{'s' if len(out.catalogs) > 1 else ''}: {where}; "
                  f"reduced {'together ' if len(out.catalogs) > 1 else ''}into {_rel(out.summary)} "
                  f"(figures and report beside it)")
+    partition = opt.partition if opt.reduce_partition is None else opt.reduce_partition
+    lines.append(f"  reduction job: {opt.reduce_ntasks} rank{'s' if opt.reduce_ntasks > 1 else ''}, "
+                 f"time {opt.reduce_time}" + (f", partition {partition}" if partition else "")
+                 + (f", memory {opt.reduce_mem}" if opt.reduce_mem else ""))
+    for catalog in out.catalogs:   # left from before in a directory written over (--force)
+        if os.path.exists(catalog):
+            lines.append(f"  note: {_rel(catalog)} exists: the run job will find it complete and do nothing "
+                         f"(remove it to run again)")
+        elif os.path.exists(f"{catalog}.partial"):
+            lines.append(f"  note: {_rel(catalog)}.partial exists: the run job will resume it")
     return "\n".join(lines)

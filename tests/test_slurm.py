@@ -20,8 +20,9 @@ import pytest
 from analysis import summary
 from ensemble import catalog
 from ensemble.config import load, loads
+from ensemble import environment
 from ensemble.slurm import (KINDS, PLACEHOLDER, PLACEHOLDERS, TEMPLATES, JobOptions, SlurmError,
-                            element_seed, fill, render, time_seconds)
+                            element_seed, fill, python_stack, render, time_seconds)
 
 from .conftest import write_config
 from .processes import child_env, poll_until, run_bounded
@@ -157,6 +158,71 @@ def test_cli_renders_without_submitting(tmp_path):
     assert res.returncode == 2 and "--time" in res.stderr
 
 
+def slurm_cli(*args, cwd):
+    return run_bounded([sys.executable, "-m", "ensemble", "slurm", *map(str, args)], 120, cwd=cwd)
+
+
+def test_an_existing_job_directory_is_not_written_over_without_force(tmp_path):
+    cfg = tiny_config(tmp_path / "tiny.toml")
+    assert slurm_cli(cfg, "--ntasks", 2, "--time", 30, cwd=tmp_path).returncode == 0
+    job = tmp_path / "slurm-tiny"
+    snapshot = (job / "config.toml").read_text()
+    (job / "tiny.h5").write_bytes(b"")       # as if the run had finished
+    res = slurm_cli(cfg, "--ntasks", 2, "--time", 30, "--set", "run.seeds=3", cwd=tmp_path)
+    assert res.returncode == 2 and res.stdout == "", res.stdout + res.stderr
+    assert res.stderr.strip() == ("error: slurm-tiny: a job directory exists (scripts, config snapshot, catalogs); "
+                                  "use --force to write over it, or -o another directory")
+    assert (job / "config.toml").read_text() == snapshot
+    # an empty directory is taken as it is
+    (tmp_path / "empty").mkdir()
+    assert slurm_cli(cfg, "--ntasks", 2, "--time", 30, "-o", "empty", cwd=tmp_path).returncode == 0
+    # --force writes the scripts and the snapshot anew, and says what the jobs will make of the old catalog
+    res = slurm_cli(cfg, "--ntasks", 2, "--time", 30, "--set", "run.seeds=3", "--force", cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert load(job / "config.toml").run.seeds == 3
+    assert "note: slurm-tiny/tiny.h5 exists: the run job will find it complete and do nothing" in res.stdout
+
+
+def test_the_reduction_job_has_its_own_time_partition_and_memory(tmp_path):
+    cfg = load(tiny_config(tmp_path / "tiny.toml"))
+
+    def headers(opt, name):
+        out = render(cfg, opt, tmp_path / name, "tiny")
+        return [[line for line in script.read_text().splitlines() if line.startswith("#SBATCH")]
+                for script in (out.run_script, out.reduce_script)]
+
+    run, reduce = headers(JobOptions(ntasks=8, time="2-00:00:00", partition="long"), "defaults")
+    assert "#SBATCH --time=2-00:00:00" in run and "#SBATCH --time=00:30:00" in reduce
+    assert "#SBATCH --partition=long" in run and "#SBATCH --partition=long" in reduce   # the run's unless given
+    assert not any(line.startswith("#SBATCH --mem") for line in run + reduce)
+    run, reduce = headers(JobOptions(ntasks=8, time="2-00:00:00", partition="long", mem="4G", reduce_time="10",
+                                     reduce_partition="short", reduce_mem="16G"), "own")
+    assert "#SBATCH --mem=4G" in run and "#SBATCH --mem=16G" in reduce
+    assert "#SBATCH --time=10" in reduce and "#SBATCH --partition=short" in reduce
+    assert "#SBATCH --partition=long" in run and "#SBATCH --time=2-00:00:00" in run
+    for opt in (JobOptions(mem="4 GB"), JobOptions(reduce_mem="-1"), JobOptions(reduce_time="1h"),
+                JobOptions(reduce_partition="a b")):
+        with pytest.raises(SlurmError):
+            render(cfg, opt, tmp_path / "bad")
+    res = slurm_cli(tmp_path / "tiny.toml", "--ntasks", 2, "--time", 30, "--reduce-mem", "lots", cwd=tmp_path)
+    assert res.returncode == 2
+    assert res.stderr.strip() == "error: --reduce-mem must be a Slurm memory size like 4G, 500M or 2000, got 'lots'"
+
+
+def test_the_command_and_the_scripts_name_the_mpi_the_nodes_need(tmp_path):
+    problem, mpi = python_stack(sys.executable)
+    assert problem is None and mpi.startswith(environment.mpi_line().removeprefix("mpi: "))
+    res = slurm_cli(tiny_config(tmp_path / "tiny.toml"), "--ntasks", 2, "--time", 30, cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    notes = [line for line in res.stdout.splitlines() if line.startswith("note: ") and mpi in line]
+    assert len(notes) == 1, res.stdout
+    assert "the nodes need" in notes[0]
+    for script in ("requeue.sbatch", "reduce.sbatch"):
+        text = (tmp_path / "slurm-tiny" / script).read_text()
+        assert f"# built against: {mpi}\n" in text and "the nodes need that same MPI" in (
+            (tmp_path / "slurm-tiny" / "requeue.sbatch").read_text())
+
+
 # ---------------------------------------------------------------- a real Slurm (slow)
 
 def _free_ports(n):
@@ -187,8 +253,8 @@ class Cluster:
         self.conf = base / "slurm.conf"
         self.procs = []
         self.env = dict(os.environ, SLURM_CONF=str(self.conf), TMPDIR=str(base / "tmp"))
-        # jobs get the submitting environment: keep numba's cache job-local (the template's
-        # default under $TMPDIR) instead of the one the test session may have exported
+        # jobs get the submitting environment: without a NUMBA_CACHE_DIR of the session's they
+        # take the package's own cache, as a user's jobs do (ensemble/kernel_cache.py)
         self.env.pop("NUMBA_CACHE_DIR", None)
 
     def write_config(self):
