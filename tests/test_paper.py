@@ -112,9 +112,9 @@ def test_reduced_run_is_labelled_and_warned(reduced):
         assert rows[claim.statement].startswith("not computed: needs points with b = "), rows[claim.statement]
 
 
-def test_bad_input_is_one_line_naming_the_file(reduced, tmp_path):
+def test_bad_input_is_one_line_naming_the_file(tmp_path):
     for path, words in ((tmp_path / "missing.summary.h5", "missing.summary.h5"),
-                        (reduced / "cat.h5", "cat.h5")):
+                        (ROOT / "examples/small.toml", "small.toml")):
         res = run_analysis("paper", path)
         assert res.returncode == 1 and not res.stdout, res
         lines = res.stderr.strip().splitlines()
