@@ -79,9 +79,11 @@ def _resume_config(args):
     path = str(args.catalog).removesuffix(".partial")
     partial = partial_path(path)
     if not os.path.exists(partial):
-        if args.set and os.path.exists(path):
+        if not os.path.exists(path):
+            return None, path, None
+        _, _, attrs = read_tasks(path)     # (verified: a damaged catalog is not called complete)
+        if args.set:
             # a finished catalog: nothing to go on with, and nothing to change
-            _, _, attrs = read_tasks(path)
             for text in args.set:
                 parse_override(text)
             loads(attrs["config"], args.set, source=f"the config stored in {path}")

@@ -190,3 +190,23 @@ def fail_spin_up(point, after_events=1):
 def main(argv):
     from ensemble.cli import main as cli_main
     sys.exit(cli_main(argv))
+
+
+def fail_in(rank, target, exception=RuntimeError):
+    """Raise `exception("injected failure in TARGET")` on MPI rank `rank` (-1: any) when `target` ("module:Class.method"
+    or "module:function", in the package) is called: a step of a collective path that fails on one rank."""
+    import importlib
+
+    from mpi4py import MPI
+    module_name, attr = target.split(":")
+    owner = importlib.import_module(module_name)
+    *path, name = attr.split(".")
+    for part in path:
+        owner = getattr(owner, part)
+    original = getattr(owner, name)
+
+    def patched(*args, **kwargs):
+        if rank in (-1, MPI.COMM_WORLD.Get_rank()):     # -1: whichever rank calls it
+            raise exception(f"injected failure in {target}")
+        return original(*args, **kwargs)
+    setattr(owner, name, patched)

@@ -1,0 +1,406 @@
+"""Attacks at the edges, repeatable: full disks under MPI, file-size limits, damaged tables and config,
+collective steps failing on one rank, and inputs nobody meant. Each attack says what must hold.
+
+    python tests/attack.py              # every attack; a table of held / FAILED / skipped; exit 1 if any failed
+    python tests/attack.py flip mpi     # those whose name contains one of the words
+
+tests/test_attacks.py runs each attack as a test (the suite and CI); .ci/run also runs this script for
+the table. The tmpfs attacks need root (mount); elsewhere they are skipped, saying so. Every command
+runs under a deadline (tests/processes.py): a hang is a failure, not a stuck suite.
+"""
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+import h5py  # noqa: E402
+import numpy as np  # noqa: E402
+
+from ensemble import catalog, lock  # noqa: E402
+from tests.processes import child_env, run_bounded, wait_for  # noqa: E402
+
+DEADLINE = 120        # seconds for any command: what they take is a few (a hang fails the attack)
+QUICK = 30            # ... for a run that must end at once (a full disk, a failed collective step)
+MPIEXEC = shutil.which("mpiexec")
+CONFIG = """[model]
+N = 60
+b = 20.0
+[run]
+seeds = 2
+events = 60
+transient = 10
+[integrator]
+method = "rk4"
+dt = 1e-3
+[output]
+batch = 20
+flush_seconds = 1000.0
+"""
+
+
+class Skip(Exception):
+    """The attack cannot be made here (the reason says why)."""
+
+
+def _python(*argv, setup=None, ranks=None, shell_prefix=None, timeout=DEADLINE):
+    """`python -m ensemble|analysis ...` (argv[0] names the package), after `setup` (tests.inject code), under
+    mpiexec -n ranks if given, after a shell prefix (e.g. 'ulimit -f 100')."""
+    package, *args = [str(a) for a in argv]
+    if setup is None:
+        cmd = [sys.executable, "-m", package, *args]
+    else:
+        main = "inject.main" if package == "ensemble" else "__import__('analysis.cli').cli.main"
+        cmd = [sys.executable, "-c", f"import sys; sys.path.insert(0, {str(ROOT)!r}); from tests import inject; "
+                                     f"{setup}; sys.exit({main}({args!r}) or 0)"]
+    if ranks:
+        if MPIEXEC is None:
+            raise Skip("mpiexec not found")
+        cmd = [MPIEXEC, "-n", str(ranks), *cmd]
+    if shell_prefix:
+        cmd = ["bash", "-c", f"{shell_prefix}; exec \"$@\"", "bash", *cmd]
+    return run_bounded(cmd, timeout, env=child_env())
+
+
+def _errors(res):
+    """stderr's lines but the process manager's own (MPICH prints one per aborted rank)."""
+    return [line for line in res.stderr.strip().splitlines()
+            if line and not line.startswith(("Abort(", "[unset]", "application called MPI_Abort"))]
+
+
+def one_line(res, codes=(1, 2), *words):
+    lines = _errors(res)
+    assert res.returncode in codes, f"exit {res.returncode} (wanted {codes}): {res.stderr[-1500:]}"
+    assert len(lines) == 1, f"{len(lines)} lines on stderr, not one: {res.stderr[-1500:]}"
+    for word in words:
+        assert word in lines[0], f"{word!r} not in {lines[0]!r}"
+    return lines[0]
+
+
+def nothing_left(folder, name):
+    left = [p.name for p in Path(folder).iterdir() if p.name.startswith(name)]
+    assert not left, f"left behind: {left}"
+
+
+class Workshop:
+    """A folder with the config, a finished catalog and an interrupted one (made once, copied per attack)."""
+
+    def __init__(self, root):
+        self.root = Path(root)
+        self.cfg = self.root / "cfg.toml"
+        self.cfg.write_text(CONFIG)
+        self.full = self.root / "full.h5"
+        res = _python("ensemble", "run", self.cfg, "-o", self.full)
+        assert res.returncode == 0, res.stderr
+        self.crashed = self.root / "crashed.h5"
+        res = _python("ensemble", "run", self.cfg, "-o", self.crashed, setup="inject.crash_at_write(60)")
+        assert res.returncode == 99, res.stderr
+
+    def copy(self, which, name):
+        """A copy of the finished ('full') or interrupted ('crashed': its .partial) catalog; its final path."""
+        dest = self.root / name
+        source = self.full if which == "full" else catalog.partial_path(self.crashed)
+        shutil.copy(source, dest if which == "full" else catalog.partial_path(dest))
+        return dest
+
+
+def _mount_tmpfs(size):
+    mount = Path(tempfile.mkdtemp(prefix="attack-disk-"))
+    res = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(mount)],
+                         capture_output=True, text=True)
+    if res.returncode != 0:
+        mount.rmdir()
+        raise Skip(f"cannot mount a small tmpfs here, which needs root ({res.stderr.strip()})")
+    return mount
+
+
+def _unmount(mount):
+    subprocess.run(["umount", "-l", str(mount)], capture_output=True)
+    mount.rmdir()
+
+
+def _flip(path, dataset, index=0, byte=3):
+    """Flip one byte of element `index` of a contiguous dataset, in the file's bytes."""
+    with h5py.File(path, "r") as h5:
+        ds = h5[dataset]
+        if ds.id.get_offset() is None:
+            raise Skip(f"/{dataset} has no bytes in the file (never written: HDF5 allocates at the first write)")
+        offset = ds.id.get_offset() + index * ds.dtype.itemsize + min(byte, ds.dtype.itemsize - 1)
+    with open(path, "r+b") as fh:
+        fh.seek(offset)
+        old = fh.read(1)[0]
+        fh.seek(offset)
+        fh.write(bytes([old ^ 0x10]))
+
+
+def _replace_bytes(path, old, new):
+    data = Path(path).read_bytes()
+    assert data.count(old) == 1, f"{old!r} found {data.count(old)} times"
+    Path(path).write_bytes(data.replace(old, new))
+
+
+# -- the attacks: name -> function(workshop) ----------------------------------------------------------
+
+def full_disk_under_mpi(writer):
+    def attack(w):
+        mount = _mount_tmpfs("2m")
+        try:
+            start = time.monotonic()
+            res = _python("ensemble", "run", w.cfg, "-o", mount / "p.h5", "--set", "run.events=20000",
+                          "--set", f'output.writer="{writer}"', ranks=2, timeout=QUICK)
+            one_line(res, (1, 2), "No space left on device")
+            nothing_left(mount, "p.h5")       # no lock, no .partial
+            assert time.monotonic() - start < QUICK
+            res = _python("ensemble", "resume", mount / "p.h5")
+            one_line(res, (2,), "no interrupted run")
+        finally:
+            _unmount(mount)
+    return attack
+
+
+def full_disk_inside_hdf5_under_mpi(writer):
+    """The check before creation bypassed (space taken by another process meanwhile): HDF5 itself fails to
+    write while the ranks are inside its collective create. All ranks leave; the file is removed."""
+    def attack(w):
+        mount = _mount_tmpfs("2m")
+        try:
+            res = _python("ensemble", "run", w.cfg, "-o", mount / "p.h5", "--set", "model.N=5000",
+                          "--set", "run.seeds=50", "--set", "run.events=10", "--set", f'output.writer="{writer}"',
+                          setup="from ensemble import space; space.check_fits = lambda path, nbytes: None",
+                          ranks=2, timeout=QUICK)
+            one_line(res, (1,), "cannot create catalog")
+            left = [p.name for p in mount.iterdir()]
+            assert "p.h5.partial" not in left and "p.h5" not in left, left
+        finally:
+            _unmount(mount)
+    return attack
+
+
+def file_size_limit(ranks, writer):
+    def attack(w):
+        out = w.root / f"big-{ranks}-{writer}.h5"
+        res = _python("ensemble", "run", w.cfg, "-o", out, "--set", "run.events=1000000",
+                      "--set", f'output.writer="{writer}"', ranks=ranks, shell_prefix="ulimit -f 50000",
+                      timeout=QUICK)
+        one_line(res, (1,), "ulimit -f")   # (MPI's own files need more than a few MB: 50 MB)
+        nothing_left(w.root, out.name)
+    return attack
+
+
+# every /tasks dataset; flipped in a finished catalog, each read refuses naming the task or the tables
+TASK_DATASETS = ("point", "seed_index", "N", "l", "nu", "a", "b", "c", "alpha", "sigma", "law", "events_written",
+                 "rank", "wall_time", "events_per_second", "seed_entropy", "spawn_key", "status", "error",
+                 "integrator", "branch_of", "record_crc")
+
+
+def flipped_table(name):
+    def attack(w):
+        bad = w.copy("full", f"flip-{name}.h5")
+        _flip(bad, f"tasks/{name}")
+        try:
+            catalog.read_tasks(bad)
+        except catalog.CatalogError as err:
+            assert "damaged" in str(err) or "corrupt" in str(err), err
+        else:
+            raise AssertionError(f"a flipped byte in /tasks/{name} was read without a word")
+    return attack
+
+
+def flipped_table_every_command(name):
+    """reduce, export and status each say it in one line; a resume of a .partial so damaged too."""
+    def attack(w):
+        bad = w.copy("full", f"cmd-{name}.h5")
+        _flip(bad, f"tasks/{name}")
+        one_line(_python("ensemble", "status", bad), (1,), str(bad))
+        one_line(_python("analysis", "reduce", bad, "-o", w.root / f"cmd-{name}.summary.h5"), (1,), str(bad))
+        one_line(_python("analysis", "export", bad, "-o", w.root / f"cmd-{name}-export"), (1,), str(bad))
+        part = w.copy("crashed", f"res-{name}.h5")
+        try:
+            _flip(catalog.partial_path(part), f"tasks/{name}")
+        except Skip:
+            return      # (not written yet in the interrupted run)
+        res = _python("ensemble", "resume", part)
+        if name in ("status", "wall_time"):      # a task's record: the task is rerun, the catalog completes
+            assert res.returncode == 0 and "rerun from its start" in res.stderr, res.stderr
+            a, _, _ = catalog.read(part)
+            b, _, _ = catalog.read(w.full)
+            for column in catalog.EVENT_FIELDS:
+                np.testing.assert_array_equal(a[column], b[column], err_msg=column)
+        else:
+            one_line(res, (1,), "damaged")
+    return attack
+
+
+def changed_config(where):
+    """One changed byte in the stored config ("b = 20.0" -> "b = 30.0"): every command refuses."""
+    def attack(w):
+        bad = w.copy(where, f"config-{where}.h5")
+        path = bad if where == "full" else catalog.partial_path(bad)
+        _replace_bytes(path, b"b = 20.0", b"b = 30.0")
+        one_line(_python("ensemble", "status", bad), (1,), "stored config")
+        one_line(_python("ensemble", "resume", bad), (1, 2))
+        args = ["--partial"] if where == "crashed" else []
+        one_line(_python("analysis", "reduce", path, "-o", w.root / f"config-{where}.s.h5", *args), (1,))
+        one_line(_python("analysis", "export", path, "-o", w.root / f"config-{where}-x", *args), (1,))
+    return attack
+
+
+def status_of_an_unknown_code(w):
+    bad = w.copy("full", "code.h5")
+    with h5py.File(bad, "r+") as h5:
+        h5["tasks/status"][0] = 7
+    one_line(_python("ensemble", "status", bad), (1,), "status code 7")
+
+
+def resume_of_a_finished_catalog_with_set(w):
+    for change in ("model.b=30", "garbage"):
+        one_line(_python("ensemble", "resume", w.full, "--set", change), (2,))
+
+
+def empty_config(w):
+    empty = w.root / "empty.toml"
+    empty.write_text("# nothing\n")
+    for path in (empty, "/dev/null"):
+        one_line(_python("ensemble", "run", path, "-o", w.root / "e.h5"), (2,), "empty config")
+    nothing_left(w.root, "e.h5")
+
+
+def output_is_the_config(w):
+    before = w.cfg.read_bytes()
+    for extra in ([], ["--force"]):
+        one_line(_python("ensemble", "run", w.cfg, "-o", w.cfg, *extra), (2,), "input")
+    assert w.cfg.read_bytes() == before
+
+
+def force_replaces_only_a_catalog(w):
+    notes = w.root / "notes.txt"
+    notes.write_text("mine\n")
+    one_line(_python("ensemble", "run", w.cfg, "-o", notes, "--force"), (2,), "replaces only an event catalog")
+    assert notes.read_text() == "mine\n"
+
+
+def absurd_values(w):
+    for key, value in (("model.nu", "1e100"), ("run.transient", "1000000000000000000"), ("model.N", "10000000"),
+                       ("sweep.b", "[20, 20]"), ("sweep.b", "20,40"), ("output.batch", "1000000000")):
+        one_line(_python("ensemble", "validate", w.cfg, "--set", f"{key}={value}"), (2,), key)
+
+
+def byte_order_mark(w):
+    bom = w.root / "bom.toml"
+    bom.write_bytes(b"\xef\xbb\xbf" + CONFIG.encode())
+    res = _python("ensemble", "validate", bom)
+    assert res.returncode == 0 and "N = 60" in res.stdout, res.stderr
+
+
+def output_name_not_utf8(w):
+    folder = w.root / os.fsdecode(b"d\xff")
+    folder.mkdir(exist_ok=True)
+    one_line(_python("ensemble", "run", w.cfg, "-o", folder / "a.h5"), (2,), "UTF-8")
+    nothing_left(folder, "a.h5")
+    one_line(_python("analysis", "reduce", w.full, "-o", folder / "s.h5"), (2,), "UTF-8")
+
+
+def missing_folder(w):
+    one_line(_python("ensemble", "run", w.cfg, "-o", w.root / "nowhere" / "x.h5"), (2,), "nowhere")
+
+
+def bad_analysis_numbers(w):
+    for option, value in (("--mu-c", "nan"), ("--mu-c", "inf"), ("--b-cut", "nan"),
+                          ("--tnu-bins", "0:1e308:10000000000")):
+        one_line(_python("analysis", "reduce", w.full, "-o", w.root / "n.h5", f"{option}={value}"), (2,), option)
+
+
+def export_of_an_unfinished_run(w):
+    part = w.copy("crashed", "unfinished.h5")
+    one_line(_python("analysis", "export", catalog.partial_path(part), "-o", w.root / "unfinished"), (1, 2),
+             "--partial")
+
+
+def one_rank_fails(target, rank, writer="auto", branch=False):
+    """A step of a collective path fails on one rank: every rank leaves, at once, with a non-zero exit."""
+    def attack(w):
+        out = w.root / f"one-{target.replace(':', '-')}-{rank}.h5"
+        extra = ["--set", "run.branch=true", "--set", "run.seeds=2"] if branch else []
+        res = _python("ensemble", "run", w.cfg, "-o", out, "--set", f'output.writer="{writer}"', *extra,
+                      setup=f"inject.fail_in({rank}, {target!r})", ranks=2, timeout=QUICK)
+        assert res.returncode != 0, res.stdout + res.stderr
+        assert "injected failure" in res.stderr, res.stderr
+        # rank 0, killed by the abort, leaves its lock to be taken over (dead pid) once the process is gone
+        wait_for(lambda: not lock.is_held(out), 10, "the lock of the aborted run released")
+    return attack
+
+
+ATTACKS = {
+    "full disk, mpi, parallel writer": full_disk_under_mpi("parallel"),
+    "full disk, mpi, rank0 writer": full_disk_under_mpi("rank0"),
+    "full disk inside HDF5, mpi, parallel writer": full_disk_inside_hdf5_under_mpi("parallel"),
+    "full disk inside HDF5, mpi, rank0 writer": full_disk_inside_hdf5_under_mpi("rank0"),
+    "ulimit -f, serial": file_size_limit(None, "auto"),
+    "ulimit -f, mpi, parallel writer": file_size_limit(2, "parallel"),
+    "ulimit -f, mpi, rank0 writer": file_size_limit(2, "rank0"),
+    **{f"flip /tasks/{name}": flipped_table(name) for name in TASK_DATASETS},
+    **{f"flip /tasks/{name}, every command": flipped_table_every_command(name) for name in ("b", "status", "wall_time")},
+    "changed stored config, finished": changed_config("full"),
+    "changed stored config, partial": changed_config("crashed"),
+    "status of an unknown status code": status_of_an_unknown_code,
+    "resume of a finished catalog with --set": resume_of_a_finished_catalog_with_set,
+    "empty config and /dev/null": empty_config,
+    "output is the config": output_is_the_config,
+    "run --force replaces only a catalog": force_replaces_only_a_catalog,
+    "absurd values": absurd_values,
+    "config with a byte-order mark": byte_order_mark,
+    "output name not UTF-8": output_name_not_utf8,
+    "output folder missing": missing_folder,
+    "non-finite and huge analysis options": bad_analysis_numbers,
+    "export of an unfinished run": export_of_an_unfinished_run,
+    **{f"mpi: {target} fails on rank {rank} ({writer})": one_rank_fails(target, rank, writer)
+       for target, rank, writer in (
+           ("ensemble.catalog:_Layout.create", 1, "parallel"),
+           ("ensemble.catalog:_reserve_space", 0, "parallel"),
+           ("ensemble.catalog:_Layout.create", 0, "rank0"),
+           ("ensemble.parallel:Coordinator.__init__", 1, "parallel"),
+           ("ensemble.catalog:ParallelWriter.close", 1, "parallel"),
+           ("ensemble.catalog:Rank0Writer.close", 1, "rank0"),
+           ("ensemble.parallel:Coordinator.close", 0, "parallel"),
+           ("ensemble.runner:_compile_kernels", 1, "parallel"))},
+    "mpi: a spin-up fails on the rank that takes it (run.branch)": one_rank_fails(
+        "ensemble.runner:TaskRunner.spin_up", -1, "parallel", branch=True),
+}
+
+
+def main(words):
+    chosen = {name: fn for name, fn in ATTACKS.items() if not words or any(w in name for w in words)}
+    results = []
+    with tempfile.TemporaryDirectory(prefix="attack-") as tmp:
+        workshop = Workshop(tmp)
+        for name, attack in chosen.items():
+            start = time.monotonic()
+            try:
+                attack(workshop)
+                outcome, detail = "held", ""
+            except Skip as why:
+                outcome, detail = "skipped", str(why)
+            except KeyboardInterrupt:
+                raise
+            except BaseException as err:  # noqa: BLE001 - a report, not a guard (pytest.fail too): every failure is listed
+                lines = [line for line in str(err).splitlines() if line.strip()]
+                outcome, detail = "FAILED", f"{type(err).__name__}: {' / '.join(lines[:1] + lines[-3:])}"
+            results.append((name, outcome, time.monotonic() - start, detail))
+            print(f"{outcome:8s} {results[-1][2]:5.1f} s  {name}" + (f"  ({detail})" if detail else ""), flush=True)
+    width = max(len(name) for name, *_ in results)
+    print(f"\n| {'attack':{width}s} | outcome | s |\n|{'-' * (width + 2)}|---------|---|")
+    for name, outcome, seconds, _ in results:
+        print(f"| {name:{width}s} | {outcome:7s} | {seconds:.0f} |")
+    failed = sum(outcome == "FAILED" for _, outcome, _, _ in results)
+    print(f"\n{len(results) - failed} of {len(results)} held or skipped; {failed} failed")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
