@@ -25,6 +25,7 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
+from . import checks
 from .config import Config, load, replace
 
 TEMPLATES = Path(__file__).resolve().parents[1] / "jobs"
@@ -198,11 +199,14 @@ def _check(opt):
         raise SlurmError(f"--kind must be one of {', '.join(KINDS)}, got {opt.kind!r}")
     if opt.launcher not in ("srun", "mpiexec"):
         raise SlurmError(f"--launcher must be srun or mpiexec, got {opt.launcher!r}")
-    for name in ("ntasks", "cpus_per_task", "reduce_ntasks"):
-        if getattr(opt, name) < 1:
-            raise SlurmError(f"--{name.replace('_', '-')} must be >= 1, got {getattr(opt, name)}")
-    if opt.max_requeues < 0 or opt.array_limit < 0:
-        raise SlurmError("--max-requeues and --array-limit must be >= 0")
+    # (checks.py: the one validator of every command's numeric options)
+    sizes = {"ntasks": (1, 10 ** 7), "cpus_per_task": (1, 10 ** 4), "reduce_ntasks": (1, 10 ** 7),
+             "max_requeues": (0, 10 ** 4), "array_limit": (0, 10 ** 7)}
+    try:
+        for name, (lo, hi) in sizes.items():
+            checks.count(f"--{name.replace('_', '-')}", getattr(opt, name), lo, hi)
+    except checks.UsageError as err:
+        raise SlurmError(str(err)) from None
     for word in (opt.partition, opt.reduce_partition, opt.account, opt.job_name, opt.srun_mpi):
         if word and not SAFE_PATH.fullmatch(word):
             raise SlurmError(f"{word!r}: not a valid Slurm name")
