@@ -130,7 +130,7 @@ def _parser():
     cp.add_argument("--bootstrap", default=1000, help="bootstrap resamples (default 1000)")
     cp.add_argument("--level", default=0.95, help="interval coverage (default 0.95)")
     cp.add_argument("--blocks", default=20, help="stretches per task when a point has fewer "
-                                                           "than 10 seeds (default 20)")
+                                                 "than 10 seeds (default 20)")
     cp.add_argument("--seed", default=0, help="bootstrap seed (default 0)")
     cp.add_argument("--force", action="store_true", help="overwrite an existing comparison")
     return p
