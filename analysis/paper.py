@@ -13,19 +13,22 @@ units (stats.bootstrap, seed 0). A number that cannot be computed says why inste
 
 The output is labelled "full size" when every point rests on at least PAPER_EVENTS events (the
 paper's one trajectory per point), else "reduced"; a run that discarded fewer events than the
-longest transient measured is warned about.
+longest transient measured is warned about. A reduced run's points that the committed full-size
+panels (docs/paper) also have are set beside them, number by number: is the full size's value
+inside this run's interval?
 """
 import tomllib
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Callable
 
 import numpy as np
 
 from ensemble.config import TRANSIENT_PER_BLOCK
 
-from . import stats
+from . import stats, summary
 from .reduce import PARAMS
-from .report import count_text, events_per_point, level_text, partial_text, point_label, size_text
+from .report import LABELS, count_text, events_per_point, level_text, partial_text, point_label, size_text
 
 PAPER_EVENTS = 200_000      # events the paper recorded per point (one trajectory, N = 800) ...
 PAPER_TRANSIENT = 10_000    # ... after discarding these
@@ -33,6 +36,14 @@ PAPER_TRANSIENT = 10_000    # ... after discarding these
 # events; benchmarks/results/transient.txt, docs/benchmarks.md); the default run.transient is
 # TRANSIENT_PER_BLOCK = 8x this
 MEASURED_TRANSIENT_PER_BLOCK = 1.25
+
+# the committed full-size panels (docs/paper.md), in the order whose claims read their own panel;
+# a reduced run's numbers are set beside theirs
+FULL_SIZE = Path(__file__).resolve().parents[1] / "docs" / "paper"
+PANELS = ("fig1_b", "fig1_a", "fig1_c", "fig2", "large_b")
+# numbers whose value does not depend on the trajectory's length (not mean T nu: a short trajectory
+# never sees the long recurrence times, so its mean is lower; docs/paper.md)
+COMPARED = ("fraction_large", "gr_b", "ks_gr")
 
 RESAMPLES = 1000
 PEAK_FROM = 3.5            # the large-magnitude peak: the maximum of R(mu) for mu >= PEAK_FROM
@@ -275,8 +286,61 @@ def size_lines(summaries, names):
     return lines
 
 
-def text(summaries, names):
-    """Everything `analysis paper` prints."""
+def full_size_panels(directory=FULL_SIZE):
+    """[(path, summary)] of the committed full-size panels ([] where they are not: outside a
+    source checkout)."""
+    paths = [Path(directory) / f"{name}.summary.h5" for name in PANELS]
+    return [(path, summary.read(path)) for path in paths if path.exists()]
+
+
+def _short(path):
+    """A summary's file name without .summary.h5."""
+    return Path(str(path)).name.removesuffix(".h5").removesuffix(".summary")
+
+
+def _same_point(s, i, r, j):
+    return all(np.array_equal(s[f"points/{k}"][i], r[f"points/{k}"][j], equal_nan=True) for k in PARAMS)
+
+
+def against_full_size(summaries, names, reference):
+    """A Markdown table: for every point of a reduced summary that a full-size panel (`reference`,
+    [(path, summary)], the first that has it) also has, with the same options, each of COMPARED
+    with this run's interval, the full size's, and whether the full size's estimate lies inside
+    this run's interval. "" when there is nothing to compare."""
+    rows, inside = [], []
+    options = ("mu_c", "window", "b_cut")
+    for s, name in zip(summaries, names):
+        if (events_per_point(s) >= PAPER_EVENTS).all():
+            continue
+        for i in range(len(s["points/N"])):
+            found = [(path, r, j) for path, r in reference for j in range(len(r["points/N"]))
+                     if _same_point(s, i, r, j) and all(s["attrs"][o] == r["attrs"][o] for o in options)]
+            if not found:
+                continue
+            path, r, j = found[0]
+            for key in COMPARED:
+                est, lo, hi = s[f"points/numbers/{key}"][i]
+                full = r[f"points/numbers/{key}"][j]
+                verdict = "yes" if lo <= full[0] <= hi else "no" if np.isfinite([lo, hi]).all() else "-"
+                inside.append(verdict)
+                rows.append(f"| {point_label(s, i)} ({_short(name)}) | {LABELS[key]} | "
+                            f"{with_interval((est, lo, hi))} | {with_interval(full)} ({_short(path)}) | "
+                            f"{verdict} |")
+    if not rows:
+        return ""
+    judged = [v for v in inside if v != "-"]
+    return "\n".join(
+        ["Against the full size (docs/paper; the same point and options): is the full size's value inside "
+         "this run's interval?", "",
+         "| point | number | this run | full size | inside |", "|---|---|---|---|---|", *rows, "",
+         f"{judged.count('yes')} of {len(judged)} inside (about {level_text(summaries[0]['attrs']['level'])} "
+         "expected if the runs differ only in length and the intervals are right; the KS intervals are "
+         "about 1.6x too narrow: docs/paper.md)"])
+
+
+def text(summaries, names, reference=None):
+    """Everything `analysis paper` prints; reference: the full-size panels to compare a reduced
+    run with (default: the committed ones, full_size_panels())."""
     lines = ["The paper's claims (Ohmura & Kawamura, EPL 77, 69001, 2007) beside this code's numbers", ""]
     lines += size_lines(summaries, names)
     for s, name in zip(summaries, names):
@@ -284,4 +348,8 @@ def text(summaries, names):
             lines.append(f"warning: {name}: {partial_text(s)}")
         lines += transients(s, name)
     lines += ["", claims_table(summaries)]
+    if not is_full_size(summaries):
+        comparison = against_full_size(summaries, names, full_size_panels() if reference is None else reference)
+        if comparison:
+            lines += ["", comparison]
     return "\n".join(lines)

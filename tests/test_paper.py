@@ -98,7 +98,10 @@ def test_reduced_run_is_labelled_and_warned(reduced):
     assert (f"warning: {reduced / 'cat.h5'}: run.transient = 100 events at N = 800, shorter than the longest "
             "transient measured (1000 events") in out
     assert not re.search(r"\bnan\b", out, re.IGNORECASE), out
-    rows = dict(line.strip(" |").split(" | ", 1) for line in out.splitlines()[out.splitlines().index("|---|---|") + 1:])
+    lines = out.splitlines()
+    start = lines.index("|---|---|") + 1
+    claims = lines[start:start + len(paper.CLAIMS)]
+    rows = dict(line.strip(" |").split(" | ", 1) for line in claims)
     assert list(rows) == [claim.statement for claim in paper.CLAIMS]
     # the b = 20..50 claims are computed; 600 events leave bins of R(mu) empty and peaks unresolved,
     # which each number says in words where it has no interval
@@ -110,6 +113,35 @@ def test_reduced_run_is_labelled_and_warned(reduced):
     assert len(re.findall(r"\d \[0\.\d+, 0\.\d+\]", ks)) == 4, ks     # four KS distances with intervals
     for claim in (paper.CLAIMS[3], paper.CLAIMS[4], paper.CLAIMS[7]):
         assert rows[claim.statement].startswith("not computed: needs points with b = "), rows[claim.statement]
+
+
+def test_reduced_run_beside_the_full_size(reduced):
+    """Every point of the reduced run is in fig1_b's full-size panel: each compared number with
+    both intervals, and whether the full size's value is inside this run's interval."""
+    s = summary.read(reduced / "sum.h5")
+    out = paper.text([s], ["sum.h5"])
+    table = out[out.index("| point | number |"):].splitlines()
+    rows = [line.strip(" |").split(" | ") for line in table[2:] if line.startswith("| ")]
+    assert len(rows) == 4 * len(paper.COMPARED)
+    full = summary.read(DOCS / "fig1_b.summary.h5")
+    for k, (point, number, this, other, inside) in enumerate(rows):
+        i, key = divmod(k, len(paper.COMPARED))
+        key = paper.COMPARED[key]
+        est, lo, hi = s[f"points/numbers/{key}"][i]
+        ref = full[f"points/numbers/{key}"][i][0]       # fig1_b's points are in the same order, b = 20..50
+        assert point == f"b = {s['points/b'][i]:g} (sum)" and this == paper.with_interval((est, lo, hi))
+        assert other.startswith(f"{ref:.3g} [") and other.endswith("(fig1_b)")
+        assert inside == ("yes" if lo <= ref <= hi else "no")
+    assert out.rstrip().splitlines()[-1].startswith(f"{[r[4] for r in rows].count('yes')} of {len(rows)} inside")
+    # the full size's estimate decides, not its interval: an interval holding only the full size's
+    # lower end leaves the estimate outside
+    ref_est, ref_lo, _ = full["points/numbers/fraction_large"][0]
+    s["points/numbers/fraction_large"][0] = (ref_lo, ref_lo, ref_lo)
+    row = next(line for line in paper.text([s], ["sum.h5"]).splitlines() if line.startswith("| b = 20 (sum) | frac"))
+    assert ref_lo < ref_est and row.endswith("| no |"), row
+    # nothing to compare with: no such section; a full-size run: none either
+    assert "Against the full size" not in paper.text([s], ["sum.h5"], reference=[])
+    assert "Against the full size" not in paper.text([full], ["fig1_b"])
 
 
 def test_bad_input_is_one_line_naming_the_file(tmp_path):
