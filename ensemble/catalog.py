@@ -365,7 +365,6 @@ class _Layout:
             wrong.append("the root attributes events_per_task, transient, spinup")
         if wrong:
             raise CatalogError(f"{self.path}: damaged catalog: {', '.join(wrong)} disagree with its stored config")
-        self.run_seed = cfg.run.seed
 
     def record_row(self, task):
         """Task `task`'s record columns (tables.RECORD), its record_crc and events_written mirror."""
@@ -377,7 +376,7 @@ class _Layout:
         written = [] if head is None else [head.written] + [
             int(self.commit[task, slot, C_WRITTEN]) for slot in (1 - head.slot,) if any(self.commit[task, slot])]
         return tables.record_problems(task, self.record_row(task) if row is None else row, written,
-                                      self.per_task, self.run_seed)
+                                      self.per_task)
 
     def _seal(self, task):
         """The record's CRC, after every write of a record column (the last write of each)."""

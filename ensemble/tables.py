@@ -14,9 +14,9 @@ protects the rest, so that no damaged table can make a reader or a resume silent
   reruns that task from its start (a run killed between the record and its CRC leaves the same
   mismatch as a damaged byte, and rerunning is right in both cases).
 - **Consistency** (`record_problems`): the status code is known, an error text belongs to a failed task
-  only, a finished task has all its events committed and its provenance set (seed_entropy = run.seed,
-  spawn_key = its index), an unfinished one none, and the /tasks/events_written mirror equals one of
-  the task's commit rows.
+  only, a finished task has all its events committed and its provenance set (or, finished by a resume
+  after its last commit, none), an unfinished one none, and the /tasks/events_written mirror equals one
+  of the task's commit rows.
 """
 import numpy as np
 
@@ -101,7 +101,7 @@ def _equal_rows(a, b):
     return a == b
 
 
-def record_problems(task, row, commit_written, per_task, run_seed):
+def record_problems(task, row, commit_written, per_task):
     """What is wrong with task `task`'s record (row: {column: value}); commit_written: the events
     written by each of its valid commit rows (the one in use first), [] if none; '' if nothing."""
     status = int(row["status"])
@@ -118,7 +118,9 @@ def record_problems(task, row, commit_written, per_task, run_seed):
     finished = status == FINISHED
     if finished and (not commit_written or commit_written[0] != per_task):
         return f"finished with {commit_written[0] if commit_written else 0} of {per_task} events committed"
-    prov_set = (int(row["rank"]) >= 0, int(row["seed_entropy"]) == run_seed, int(row["spawn_key"]) == task,
+    # (the stream a task drew from is run.seed and its index when a run wrote it; a catalog put together from
+    # another's trajectories names theirs, which the reduction uses to refuse one trajectory counted twice)
+    prov_set = (int(row["rank"]) >= 0, int(row["seed_entropy"]) >= 0, int(row["spawn_key"]) >= 0,
                 np.isfinite(row["wall_time"]) and row["wall_time"] >= 0,
                 np.isfinite(row["events_per_second"]) and row["events_per_second"] >= 0)
     prov_unset = (int(row["rank"]) == -1, int(row["seed_entropy"]) == -1, int(row["spawn_key"]) == -1,

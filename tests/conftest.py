@@ -34,6 +34,7 @@ os.environ["PATH"] = os.path.dirname(sys.executable) + os.pathsep + os.environ.g
 # is one list to read. tests/test_quick_tier.py checks that every name exists and that every test
 # file is here or in NOT_QUICK, with the reason.
 QUICK = {
+    "test_attacks.py": ["test_a_flipped_parameter_table_and_record_are_refused"],
     "test_install.py": ["test_an_unknown_stack_is_an_error_naming_it", "test_a_module_system_prefix_in_hdf5_dir",
                         "test_every_entry_point_takes_the_packages_kernel_cache"],
     "test_onset.py": ["test_lambert_root_on_upper_branch", "test_onset_delay_matches_brute_force",

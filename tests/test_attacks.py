@@ -16,3 +16,9 @@ def test_attack_holds(workshop, name):
         attack.ATTACKS[name](workshop)
     except attack.Skip as why:
         pytest.skip(str(why))
+
+
+def test_a_flipped_parameter_table_and_record_are_refused(workshop):
+    """The quick tier's attack: a flipped byte in a parameter table and in a task's record, read in-process."""
+    for name in ("b", "status"):
+        attack.ATTACKS[f"flip /tasks/{name}"](workshop)
