@@ -22,3 +22,25 @@ def test_a_flipped_parameter_table_and_record_are_refused(workshop):
     """The quick tier's attack: a flipped byte in a parameter table and in a task's record, read in-process."""
     for name in ("b", "status"):
         attack.ATTACKS[f"flip /tasks/{name}"](workshop)
+
+
+@pytest.mark.parametrize("sets", [["run.events=20000"], ["model.N=5000", "run.seeds=50", "run.events=10"],
+                                  ["model.N=10", "run.seeds=2000", "run.events=1"],
+                                  ["run.branch=true", "run.seeds=3", "sweep.b=[20, 30, 40]", "run.events=100"]])
+def test_the_size_checked_before_creation_bounds_the_catalog(tmp_path, sets):
+    """space.check_fits asks for catalog.estimate_bytes: it must not be below the file HDF5 makes (then a
+    disk that passed the check could still fill inside HDF5's collective create), nor far above it."""
+    import os
+
+    import h5py
+
+    from ensemble import catalog
+    from ensemble.config import load
+    from ensemble.tasks import task_list
+    cfg = load(attack.ROOT / "examples" / "small.toml", sets)
+    tasks = task_list(cfg)
+    path = tmp_path / "c.h5"
+    with h5py.File(path, "w") as h5:
+        catalog._Layout.create(h5, cfg, tasks, "method = 'ark4'", "software")
+    actual, estimate = os.path.getsize(path), catalog.estimate_bytes(cfg, tasks)
+    assert actual <= estimate <= 1.5 * actual + 2 ** 20, (actual, estimate)
