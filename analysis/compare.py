@@ -219,6 +219,15 @@ def label(law, params):
     return f"{law}: " + ", ".join(f"{k} = {params[k]:g}" for k in keys)
 
 
+def _check_memory(opt, n_tasks, n_blocks):
+    """Refuse options whose arrays this machine cannot hold (checks.memory): a point's stretches
+    of counts per n and per mu bin, and each resample's picks and numbers."""
+    units = n_tasks * opt.blocks
+    n_bytes = 8 * units * (n_blocks + 1 + len(MU_EDGES)) + 8 * opt.bootstrap * (units + len(MU_EDGES) + 2 * n_blocks)
+    checks.memory(f"--blocks {opt.blocks} and --bootstrap {opt.bootstrap} over {n_tasks} tasks of {n_blocks} blocks",
+                  n_bytes)
+
+
 def compare(paths, opt):
     """Every point of the catalogs compared: a list of dicts (compare_point's, with law, params, label)."""
     if opt.n_large < 2 or opt.n_min < 1 or opt.n_min >= opt.n_large - 1:
@@ -226,10 +235,8 @@ def compare(paths, opt):
     if not (0 < opt.level < 1) or opt.bootstrap < 1 or opt.blocks < 1 or opt.window < 0:
         raise checks.UsageError("--level must be in (0, 1); --bootstrap, --blocks >= 1; --window >= 0")
     inputs = merge.read(paths)
-    for params, rows in inputs.points:   # a point's (units, N + 1) counts per n and its resamples' picks
-        checks.memory(f"--blocks {opt.blocks} and --bootstrap {opt.bootstrap} over {len(rows)} tasks of "
-                      f"{int(params['N'])} blocks", 8 * len(rows) * opt.blocks * (int(params["N"]) + 1 + len(MU_EDGES))
-                      + 8 * opt.bootstrap * (len(rows) * opt.blocks + len(MU_EDGES) + 2 * int(params["N"])))
+    for params, rows in inputs.points:
+        _check_memory(opt, len(rows), int(params["N"]))
     out = []
     for params, rows in inputs.points:
         law = inputs.tasks["law"][rows[0]]

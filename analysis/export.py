@@ -435,14 +435,14 @@ def write(source, directory, fmt="csv", force=False, chunk=catalog.READ_CHUNK, p
             checks.output(path, inputs=[source], force=force, what="table")
     tables, settings = _tables(source, names, chunk, partial)
     os.makedirs(directory, exist_ok=True)
-    partial = [p + ".partial" for p in paths]
+    beside = [p + ".partial" for p in paths]
     try:
-        for name, tmp in zip(names, partial):
+        for name, tmp in zip(names, beside):
             writer(tmp, name, tables[name], source, settings)
-        for tmp, path in zip(partial, paths):
+        for tmp, path in zip(beside, paths):
             os.replace(tmp, path)
     finally:
-        for tmp in partial:
+        for tmp in beside:
             if os.path.exists(tmp):
                 os.remove(tmp)
     return paths
