@@ -271,7 +271,7 @@ class _Layout:
         sizes = 2 * (4 * self.record_blocks + 2)
         if (self.commit.shape != (n_records, 2, NCOMMIT) or len(self.offset) != n_records
                 or any(ds.shape[0] != n_tasks * self.per_task for ds in self.events.values())
-                or np.any(self.record_blocks < 2) or self.per_task < 1 or self.transient < 0
+                or np.any(self.record_blocks < 1) or self.per_task < 1 or self.transient < 0
                 or self.spinup_events < 0 or (self.spinup_events > 0) != bool(self.spinup)
                 or np.any(self.offset != np.concatenate([[0], np.cumsum(sizes)[:-1]]))
                 or self.state.shape[0] != int(sizes.sum())):

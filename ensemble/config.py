@@ -124,7 +124,7 @@ MAX_NU = 10.0
 
 _RULES = {
     # a rank holds about 500 bytes per block: 1e6 blocks are 0.5 GB (the paper: 800 and 1600)
-    ("model", "N"): (lambda x: 2 <= x <= MAX_BLOCKS, f"an integer in [2, {MAX_BLOCKS}] (a rank holds about 500 "
+    ("model", "N"): (lambda x: 1 <= x <= MAX_BLOCKS, f"an integer in [1, {MAX_BLOCKS}] (a rank holds about 500 "
                                                       f"bytes per block)"),
     ("model", "l"): (_positive, "> 0"),
     # the plate must be slow against slip, whose velocities are of order 1 in these units (the paper:

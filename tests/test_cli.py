@@ -147,7 +147,7 @@ def test_run_log_and_catalog_name_the_stack(small_run):
 
 @pytest.mark.parametrize("sections,key", [
     ({"model": {"N": 60, "bb": 1.0}}, "model.bb"),
-    ({"model": {"N": 1}}, "model.N"),
+    ({"model": {"N": 0}}, "model.N"),
     ({"model": {"N": 60, "nu": -1e-8}}, "model.nu"),
     ({"model": {"N": 60, "b": "big"}}, "model.b"),
     ({"run": {"events": 0}}, "run.events"),

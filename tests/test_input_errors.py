@@ -169,8 +169,8 @@ def test_loads_applies_overrides_like_load(files):
 
 
 def test_loads_names_its_source():
-    with pytest.raises(ConfigError, match=r"^the config stored in x\.h5: model\.N must be an integer in \[2, "):
-        loads("[model]\nN = 1\n", source="the config stored in x.h5")
+    with pytest.raises(ConfigError, match=r"^the config stored in x\.h5: model\.N must be an integer in \[1, "):
+        loads("[model]\nN = 0\n", source="the config stored in x.h5")
     with pytest.raises(ConfigError, match=r"^stored: not valid TOML"):
         loads("[model\n", source="stored")
     with pytest.raises(ConfigError, match=r"^--set expects section.key=value"):   # not the text's fault

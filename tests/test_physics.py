@@ -129,3 +129,23 @@ def test_kernel_agrees_with_independent_full_chain_reference():
     # is off by up to one step (measured 1.9e-5).
     np.testing.assert_allclose(ours.profile, ref["profile"], rtol=1e-8, atol=1e-9 * ours.slip)
     assert ours.duration == pytest.approx(ref["duration"], abs=3e-5)
+
+
+def test_a_single_block_runs_its_stick_slip_cycle(tmp_path):
+    """model.N = 1 (the first check a user makes): its only spring is the loader's. Above that stiffness
+    (b = 20 > 1) it runs a periodic stick-slip cycle, in which each event's slip equals the plate's
+    displacement nu T since the event before (nothing else can take up the load)."""
+    import sys
+
+    from ensemble import catalog
+
+    from .processes import child_env, run_bounded
+    cfg = tmp_path / "one.toml"
+    cfg.write_text("[model]\nN = 1\nb = 20.0\n[run]\nevents = 50\ntransient = 10\n")
+    res = run_bounded([sys.executable, "-m", "ensemble", "run", cfg, "-o", tmp_path / "one.h5"], 300, env=child_env())
+    assert res.returncode == 0, res.stderr
+    ev, tasks, _ = catalog.read(tmp_path / "one.h5")
+    assert len(ev["t"]) == 50 and np.all(ev["n_slipped"] == 1) and np.all(ev["boundary"])
+    interval = np.diff(ev["t"]) * 1e-8
+    np.testing.assert_allclose(ev["slip"][1:], interval, rtol=1e-5)
+    np.testing.assert_allclose(ev["slip"], ev["slip"][0], rtol=1e-5)     # periodic
