@@ -53,6 +53,9 @@ from .integrity import EventCrc, commit_crc, crc, event_problems
 from .tables import FAILED, FINISHED, OPEN, STATUS_NAMES
 
 FORMAT = "bk-catalog-4"
+# formats this version reads: bk-catalog-3 has the same layout without tables_crc and /tasks/record_crc
+# (its tables are checked against its config only); only FORMAT is written and resumed
+READABLE = {"bk-catalog-3", FORMAT}
 
 EVENT_FIELDS = {
     "task": np.int64, "t": np.float64, "epicenter": np.int64, "mu": np.float64,
@@ -278,6 +281,7 @@ class _Layout:
             raise CatalogError(f"{self.path}: damaged catalog (its datasets do not fit together)")
         self.n_tasks = n_tasks
         self.n_records = n_records
+        self.protected = h5.attrs.get("format") == FORMAT      # (bk-catalog-3: no tables_crc, no record_crc)
         self._verify_tables()
         self._crc = {}    # task -> EventCrc of its rows written so far (on the writing process)
         self._head = {}   # task -> Head in use (on the writing process)
@@ -349,13 +353,15 @@ class _Layout:
     def _verify_tables(self):
         """The tables fixed at creation against their checksum, and against the stored config."""
         stored = self.h5.attrs.get("tables_crc")
-        if stored is None or int(stored) != _fixed_digest(self.h5):
+        if self.protected and (stored is None or int(stored) != _fixed_digest(self.h5)):
             raise CatalogError(f"{self.path}: damaged catalog: its parameter tables or stored config fail "
                                f"their checksum (tables_crc); its events cannot be attributed, rerun")
         try:
             cfg = loads(self.h5.attrs["config"])
-        except ConfigError as err:
-            raise CatalogError(f"{self.path}: damaged catalog: its stored config is invalid ({err})") from None
+        except ConfigError:
+            # intact (its checksum holds) but not this version's: e.g. a friction law added in a copy of
+            # the package; its tables are protected by tables_crc alone
+            return
         tasks = task_list(cfg)
         spinups = spinup_points(cfg, tasks)
         wrong = tables.config_problems({name: ds[...] for name, ds in self.tasks.items()},
@@ -368,7 +374,8 @@ class _Layout:
 
     def record_row(self, task):
         """Task `task`'s record columns (tables.RECORD), its record_crc and events_written mirror."""
-        return {name: self.tasks[name][task] for name in (*tables.RECORD, "record_crc", "events_written")}
+        return {name: self.tasks[name][task] for name in (*tables.RECORD, "record_crc", "events_written")
+                if name in self.tasks}
 
     def record_problem(self, task, row=None):
         """What is wrong with a task's record (tables.record_problems), '' if nothing."""
@@ -376,7 +383,7 @@ class _Layout:
         written = [] if head is None else [head.written] + [
             int(self.commit[task, slot, C_WRITTEN]) for slot in (1 - head.slot,) if any(self.commit[task, slot])]
         return tables.record_problems(task, self.record_row(task) if row is None else row, written,
-                                      self.per_task)
+                                      self.per_task, checksummed=self.protected)
 
     def _seal(self, task):
         """The record's CRC, after every write of a record column (the last write of each)."""
@@ -560,11 +567,15 @@ class writing:
                            broken=True) from None
 
 
+_REWRITTEN = {*tables.RECORD, "record_crc", "events_written"}
+
+
 def _fixed_digest(h5):
     """CRC of everything fixed at a catalog's creation (tables.py): the parameter tables, /spinup,
     /checkpoint/offset and the root attributes."""
-    fixed = (*TASK_FIELDS, "law", "branch_of")
-    named = {f"tasks/{name}": h5["tasks"][name][...] for name in fixed if name in h5["tasks"]}
+    # every /tasks column but a task's record and the events_written mirror, which runs rewrite (also the
+    # columns of a law this version does not know)
+    named = {f"tasks/{name}": ds[...] for name, ds in h5["tasks"].items() if name not in _REWRITTEN}
     named.update({f"spinup/{name}": ds[...] for name, ds in h5["spinup"].items()} if "spinup" in h5 else {})
     named["checkpoint/offset"] = h5["checkpoint"]["offset"][...]
     named.update({f"@{name}": h5.attrs[name] for name in tables.FIXED_ATTRS if name in h5.attrs})
@@ -641,7 +652,7 @@ def _open_file(path, open_file):
         h5 = open_file(path, "r+")
     except OSError as err:
         raise CatalogError(f"{path}: cannot open catalog ({err})") from None
-    _check_format(h5, path)
+    _check_format(h5, path, writing=True)
     return h5
 
 
@@ -893,14 +904,18 @@ def choose_writer(name, comm):
 
 # -- reading --------------------------------------------------------------------------------
 
-def _check_format(h5, path):
+def _check_format(h5, path, writing=False):
     found = h5.attrs.get("format")
-    if found != FORMAT:
-        h5.close()
-        if isinstance(found, str) and found.startswith("bk-catalog-"):
-            raise CatalogError(f"{path}: catalog format {found}, this version reads {FORMAT} "
-                               "(the checkpoint layout changed; rerun, or read it with the older version)")
-        raise CatalogError(f"{path}: not an event catalog of this package")
+    if found == FORMAT or (found in READABLE and not writing):
+        return
+    h5.close()
+    if found in READABLE:
+        raise CatalogError(f"{path}: catalog format {found}, written before its tables were checksummed: this "
+                           f"version reads it but does not continue it (finish it with the older version, or rerun)")
+    if isinstance(found, str) and found.startswith("bk-catalog-"):
+        raise CatalogError(f"{path}: catalog format {found}, this version reads {', '.join(sorted(READABLE))} "
+                           "(the checkpoint layout changed; rerun, or read it with the older version)")
+    raise CatalogError(f"{path}: not an event catalog of this package")
 
 
 def _open_for_reading(path):
@@ -952,7 +967,7 @@ class Reader:
             self.damaged = {}
             for k in range(self.layout.n_tasks):
                 problem = self.layout.record_problem(k, {name: self.tasks[name][k] for name in (
-                    *tables.RECORD, "record_crc", "events_written")})
+                    *tables.RECORD, "record_crc", "events_written") if name in self.tasks})
                 if problem and not self.damaged_ok:
                     raise self.layout._fail(k, problem)
                 if problem:

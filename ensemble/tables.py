@@ -3,11 +3,13 @@
 The events, checkpoints and commit rows carry their own checksums (integrity.py). This module
 protects the rest, so that no damaged table can make a reader or a resume silently wrong:
 
-- **Fixed at creation** (`FIXED`): the parameter tables (/tasks/point, seed_index, N, l, nu, law, the
-  law keys, branch_of), /spinup/*, /checkpoint/offset and the root attributes (the stored config
-  among them). One CRC of all of them is stored as the root attribute `tables_crc` at creation and
-  verified on every open; the parameter tables are also recomputed from the stored config and
-  compared (`config_problems`), so a config and its tables can never disagree.
+- **Fixed at creation**: every /tasks column but a task's record and the events_written mirror (the
+  parameter tables point, seed_index, N, l, nu, law, the law keys, branch_of), /spinup/*,
+  /checkpoint/offset and the root attributes (the stored config among them). One CRC of all of them is
+  stored as the root attribute `tables_crc` at creation and verified on every open; the parameter
+  tables are also recomputed from the stored config, where this version can read it, and compared
+  (`config_problems`), so a config and its tables can never disagree. Catalogs of format bk-catalog-3,
+  written before these checksums, are read with the comparison and the consistency rules only.
 - **A task's record** (`RECORD`): /tasks/status, error, integrator and the provenance columns, written
   when a task finishes, fails or is taken up again. Each write of them ends with /tasks/record_crc[k],
   the CRC of the task's record bound to its index. A reader refuses a record that fails it; a resume
@@ -101,13 +103,14 @@ def _equal_rows(a, b):
     return a == b
 
 
-def record_problems(task, row, commit_written, per_task):
+def record_problems(task, row, commit_written, per_task, checksummed=True):
     """What is wrong with task `task`'s record (row: {column: value}); commit_written: the events
-    written by each of its valid commit rows (the one in use first), [] if none; '' if nothing."""
+    written by each of its valid commit rows (the one in use first), [] if none; '' if nothing.
+    checksummed: the catalog has record_crc (not bk-catalog-3)."""
     status = int(row["status"])
     if status not in STATUS_NAMES:
         return f"status code {status} is not one of {sorted(STATUS_NAMES)}"
-    if row["record_crc"] != record_crc(task, row):
+    if checksummed and row["record_crc"] != record_crc(task, row):
         return "its record (status, error, integrator, provenance) fails its checksum"
     error = bytes(row["error"]).rstrip(b"\0")
     if bool(error) != (status == FAILED):

@@ -251,6 +251,18 @@ def changed_config(where):
     return attack
 
 
+def an_older_format(w):
+    """A catalog of the format before the tables were checksummed (bk-catalog-3) still reads; a run of that
+    format is not continued (it would write records without their checksums)."""
+    old = w.copy("crashed", "old.h5")
+    with h5py.File(catalog.partial_path(old), "r+") as h5:
+        h5.attrs["format"] = "bk-catalog-3"
+        del h5.attrs["tables_crc"]
+        del h5["tasks/record_crc"]
+    catalog.read(catalog.partial_path(old))
+    one_line(_python("ensemble", "resume", old), (1,), "bk-catalog-3")
+
+
 def status_of_an_unknown_code(w):
     bad = w.copy("full", "code.h5")
     with h5py.File(bad, "r+") as h5:
@@ -349,6 +361,7 @@ ATTACKS = {
     "changed stored config, finished": changed_config("full"),
     "changed stored config, partial": changed_config("crashed"),
     "status of an unknown status code": status_of_an_unknown_code,
+    "an older catalog format reads, and is not continued": an_older_format,
     "resume of a finished catalog with --set": resume_of_a_finished_catalog_with_set,
     "empty config and /dev/null": empty_config,
     "output is the config": output_is_the_config,
