@@ -55,15 +55,6 @@ def record_crc(task, values):
     return digest({"task": np.int64(task), **{name: values[name] for name in RECORD}})
 
 
-def _same(a, b):
-    a, b = np.asarray(a), np.asarray(b)
-    if a.shape != b.shape:
-        return False
-    if a.dtype.kind == "f" or b.dtype.kind == "f":
-        return bool(np.array_equal(a.astype(np.float64), b.astype(np.float64), equal_nan=True))
-    return bool(np.array_equal(a, b))
-
-
 def expected_parameters(tasks, spinups, law_keys):
     """The parameter tables a run's task list implies: {column: array} (as catalog.create writes them)."""
     out = {"point": np.array([t.point for t in tasks], dtype=np.int64),
@@ -88,10 +79,12 @@ def config_problems(stored, expected):
         have = stored[name]
         if name == "law":
             have = np.array([bytes(x).rstrip(b"\0") for x in have])
-        if not _same(have, values):
-            rows = np.flatnonzero(~_equal_rows(have, values)) if np.shape(have) == np.shape(values) else []
-            where = f" (task {int(rows[0])}: {have[rows[0]]!r}, the config says {values[rows[0]]!r})" if len(rows) else ""
-            wrong.append(f"/tasks/{name}{where}")
+        if np.shape(have) != np.shape(values):
+            wrong.append(f"/tasks/{name} ({len(have)} rows, the config has {len(values)} tasks)")
+            continue
+        rows = np.flatnonzero(~_equal_rows(have, values))
+        if len(rows):
+            wrong.append(f"/tasks/{name} (task {int(rows[0])}: {have[rows[0]]!r}, the config says {values[rows[0]]!r})")
     return wrong
 
 
