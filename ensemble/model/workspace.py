@@ -70,7 +70,18 @@ ARK_A = ARK_V + ARK_STAGES
 ARK_G = ARK_A + ARK_STAGES
 TS = ARK_G + ARK_STAGES   # local time at which the block started to slide in this event (step trace)
 LOGGED = TS + 1           # 1 while the block's between-events values are in the undo log (undo.py)
-NCOLS = LOGGED + 1
+# the exponential integrator (exponential.py): theta = exp(psi) at the step start, and the step's
+# coefficients of the state's exact linear part, functions of z = h r(v0) (laws: linear_state)
+X_THETA0 = LOGGED + 1     # theta at the step start
+X_RATE0 = X_THETA0 + 1    # r(v0): the rate of the linear part, frozen over the step
+X_EH = X_RATE0 + 1        # exp(-z/2)
+X_P1H = X_EH + 1          # phi_1(-z/2)
+X_P2H = X_P1H + 1         # phi_2(-z/2)
+X_P1 = X_P2H + 1          # phi_1(-z)
+X_P2 = X_P1 + 1           # phi_2(-z)
+X_P3 = X_P2 + 1           # phi_3(-z)
+X_THETA = X_P3 + 1        # theta of the stage
+NCOLS = X_THETA + 1
 
 # entries of the per-event diagnostics vector
 (D_DURATION, D_SLIP, D_FIRST, D_LAST, D_NSLIP, D_WORK, D_RESIDUAL, D_STEPS, D_VMAX,

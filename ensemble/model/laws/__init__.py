@@ -14,6 +14,7 @@ F >= threshold(law, psi). A law without a state variable ignores psi (the kernel
 Adding a law: docs/laws.md, section "Adding a friction law".
 """
 import importlib
+import math
 import pkgutil
 from dataclasses import dataclass
 
@@ -62,6 +63,10 @@ class Law:
     stiff_limit: object   # (law, rate_limit) -> the state bound beyond which RK4 is unstable
     rk4_unstable: object  # (law, v, psi, rate_limit, state_limit) -> RK4's step left its stability region
     scales: Scales        # the reduction's defaults for this law's magnitudes and recurrence times
+    linear_state: object = None  # (law, v) -> (s, r): the state's equation is linear in theta = exp(psi),
+                          # theta' = s - r theta while sliding, with s and r functions of v alone (the
+                          # exponential integrator, model/exponential.py, solves it exactly over a step);
+                          # None: not of this form, and a law with a state then refuses that method
 
     def kernel_params(self, model):
         """The law's parameter record for the kernels from a config's model section."""
@@ -120,6 +125,10 @@ def implicit_state(law, W, act, na, hg):
     """The implicit stage of the state of the active blocks (steppers.ark_step)."""
 
 
+def linear_state(law, v):
+    """(s, r) of the state's equation theta' = s - r theta, theta = exp(psi), at velocity v (Law.linear_state)."""
+
+
 def stiff_limit(law, rate_limit):
     """The state bound of RK4's stability for a step with rate_limit = RK4_STABILITY / dt."""
 
@@ -175,6 +184,16 @@ def _constant(stub, field):
         def impl(law):
             return value
         return impl
+
+
+@overload(linear_state, inline="always")
+def _linear_state(law, v):
+    fn = _BY_PARAMS[law.instance_class].linear_state
+    if fn is None:
+        # a law without the form: never reached at run time (methods.Method.refusal refuses the
+        # method for a law with a state; a law without one takes no state stages)
+        return lambda law, v: (math.nan, math.nan)
+    return lambda law, v: fn(law, v)
 
 
 for _stub in (friction, threshold, state_rate, rest_state, onset_delay, implicit_state, stiff_limit,

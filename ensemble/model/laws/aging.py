@@ -54,6 +54,12 @@ def onset_delay(law, force, psi, nu):
 
 
 @nb.njit(cache=True, inline="always")
+def linear_state(law, v):
+    """theta' = 1 - v theta (v clamped at 0): source 1, rate v."""
+    return 1.0, (v if v > 0.0 else 0.0)
+
+
+@nb.njit(cache=True, inline="always")
 def stiff_limit(law, rate_limit):
     """The state relaxes at rate exp(-psi): RK4 needs psi > -ln(RK4_STABILITY / dt)."""
     return -math.log(rate_limit)
@@ -176,6 +182,6 @@ LAW = Law(
     has_state=True, loader_moves=True,
     friction=friction, threshold=threshold, state_rate=state_rate, rest_state=rest_state,
     onset_delay=onset_delay, implicit_state=implicit_state, stiff_limit=stiff_limit,
-    rk4_unstable=rk4_unstable,
+    rk4_unstable=rk4_unstable, linear_state=linear_state,
     # the paper's axes: R(mu) over 0..7, large events mu >= 4, GR fit above 3, T nu up to 2000
     scales=Scales(mu_bins="0:7:70", mu_c=4.0, b_cut=3.0, tnu_bins="0:2000:80"))
