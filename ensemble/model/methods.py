@@ -1,8 +1,9 @@
 """Event integrators: the registry (config name -> Method), and the calls through which the kernel steps.
 
 An entry's tableau decides the rest: an IMEX pair of tableaux.py gives an adaptive method (its
-stages, its step-size control exponent from the embedded order, its error weights), None the
-classical RK4 at the fixed step dt. The kernels receive the method as a record
+stages, its step-size control exponent from the embedded order, its error weights), an
+exponential scheme of exponential.py the adaptive exponential integrator written out there
+(_STEPPERS: the stepper of each kind of tableau), None the classical RK4 at the fixed step dt. The kernels receive the method as a record
 (KernelParams.method) of a class of its own, so numba compiles them once per method, and each
 call here resolves at compile time to that method's stepper with its tableau frozen in as
 constants: no branch on the method at run time (the friction laws' pattern, laws/__init__.py).
@@ -10,7 +11,8 @@ constants: no branch on the method at run time (the friction laws' pattern, laws
 The registry lives beside the kernels because it decides what they compile: the numba cache is
 keyed on the sources of this package (model/__init__.py).
 
-Adding a method: its pair in tableaux.py, one entry in METHODS.
+Adding a method: its pair in tableaux.py, one entry in METHODS. A method may refuse a friction law
+(Method.refusal: exp4 needs a state linear in theta = exp(psi)).
 """
 import functools
 from collections import namedtuple
@@ -20,8 +22,9 @@ import numba as nb
 import numpy as np
 from numba.extending import overload
 
+from .exponential import ETDRK4_KROGSTAD, ExponentialScheme, exp_step
 from .steppers import ark_step, rk4_step
-from .tableaux import ARK324, ARK436, ARK548
+from .tableaux import ARK324, ARK436, ARK548, ArkPair
 from .workspace import ARK_STAGES
 
 
@@ -29,7 +32,8 @@ from .workspace import ARK_STAGES
 class Method:
     """An event integrator as the config names it."""
     name: str             # the value of integrator.method
-    tableau: object       # the IMEX pair (tableaux.ArkPair) of an adaptive method; None: classical RK4
+    tableau: object       # an adaptive method's pair: IMEX (tableaux.ArkPair) or exponential
+                          # (exponential.ExponentialScheme); None: classical RK4
     description: str      # one paragraph, for the docs and `validate`
 
     def __post_init__(self):
@@ -61,6 +65,15 @@ class Method:
         """The method's record for the kernels (KernelParams.method)."""
         return self._record(control_exponent=self.control_exponent)
 
+    def refusal(self, law):
+        """Why this method cannot integrate the friction law `law` (laws.Law), one line naming the
+        keys; None if it can."""
+        if isinstance(self.tableau, ExponentialScheme) and law.has_state and law.linear_state is None:
+            return (f"integrator.method = {self.name!r} needs a state equation linear in theta = exp(psi) "
+                    f"(Law.linear_state), which model.law = {law.name!r} does not have: choose another "
+                    f"integrator.method")
+        return None
+
 
 METHODS = {m.name: m for m in (
     Method("rk4", None, "classical fourth-order Runge-Kutta with fixed step integrator.dt "
@@ -73,6 +86,11 @@ METHODS = {m.name: m for m in (
                            "state, step controlled by integrator.rtol / atol, max_step)"),
     Method("ark5", ARK548, "adaptive IMEX Runge-Kutta ARK5(4)8L[2]SA: fifth order, otherwise "
                            "as ark3"),
+    Method("exp4", ETDRK4_KROGSTAD, "adaptive exponential Runge-Kutta (Krogstad's ETDRK4 with an "
+                                    "embedded order 3): classical RK4 in slip and velocity, the state "
+                                    "theta = exp(psi) advanced exactly in its linear part, every stage "
+                                    "explicit; step controlled by integrator.rtol / atol, max_step; laws "
+                                    "with a state need Law.linear_state (aging)"),
 )}
 
 
@@ -86,17 +104,28 @@ def _method_of(params_type):
     return _method(params_type.types[params_type.fields.index("method")])
 
 
+def _ark_stepper(pair):
+    c, ae, ai, bw, bd, gamma = pair.kernel_arrays()
+
+    def step(W, act, na, n, tau, h, p, yrest):
+        return ark_step(W, act, na, n, tau, h, p, yrest, c, ae, ai, bw, bd, gamma)
+    return nb.njit(error_model="numpy")(step)
+
+
+# the stepper of each kind of tableau, and its error weights (b - bhat) for steppers.block_error
+_STEPPERS = {
+    ArkPair: (_ark_stepper, lambda pair: pair.kernel_arrays()[4]),
+    ExponentialScheme: (lambda scheme: exp_step, lambda scheme: np.array(scheme.error_weights)),
+}
+
+
 @functools.cache
 def _stepper(method):
     """The numba function that takes one step of `method` (compiled once a process; not inlined:
     one copy however often the kernel steps, with steppers.py's error model)."""
     if not method.adaptive:
         return rk4_step
-    c, ae, ai, bw, bd, gamma = method.tableau.kernel_arrays()
-
-    def step(W, act, na, n, tau, h, p, yrest):
-        return ark_step(W, act, na, n, tau, h, p, yrest, c, ae, ai, bw, bd, gamma)
-    return nb.njit(error_model="numpy")(step)
+    return _STEPPERS[type(method.tableau)][0](method.tableau)
 
 
 # The kernels' calls; each stub is replaced by numba with the method's own code.
@@ -124,7 +153,7 @@ def _take_step(W, act, na, n, tau, h, p, yrest):
 @overload(error_weights, inline="always")
 def _error_weights(method):
     m = _method(method)
-    bd = m.tableau.kernel_arrays()[4] if m.adaptive else np.zeros(0)
+    bd = _STEPPERS[type(m.tableau)][1](m.tableau) if m.adaptive else np.zeros(0)
     return lambda method: bd
 
 
