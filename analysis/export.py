@@ -114,6 +114,7 @@ INTEGRATOR_MEANINGS = {   # key -> (unit, meaning), the keys of ensemble.config.
     "atol": ("model length", "adaptive methods: absolute tolerance (slip, velocity)"),
     "max_step": ("model time", "adaptive methods: largest step"),
     "max_duration": ("model time", "an event lasting longer is an error"),
+    "creep_tol": ("1", "creep phase: local error of the state psi per creep step"),
 }
 
 

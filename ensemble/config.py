@@ -104,6 +104,7 @@ class Integrator:
     atol: float = 1e-12            # adaptive methods: absolute tolerance (slip, velocity)
     max_step: float = 0.5          # adaptive methods: largest step
     max_duration: float = 1e5      # an event lasting longer than this is an error
+    creep_tol: float = 1e-6        # creep phase (b below a block's stiffness): local error of the state psi per creep step
 
 
 @dataclass(frozen=True)
@@ -143,6 +144,7 @@ _RULES = {
     ("integrator", "rtol"): (lambda x: 0 < x < 1, "in (0, 1)"),
     ("integrator", "atol"): (_positive, "> 0"),
     ("integrator", "max_step"): (_positive, "> 0"),
+    ("integrator", "creep_tol"): (lambda x: 0 < x < 1, "in (0, 1)"),
     # a task buffers a batch in memory, 80 bytes per event
     ("output", "batch"): (lambda x: 1 <= x <= MAX_BATCH, f"an integer in [1, {MAX_BATCH:.0e}] (80 bytes per event "
                                                           f"in memory)"),

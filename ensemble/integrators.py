@@ -20,4 +20,5 @@ def kernel_params(model, integrator):
     return KernelParams(l2=model.l ** 2, nu=model.nu, law=laws.get(model.law).kernel_params(model),
                         method=INTEGRATORS[integrator.method].kernel_params(), dt=integrator.dt,
                         rtol=integrator.rtol, atol=integrator.atol, max_step=integrator.max_step,
-                        max_duration=integrator.max_duration, max_steps=max_steps)
+                        max_duration=integrator.max_duration, max_steps=max_steps,
+                        creep_tol=integrator.creep_tol)

@@ -19,12 +19,13 @@ import math
 import numba as nb
 import numpy as np
 
-from .event import begin_event, continue_event
-from .laws import loader_moves, onset_delay, threshold
+from .creep import ENDED, HANDOVER, after_event, continue_creep, join, off_schedule, possible, report, stable
+from .event import begin_event, begin_handover, continue_event
+from .laws import creep_weakening, loader_moves, onset_delay, threshold
 from .schedule import advance_clock, build_schedule, finite_state, materialize, tree_min
 from .undo import log_block
-from .workspace import (BETWEEN, D_DURATION, D_SLIP, EV_CLOCK_HI, EV_CLOCK_LO, EV_EPICENTER, EV_PHASE,
-                        F0, NONFINITE, NTRACE, OK, P, PAUSED)
+from .workspace import (BETWEEN, CS_ENDED, CS_NCREEP, D_DURATION, D_ENDING, D_KIND, D_SLIP, EV_CLOCK_HI,
+                        EV_CLOCK_LO, EV_EPICENTER, EV_PHASE, F0, KIND_EVENT, NONFINITE, NTRACE, OK, P, PAUSED)
 
 # Work units charged for each event besides its block-steps: a fixed stand-in for the onset
 # search (tree descent, onset delay), setting the event up and finishing it (O(log N) and
@@ -65,11 +66,37 @@ def simulate(arrays, clock, p, n_events, budget, out_t, out_epicenter, out_diag)
         if not finite_state(W, since):
             return NONFINITE, 0
         build_schedule(W, since, tree, p)
+        if possible(p, n):
+            off_schedule(arrays, n)
     onset = np.empty(2)
     k = 0
     spent = 0
+    creep_on = possible(p, n)
+    cstate = arrays.cstate
     while k < n_events:
-        if event[EV_PHASE] == BETWEEN:
+        handover = -1
+        if event[EV_PHASE] == BETWEEN and creep_on and (cstate[CS_NCREEP] > 0.0 or cstate[CS_ENDED] > 0.0):
+            # -- the creep phase (creep.py): its ended episodes are rows, then it runs up to the
+            # next onset by loading, or hands over to an event
+            if cstate[CS_ENDED] > 0.0:
+                k += report(arrays, n, out_t, out_epicenter, out_diag, k)
+                continue
+            if spent >= budget:
+                return OK, k
+            code, used, handover = continue_creep(arrays, clock, n, p, budget - spent)
+            spent += used
+            if code == PAUSED:
+                return OK, k
+            if code == ENDED:
+                continue
+            if code != HANDOVER:
+                handover = -1
+        if event[EV_PHASE] == BETWEEN and handover >= 0:
+            event[EV_CLOCK_HI] = clock[0]
+            event[EV_CLOCK_LO] = clock[1]
+            begin_handover(arrays, clock, n, handover, p)
+            spent += EVENT_WORK
+        elif event[EV_PHASE] == BETWEEN:
             if spent >= budget:
                 return OK, k
             _, epicenter = tree_min(tree)
@@ -81,6 +108,16 @@ def simulate(arrays, clock, p, n_events, budget, out_t, out_epicenter, out_diag)
             onset[0] = since[epicenter, 0]
             onset[1] = since[epicenter, 1]
             advance_clock(onset, delay)
+            if creep_on and stable(n, p.l2, creep_weakening(p.law), epicenter, epicenter):
+                # a block stiffer than its law's weakening creeps instead of rupturing
+                if (onset[0] - clock[0]) + (onset[1] - clock[1]) > 0.0:
+                    clock[0] = onset[0]
+                    clock[1] = onset[1]
+                materialize(W, since, epicenter, clock, p)
+                if W[epicenter, F0] < threshold(p.law, W[epicenter, P]):
+                    W[epicenter, F0] = threshold(p.law, W[epicenter, P])
+                join(arrays, n, p, epicenter, 0.0, clock)
+                continue
             # from here on the event changes the between-events state: keep what it was
             event[EV_CLOCK_HI] = clock[0]
             event[EV_CLOCK_LO] = clock[1]
@@ -104,11 +141,15 @@ def simulate(arrays, clock, p, n_events, budget, out_t, out_epicenter, out_diag)
             advance_clock(clock, diag[D_DURATION])
         if status != OK:
             return status, k
+        if creep_on:
+            after_event(arrays, n, p, clock)
         if diag[D_SLIP] == 0.0:
             continue    # nothing moved (an onset within round-off of the threshold): no event
         out_t[k] = t_onset
         out_epicenter[k] = int(event[EV_EPICENTER])
         out_diag[k, :] = diag
+        out_diag[k, D_KIND] = KIND_EVENT
+        out_diag[k, D_ENDING] = 0.0
         k += 1
     return (OK if event[EV_PHASE] == BETWEEN else PAUSED), k
 

@@ -36,6 +36,7 @@ import numba as nb
 import numpy as np
 
 from .control import accepted, next_step_size, record, retry_size
+from .creep import possible, run_of, slow_enough
 from .geometry import left, right
 from .laws import loader_moves, onset_delay, rest_state, rk4_unstable, stiff_limit
 from .methods import adaptive, take_step
@@ -47,7 +48,7 @@ from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D
                         D_LAST, D_LOAD_WORK, D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK,
                         EV_BLOCK_STEPS, EV_CUTS, EV_EPICENTER, EV_ERR_PREV, EV_FAR, EV_H_NEXT, EV_NA, EV_NT,
                         EV_PHASE, EV_REJECTED, EV_SLIP_TIME, EV_STEPS, EV_T_FAR, EV_TAU, EV_TRACED, EV_VMAX,
-                        EV_WORK, EV_YREST, F0, HD0, HD1, IN_EVENT, NONFINITE, OK, P, P0, PAUSED, SLIDING,
+                        EV_WORK, EV_YREST, F0, HD0, CR_HB, CR_V, CR_VN, HD1, IN_EVENT, NONFINITE, OK, P, P0, PAUSED, SLIDING,
                         STOPPED, TOO_LONG, TR, TS, UNLIMITED, UNSTABLE, UNTOUCHED, V, V0, Y, Y0, YS)
 
 # Stability limit of classical RK4 on the negative real axis: the state equation
@@ -157,6 +158,26 @@ def begin_event(arrays, t0, n, epicenter, v_start, p):
     _keep(event, na, nt, yrest, t_far, far, 0.0, 0.0, 0.0, 0, 0, 0, 0, v_start, p.dt, 1.0, 0)
 
 
+@nb.njit(cache=True)
+def begin_handover(arrays, t0, n, epicenter, p):
+    """Start an event where creep hands over to inertia (creep.continue_creep): `epicenter` starts
+    from rest at time t0, and every block creeping in its run slides from its creep velocity (as
+    begin_event otherwise; the creep arrays keep them until the event's end, creep.after_event)."""
+    W, event, C = arrays.W, arrays.event, arrays.creep
+    na, nt, yrest = _start(arrays, 0, 0, t0, p, epicenter, 0.0, 0.0)
+    lo, hi = run_of(C, n, epicenter)
+    vmax = 0.0
+    for i in range(lo, hi + 1):
+        if i != epicenter and C[i, CR_V] > 0.0:
+            na, nt, yrest = _start(arrays, na, nt, t0, p, i, 0.0, yrest)
+            W[i, V] = C[i, CR_V]
+            vmax = max(vmax, W[i, V])
+    t_far, far = _far_onset(W, arrays.flag, n, arrays.since, arrays.tree, t0, 0.0, p)
+    event[EV_PHASE] = IN_EVENT
+    event[EV_EPICENTER] = epicenter
+    _keep(event, na, nt, yrest, t_far, far, 0.0, 0.0, 0.0, 0, 0, 0, 0, vmax, p.dt, 1.0, 0)
+
+
 @nb.njit(cache=True, inline="always")
 def _keep(event, na, nt, yrest, t_far, far, tau, work, slip_time, steps, block_steps, rejected, cuts,
           vmax, h_next, err_prev, traced):
@@ -205,6 +226,7 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
     status = OK
     v_limit = RK4_STABILITY / p.dt
     psi_limit = stiff_limit(p.law, v_limit)
+    creep_on = possible(p, n)
     used = 0
     while na > 0:
         if used >= budget:
@@ -316,6 +338,21 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
             for j in (left(i), right(i, n)):
                 if j != i and above_threshold(W, flag, n, j, tau, p):
                     na, nt, yrest = _start(arrays, na, nt, t0, p, j, tau, yrest)
+        # -- the hand-back: sliding blocks slow enough to creep stop here and creep from here on
+        # (creep.slow_enough, creep.after_event)
+        if creep_on and na > 0 and slow_enough(arrays, n, p, na):
+            for k in range(na):
+                i = act[k]
+                arrays.creep[i, CR_HB] = 1.0
+                arrays.creep[i, CR_VN] = W[i, V]
+                W[i, V] = 0.0
+                W[i, TR] = tau
+                W[i, YS] = W[i, Y]
+                flag[i] = STOPPED
+                yrest += W[i, Y]
+                stuck[nstuck] = i
+                nstuck += 1
+            na = 0
         # -- rescheduling, once the set of watched blocks has changed
         if kind != NO_CUT or nstuck > 0 or na != m:
             t_far, far = _reschedule(W, flag, stuck, since, tree, nstuck, n, t0, tau, p)

@@ -7,7 +7,7 @@ ensemble.integrators.kernel_params builds it from the config.
 """
 from collections import namedtuple
 
-_Fields = namedtuple("KernelParams", "l2 nu law method dt rtol atol max_step max_duration max_steps")
+_Fields = namedtuple("KernelParams", "l2 nu law method dt rtol atol max_step max_duration max_steps creep_tol")
 _INTEGERS = ("max_steps",)
 _RECORDS = ("law", "method")     # records of their own classes (below); the others are float64
 
@@ -29,6 +29,7 @@ class KernelParams(_Fields):
     max_duration  an event lasting longer than this (local time since its onset) ends with TOO_LONG
     max_steps     steps of one event, rejected ones included, after which it ends with TOO_LONG (a
                   backstop behind max_duration for steps too small to reach it)
+    creep_tol     the creep phase (creep.py): local error of the state psi per creep step
     """
     __slots__ = ()
 

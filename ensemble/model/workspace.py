@@ -85,8 +85,11 @@ NCOLS = X_THETA + 1
 
 # entries of the per-event diagnostics vector
 (D_DURATION, D_SLIP, D_FIRST, D_LAST, D_NSLIP, D_WORK, D_RESIDUAL, D_STEPS, D_VMAX,
- D_BLOCK_STEPS, D_REJECTED, D_CUTS, D_ENERGY_SCALE, D_ELASTIC, D_LOAD_WORK) = range(15)
-NDIAG = 15
+ D_BLOCK_STEPS, D_REJECTED, D_CUTS, D_ENERGY_SCALE, D_ELASTIC, D_LOAD_WORK, D_KIND, D_ENDING) = range(17)
+NDIAG = 17
+# D_KIND: what a row of the kernels' output is; D_ENDING: how a creep episode ended (1 its blocks
+# stopped, 2 an inertial event took them; 0 for an event)
+KIND_EVENT, KIND_CREEP = 0, 1
 
 # columns of the optional step trace of an event (one row per step tried, rejected ones included)
 (T_TAU, T_H, T_SLIDING, T_ERROR, T_BLOCK, T_PART, T_AGE, T_V, T_PSI, T_OWN) = range(10)
@@ -129,6 +132,45 @@ EV_ERR_PREV = 18    # error norm of the last accepted step (PI control)
 EV_TRACED = 19      # rows of the step trace filled
 EV_NUNDO = 20       # entries of the undo log
 NEVENT = 21
+# The creep phase (creep.py). Per block, the array `creep`: its first CR_KEEP columns are state
+# (a checkpoint keeps them), the others scratch of one creep step.
+CR_EP = 0       # 1 + the slot of the episode the block creeps in (0: not creeping)
+CR_V = 1        # creep velocity at the last step's end
+CR_SERIAL = 2   # serial number of the last episode that counted the block among its blocks
+CR_KEEP = 3
+CR_VN = 3       # the step's velocity (Newton's iterate); at an event's end the velocity handed back
+CR_PSI = 4      # the step's psi at its end
+CR_DPSI = 5     # d psi / d v of the step's state equation
+CR_DU = 6       # the step's slip
+CR_H = 7        # the block's own step (from its time since[i])
+CR_RES = 8      # Newton's right-hand side; Thomas' forward sweep; the force at the step's end
+CR_DIAG = 9     # Thomas' pivot
+CR_UPPER = 10   # Newton's update of the block (read by its left neighbour in the back sweep)
+CR_HB = 11      # 1: the event that just ended handed the block back to creep
+CR_LEFT = 12    # 1: the block stopped creeping in the step being taken
+NCREEP = 13
+# The episode table `episodes`: one row (slot) per episode running or ended and not yet reported
+E_STATE = 0     # 0 free, E_RUNNING, E_STOPPED (its blocks stopped), E_RUPTURED (an event took them)
+E_START_HI, E_START_LO = 1, 2      # two-float time at which it began
+E_EPICENTER = 3                    # its first block
+E_SLIP = 4                         # sum of its blocks' slips
+E_FIRST, E_LAST = 5, 6             # lowest and highest block that slipped in it
+E_NBLOCKS = 7                      # blocks that crept in it
+E_VMAX = 8                         # largest creep velocity
+E_ACTIVE = 9                       # blocks creeping in it now
+E_SERIAL = 10                      # its serial number (creep.join counts a block once per episode)
+E_END_HI, E_END_LO = 11, 12        # two-float time at which it ended
+E_BLOCK_STEPS = 13                 # creep steps of its blocks
+NEPISODE = 14
+E_RUNNING, E_STOPPED, E_RUPTURED = 1.0, 2.0, 3.0
+# The creep phase's own scalars `cstate`
+CS_NCREEP = 0   # blocks creeping
+CS_H = 1        # the next creep step
+CS_SERIAL = 2   # episodes begun so far (serial numbers)
+CS_ENDED = 3    # episodes ended and not yet reported
+CS_T_HI, CS_T_LO = 4, 5   # two-float time up to which the creep is integrated
+NCSTATE = 6
+
 # values of EV_PHASE
 BETWEEN, IN_EVENT = 0, 1
 
@@ -169,6 +211,9 @@ WorkArrays = namedtuple("WorkArrays", [
     "diag",     # (NDIAG,) float64: summary of the last event (D_*)
     "event",    # (NEVENT,) float64: the event in progress (EV_*)
     "undo",     # (n, NUNDO) float64: undo log of the event in progress (U_*, undo.py)
+    "creep",    # (n, NCREEP) float64: per block, the creep phase (CR_*, creep.py)
+    "episodes", # (2 n, NEPISODE) float64: creep episodes running or waiting to be reported (E_*)
+    "cstate",   # (NCSTATE,) float64: the creep phase's scalars (CS_*)
 ])
 
 
@@ -198,15 +243,20 @@ class Workspace:
         self.diag = np.zeros(NDIAG)
         self.event = np.zeros(NEVENT)
         self.undo = np.zeros((n, NUNDO))
+        self.creep = np.zeros((n, NCREEP))
+        self.episodes = np.zeros((2 * n, NEPISODE))
+        self.cstate = np.zeros(NCSTATE)
 
     @property
     def arrays(self):
         """The work arrays as the kernels take them (WorkArrays)."""
         return WorkArrays(W=self.W, act=self.act, flag=self.flag, touched=self.touched, stuck=self.stuck,
-                          since=self.since, tree=self.tree, diag=self.diag, event=self.event, undo=self.undo)
+                          since=self.since, tree=self.tree, diag=self.diag, event=self.event, undo=self.undo,
+                          creep=self.creep, episodes=self.episodes, cstate=self.cstate)
 
-    def load(self, force, psi, since=None):
-        """Set the between-events state: force and psi of every block (at time since, default 0).
+    def load(self, force, psi, since=None, creep=None):
+        """Set the between-events state: force and psi of every block (at time since, default 0),
+        and the creep phase's state (`creep_state`; default: nothing creeps).
 
         An event in progress is dropped.
         """
@@ -217,6 +267,26 @@ class Workspace:
         self.since[:] = 0.0 if since is None else since
         self.tree[:] = np.nan    # the kernels rebuild the schedule
         self.event[:] = 0.0      # BETWEEN, undo log empty
+        self.creep[:] = 0.0
+        self.episodes[:] = 0.0
+        self.cstate[:] = 0.0
+        if creep is not None:
+            n = self.creep.shape[0]
+            k = n * CR_KEEP
+            self.creep[:, :CR_KEEP] = creep[:k].reshape(n, CR_KEEP)
+            self.episodes[:] = creep[k:k + self.episodes.size].reshape(self.episodes.shape)
+            self.cstate[:] = creep[k + self.episodes.size:]
+
+    @staticmethod
+    def creep_size(n):
+        """Length of `creep_state` for n blocks."""
+        return n * CR_KEEP + 2 * n * NEPISODE + NCSTATE
+
+    def creep_state(self):
+        """The creep phase's state as one flat array (a copy), for a checkpoint: with the
+        between-events state it continues the run exactly (`load`). An event in progress leaves it
+        unchanged until the event's end (creep.after_event)."""
+        return np.concatenate([self.creep[:, :CR_KEEP].ravel(), self.episodes.ravel(), self.cstate])
 
     @property
     def paused(self):

@@ -67,6 +67,17 @@ class Law:
                           # theta' = s - r theta while sliding, with s and r functions of v alone (the
                           # exponential integrator, model/exponential.py, solves it exactly over a step);
                           # None: not of this form, and a law with a state then refuses that method
+    # Quasi-static creep (model/creep.py, docs/numerics.md "Quasi-static creep"); a law without
+    # `creep_state` never creeps (a block that reaches its threshold always starts an event)
+    creep_weakening: object = None  # (law) -> w: a cluster of blocks may creep while K_C - w I is
+                          # positive definite (K_C its stiffness matrix); the aging law: b
+    creep_state: object = None  # (law, psi0, v, h) -> (psi, d psi / d v): the state after a backward
+                          # Euler step of size h at velocity v from psi0
+    friction_slopes: object = None  # (law, v, psi) -> (d friction / d v, d friction / d psi)
+
+    @property
+    def creeps(self):
+        return self.creep_state is not None
 
     def kernel_params(self, model):
         """The law's parameter record for the kernels from a config's model section."""
@@ -127,6 +138,22 @@ def implicit_state(law, W, act, na, hg):
 
 def linear_state(law, v):
     """(s, r) of the state's equation theta' = s - r theta, theta = exp(psi), at velocity v (Law.linear_state)."""
+
+
+def creeps(law):
+    """The law has a quasi-static creep phase (a compile-time constant)."""
+
+
+def creep_weakening(law):
+    """w: a cluster may creep while its stiffness matrix minus w I is positive definite."""
+
+
+def creep_state(law, psi0, v, h):
+    """(psi, d psi / d v) after a backward-Euler step h of the state at velocity v from psi0."""
+
+
+def friction_slopes(law, v, psi):
+    """(d friction / d v, d friction / d psi) of a sliding block."""
 
 
 def stiff_limit(law, rate_limit):
@@ -195,6 +222,40 @@ def _linear_state(law, v):
         return lambda law, v: (math.nan, math.nan)
     return lambda law, v: fn(law, v)
 
+
+@overload(creeps, inline="always")
+def _creeps(law):
+    value = _BY_PARAMS[law.instance_class].creeps
+    return lambda law: value
+
+
+def _optional(stub, field, arity):
+    """Compile calls of `stub` to the law's optional function `field`; a law without it never
+    reaches the call (creeps(law) is False), which compiles to NaNs."""
+    def choose(law):
+        return getattr(_BY_PARAMS[law.instance_class], field)
+
+    if arity == 1:
+        @overload(stub, inline="always")
+        def _one(law):
+            fn = choose(law)
+            return (lambda law: math.nan) if fn is None else (lambda law: fn(law))
+    elif arity == 2:
+        @overload(stub, inline="always")
+        def _two(law, x, y):
+            fn = choose(law)
+            return (lambda law, x, y: (math.nan, math.nan)) if fn is None else (lambda law, x, y: fn(law, x, y))
+    else:
+        @overload(stub, inline="always")
+        def _three(law, x, y, z):
+            fn = choose(law)
+            return ((lambda law, x, y, z: (math.nan, math.nan)) if fn is None
+                    else (lambda law, x, y, z: fn(law, x, y, z)))
+
+
+_optional(creep_weakening, "creep_weakening", 1)
+_optional(friction_slopes, "friction_slopes", 2)
+_optional(creep_state, "creep_state", 3)
 
 for _stub in (friction, threshold, state_rate, rest_state, onset_delay, implicit_state, stiff_limit,
               rk4_unstable):

@@ -60,6 +60,37 @@ def linear_state(law, v):
 
 
 @nb.njit(cache=True, inline="always")
+def creep_weakening(law):
+    """A cluster creeps while K_C - b I is positive definite (docs/numerics.md)."""
+    return law.b
+
+
+@nb.njit(cache=True, inline="always")
+def friction_slopes(law, v, psi):
+    """(a / (1 + v), b) at max(v, 0)."""
+    vp = v if v > 0.0 else 0.0
+    return law.a / (1.0 + vp), law.b
+
+
+@nb.njit(cache=True)
+def creep_state(law, psi0, v, h):
+    """Backward Euler of psi' = exp(-psi) - v over h: psi - h exp(-psi) = psi0 - h v (the root lies
+    above the right side; _newton_state), and d psi / d v = -h / (1 + h exp(-psi)). The first guess
+    is the exact state for v held over the step, theta = 1/v + (theta0 - 1/v) exp(-v h)."""
+    vp = v if v > 0.0 else 0.0
+    target = psi0 - h * vp
+    theta0 = math.exp(psi0)
+    z = vp * h
+    if z > 1e-8:
+        theta = 1.0 / vp + (theta0 - 1.0 / vp) * math.exp(-z)
+    else:
+        theta = theta0 + h * (1.0 - vp * theta0)
+    guess = math.log(theta) if theta > 0.0 else target
+    psi = _newton_state(max(guess, target), target, h)
+    return psi, (-h / (1.0 + h * math.exp(-psi)) if v > 0.0 else 0.0)
+
+
+@nb.njit(cache=True, inline="always")
 def stiff_limit(law, rate_limit):
     """The state relaxes at rate exp(-psi): RK4 needs psi > -ln(RK4_STABILITY / dt)."""
     return -math.log(rate_limit)
@@ -183,5 +214,6 @@ LAW = Law(
     friction=friction, threshold=threshold, state_rate=state_rate, rest_state=rest_state,
     onset_delay=onset_delay, implicit_state=implicit_state, stiff_limit=stiff_limit,
     rk4_unstable=rk4_unstable, linear_state=linear_state,
+    creep_weakening=creep_weakening, creep_state=creep_state, friction_slopes=friction_slopes,
     # the paper's axes: R(mu) over 0..7, large events mu >= 4, GR fit above 3, T nu up to 2000
     scales=Scales(mu_bins="0:7:70", mu_c=4.0, b_cut=3.0, tnu_bins="0:2000:80"))

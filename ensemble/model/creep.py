@@ -1,0 +1,588 @@
+"""Quasi-static creep: the third scene of rate-and-state friction, beside rest and inertial events.
+
+Where a block's stiffness exceeds its law's weakening (the aging law: b below 1 + 2 l^2 for an
+interior block), a block that reaches its static threshold does not rupture: it creeps, holding its
+force equal to its friction, with inertia negligible, on time scales of 1e6 to 1e10. Its neighbours
+at rest load up through its slip; when one of them reaches its threshold it joins the creeping
+cluster, and a cluster too soft for its law (its stiffness matrix minus the weakening no longer
+positive definite) hands over to an inertial event. Equations and criteria: docs/numerics.md,
+"Quasi-static creep".
+
+The creep phase is part of the between-events state. Creeping blocks (the set C) keep, like blocks
+at rest, their force W[i, F0] and state W[i, P] at their time since[i]; besides, their velocity, the
+episode they belong to, and the step size live in the creep arrays below, which a checkpoint keeps
+(Workspace.creep_state). Creep advances all creeping blocks together by backward-Euler steps of
+the index-1 system "force = friction, psi' = g(v, psi)", with the step size controlled by an error
+estimate of the state, cut where a block at rest reaches its threshold (located by bisection, as in
+events) and where the onset schedule's next block starts by loading alone. A block whose creep
+velocity comes out negative stops (an active-set pass). Creeping blocks and their resting
+neighbours are off the onset schedule (key inf) while they creep.
+
+An episode of creep begins when a block starts to creep with no creeping neighbour; a block that
+starts beside a creeping one joins its episode (its left neighbour's, if both creep). It ends when
+its last block has stopped (STOPPED) or has been taken by an inertial event (RUPTURED); the kernel
+then reports it as a row of its own (kind 1, chain.simulate).
+
+While an event runs, creep elsewhere waits: an event lasts 1e0 to 1e3 time units, creep moves
+1e-9 per unit, and the next creep step covers the event's duration (each block steps from its own
+time since[i]), with the event's slip already in the forces.
+"""
+import math
+
+import numba as nb
+import numpy as np
+
+from .geometry import left, right
+from .laws import creep_state, creep_weakening, creeps, friction, friction_slopes, onset_delay, rest_state, state_rate, threshold
+from .schedule import advance_clock, elapsed, materialize, onset_key, tree_min, tree_set
+from .workspace import (CR_DIAG, CR_DPSI, CR_DU, CR_EP, CR_H, CR_HB, CR_LEFT, CR_PSI, CR_RES, CR_SERIAL, CR_UPPER, CR_V,
+                        CR_VN, CS_ENDED, CS_H, CS_NCREEP, CS_SERIAL, CS_T_HI, CS_T_LO, E_ACTIVE, E_BLOCK_STEPS,
+                        E_END_HI, E_END_LO, E_EPICENTER, E_FIRST, E_LAST, E_NBLOCKS, E_RUNNING, E_RUPTURED,
+                        E_SERIAL, E_SLIP, E_START_HI, E_START_LO, E_STATE, E_STOPPED, E_VMAX, F0, P,
+                        D_BLOCK_STEPS, D_DURATION, D_ENDING, D_FIRST, D_KIND, D_LAST, D_NSLIP, D_SLIP, D_VMAX,
+                        EV_NT, KIND_CREEP, PAUSED, SLIDING, V)
+
+# what continue_creep returns besides PAUSED
+REACHED = 10      # creep is integrated up to the onset of the schedule's next block (or nothing creeps)
+ENDED = 11        # episodes have ended: their rows wait (CS_ENDED), chain.simulate reports them
+HANDOVER = 12     # a cluster became too soft to creep: the block `who` starts an inertial event there
+
+_NEWTON = 40      # Newton iterations of one creep step before the step is halved
+_BISECT = 60      # halvings locating an onset inside a creep step (2^-60 of the step)
+_GROW = 5.0       # the step grows at most fivefold, ...
+_SHRINK = 0.2     # ... and shrinks at most fivefold, per step
+
+
+@nb.njit(cache=True, inline="always")
+def stiffness(i, n, l2):
+    """K_ii, the diagonal of the chain's stiffness: the loader's spring and one or two of l^2."""
+    return 1.0 + l2 * ((1.0 if i > 0 else 0.0) + (1.0 if i < n - 1 else 0.0))
+
+
+@nb.njit(cache=True)
+def possible(p, n):
+    """Some block of this chain can creep under these parameters: its law creeps, and the stiffest
+    single block (interior 1 + 2 l^2, at a free end 1 + l^2, alone 1) is stiffer than the law's
+    weakening. Otherwise no cluster ever creeps (a cluster is never stiffer than its stiffest block
+    alone), and the kernels run exactly as without a creep phase."""
+    if not creeps(p.law):
+        return False
+    k_max = stiffness(min(1, n - 1), n, p.l2)
+    return creep_weakening(p.law) < k_max
+
+
+@nb.njit(cache=True, inline="always")
+def creeping(C, i):
+    return C[i, CR_EP] != 0.0
+
+
+@nb.njit(cache=True)
+def run_of(C, n, j):
+    """(lo, hi): the run of creeping blocks around block j, j counted as creeping."""
+    lo = j
+    while lo > 0 and creeping(C, lo - 1):
+        lo -= 1
+    hi = j
+    while hi < n - 1 and creeping(C, hi + 1):
+        hi += 1
+    return lo, hi
+
+
+@nb.njit(cache=True)
+def stable(n, l2, weakening, lo, hi):
+    """The cluster lo..hi may creep: K_C - weakening I is positive definite (every pivot of its
+    tridiagonal LDL^T factorisation positive)."""
+    pivot = 1.0
+    for i in range(lo, hi + 1):
+        d = stiffness(i, n, l2) - weakening
+        if i > lo:
+            d -= l2 * l2 / pivot
+        if not d > 0.0:
+            return False
+        pivot = d
+    return True
+
+
+@nb.njit(cache=True)
+def fastest_creep(C, n, l2, weakening, nu, lo, hi):
+    """C[lo..hi, CR_RES] = (K_C - weakening I)^-1 nu 1 for the stable cluster lo..hi: the fastest creep
+    it can sustain (its creep velocities solve M v = nu - b exp(-psi) <= nu componentwise, and M^-1
+    has positive entries). Thomas' algorithm, the pivots in CR_DIAG."""
+    for i in range(lo, hi + 1):
+        d = stiffness(i, n, l2) - weakening
+        r = nu
+        if i > lo:
+            m = -l2 / C[i - 1, CR_DIAG]
+            d += m * l2
+            r -= m * C[i - 1, CR_RES]
+        C[i, CR_DIAG] = d
+        C[i, CR_RES] = r
+    C[hi, CR_RES] /= C[hi, CR_DIAG]
+    for i in range(hi - 1, lo - 1, -1):
+        C[i, CR_RES] = (C[i, CR_RES] + l2 * C[i + 1, CR_RES]) / C[i, CR_DIAG]
+
+
+@nb.njit(cache=True, inline="always")
+def _creep_time(cs):
+    return cs[CS_T_HI], cs[CS_T_LO]
+
+
+@nb.njit(cache=True)
+def _watched(C, n, j):
+    """Block j is creeping or beside a creeping block: off the onset schedule."""
+    return creeping(C, j) or creeping(C, left(j)) or creeping(C, right(j, n))
+
+
+@nb.njit(cache=True)
+def rekey(arrays, n, p, j):
+    """Block j's onset key: inf while creep watches it, else its onset by loading alone."""
+    if _watched(arrays.creep, n, j):
+        tree_set(arrays.tree, j, np.inf)
+    else:
+        tree_set(arrays.tree, j, onset_key(arrays.W, arrays.since, j, p))
+
+
+@nb.njit(cache=True)
+def off_schedule(arrays, n):
+    """Creeping blocks and their neighbours off the onset schedule (after it was built anew)."""
+    for j in range(n):
+        if _watched(arrays.creep, n, j):
+            tree_set(arrays.tree, j, np.inf)
+
+
+@nb.njit(cache=True)
+def _new_episode(E, cs, t, j):
+    """A free slot of the episode table for an episode starting at block j at time t (two floats)."""
+    slot = 0
+    while E[slot, E_STATE] != 0.0:
+        slot += 1
+    E[slot, :] = 0.0
+    E[slot, E_STATE] = E_RUNNING
+    E[slot, E_START_HI] = t[0]
+    E[slot, E_START_LO] = t[1]
+    E[slot, E_EPICENTER] = j
+    E[slot, E_FIRST] = j
+    E[slot, E_LAST] = j
+    cs[CS_SERIAL] += 1.0
+    E[slot, E_SERIAL] = cs[CS_SERIAL]
+    return slot
+
+
+@nb.njit(cache=True)
+def join(arrays, n, p, j, v0, t):
+    """Block j starts to creep at time t (two floats; its F0 and P hold there) with velocity v0:
+    into the episode of a creeping neighbour (the left one first), or a new episode."""
+    C, E, cs, W, since = arrays.creep, arrays.episodes, arrays.cstate, arrays.W, arrays.since
+    if cs[CS_NCREEP] == 0.0:
+        # a new creep phase: its clock starts here, its first step from the state's own time scale
+        cs[CS_T_HI] = t[0]
+        cs[CS_T_LO] = t[1]
+        cs[CS_H] = p.creep_tol * math.exp(W[j, P]) + 2.0 * math.pi / math.sqrt(stiffness(min(1, n - 1), n, p.l2))
+    if j > 0 and creeping(C, j - 1):
+        slot = int(C[j - 1, CR_EP]) - 1
+    elif j < n - 1 and creeping(C, j + 1):
+        slot = int(C[j + 1, CR_EP]) - 1
+    else:
+        slot = _new_episode(E, cs, t, j)
+    C[j, CR_EP] = slot + 1
+    C[j, CR_V] = v0
+    E[slot, E_ACTIVE] += 1.0
+    if C[j, CR_SERIAL] != E[slot, E_SERIAL]:
+        C[j, CR_SERIAL] = E[slot, E_SERIAL]
+        E[slot, E_NBLOCKS] += 1.0
+    cs[CS_NCREEP] += 1.0
+    for k in (left(j), j, right(j, n)):
+        if k != j and not creeping(C, k):
+            materialize(W, since, k, t, p)      # a watched neighbour stays at the creep's time
+        tree_set(arrays.tree, k, np.inf)
+
+
+@nb.njit(cache=True)
+def leave(arrays, n, p, i, t, outcome):
+    """Block i stops creeping at time t (two floats): it stopped (outcome E_STOPPED) or an event took
+    it (E_RUPTURED). Its episode ends with its last block."""
+    C, E, cs = arrays.creep, arrays.episodes, arrays.cstate
+    slot = int(C[i, CR_EP]) - 1
+    C[i, CR_EP] = 0.0
+    C[i, CR_V] = 0.0
+    cs[CS_NCREEP] -= 1.0
+    E[slot, E_ACTIVE] -= 1.0
+    if E[slot, E_ACTIVE] == 0.0:
+        E[slot, E_STATE] = outcome
+        E[slot, E_END_HI] = t[0]
+        E[slot, E_END_LO] = t[1]
+        cs[CS_ENDED] += 1.0
+    for k in (left(i), i, right(i, n)):
+        rekey(arrays, n, p, k)
+
+
+@nb.njit(cache=True)
+def _step_sizes(C, since, n, t, h):
+    """CR_H of every creeping block: from its own time to t + h (they differ after an event)."""
+    for i in range(n):
+        if creeping(C, i):
+            C[i, CR_H] = h + ((t[0] - since[i, 0]) + (t[1] - since[i, 1]))
+
+
+@nb.njit(cache=True)
+def _newton(arrays, n, p):
+    """One backward-Euler step of every creeping block to its CR_H: the velocities CR_VN that put
+    every creeping block's force at the step's end on its friction, with psi from its own state
+    equation (creep_state). Tridiagonal Newton from CR_V. Returns False if it does not converge or
+    a pivot is not negative (the step's system is no longer that of a creeping cluster)."""
+    C, W = arrays.creep, arrays.W
+    l2 = p.l2
+    for i in range(n):
+        if creeping(C, i):
+            C[i, CR_VN] = C[i, CR_V]
+            C[i, CR_PSI] = W[i, P]
+    for _ in range(_NEWTON):
+        for i in range(n):
+            if creeping(C, i):
+                h = C[i, CR_H]
+                v = C[i, CR_VN]
+                psi, dpsi = creep_state(p.law, W[i, P], v, h)
+                C[i, CR_PSI] = psi
+                C[i, CR_DPSI] = dpsi
+                C[i, CR_DU] = h * v
+        done = True
+        for i in range(n):
+            if not creeping(C, i):
+                continue
+            h = C[i, CR_H]
+            v = C[i, CR_VN]
+            psi = C[i, CR_PSI]
+            du_l = C[i - 1, CR_DU] if i > 0 and creeping(C, i - 1) else 0.0
+            du_r = C[i + 1, CR_DU] if i < n - 1 and creeping(C, i + 1) else 0.0
+            force = W[i, F0] + p.nu * h - stiffness(i, n, l2) * C[i, CR_DU] + l2 * (du_l + du_r)
+            f_v, f_psi = friction_slopes(p.law, v, psi)
+            d = -stiffness(i, n, l2) * h - f_v - f_psi * C[i, CR_DPSI]
+            r = -(force - friction(p.law, v, psi))
+            if i > 0 and creeping(C, i - 1):
+                m = l2 * C[i - 1, CR_H] / C[i - 1, CR_DIAG]     # J[i, i-1] / pivot[i-1]
+                d -= m * l2 * h                                   # J[i-1, i] = l2 h_i
+                r -= m * C[i - 1, CR_RES]
+            if not d < 0.0:
+                return False
+            C[i, CR_DIAG] = d
+            C[i, CR_RES] = r
+        for i in range(n - 1, -1, -1):
+            if not creeping(C, i):
+                continue
+            r = C[i, CR_RES]
+            if i < n - 1 and creeping(C, i + 1):
+                r -= l2 * C[i + 1, CR_H] * C[i + 1, CR_UPPER]
+            delta = r / C[i, CR_DIAG]
+            C[i, CR_UPPER] = delta          # the step of block i, read by block i - 1
+            v = C[i, CR_VN] + delta
+            C[i, CR_VN] = v
+            # converged: the update is below 1e-12 of v, or below what the rounding of the force
+            # (~1e-14 of its size) moves v by
+            if not (abs(delta) <= 1e-12 * abs(v) + 1e-14 * (abs(W[i, F0]) + 1.0) / abs(C[i, CR_DIAG])):
+                done = False
+        if done:
+            for i in range(n):
+                if creeping(C, i):
+                    C[i, CR_PSI], C[i, CR_DPSI] = creep_state(p.law, W[i, P], C[i, CR_VN], C[i, CR_H])
+                    C[i, CR_DU] = C[i, CR_H] * C[i, CR_VN]
+            return True
+    return False
+
+
+@nb.njit(cache=True)
+def _excess(W, C, since, n, p, j, t, h, x):
+    """Force above the static threshold of resting block j at fraction x of the creep step of size
+    h from time t (two floats): loading since its own time, and x of its creeping neighbours'
+    slips over the step (backward Euler: linear in time)."""
+    dt = (t[0] - since[j, 0]) + (t[1] - since[j, 1]) + x * h
+    slip = 0.0
+    for k in (left(j), right(j, n)):
+        if k != j and creeping(C, k):
+            slip += C[k, CR_DU]
+    return W[j, F0] + p.nu * dt + p.l2 * x * slip - threshold(p.law, rest_state(p.law, W[j, P], dt))
+
+
+@nb.njit(cache=True)
+def _locate(W, C, since, n, p, j, t, h):
+    """The earliest fraction of the step by which resting block j has reached its threshold (it has
+    by the step's end), by bisection."""
+    if _excess(W, C, since, n, p, j, t, h, 0.0) >= 0.0:
+        return 0.0
+    lo = 0.0
+    hi = 1.0
+    for _ in range(_BISECT):
+        mid = 0.5 * (lo + hi)
+        if _excess(W, C, since, n, p, j, t, h, mid) > 0.0:
+            hi = mid
+        else:
+            lo = mid
+    return hi
+
+
+@nb.njit(cache=True)
+def _rate(law, v, psi):
+    """The state's rate (a call of its own: numba's inliner mislabels two in one loop)."""
+    return state_rate(law, v, psi)
+
+
+@nb.njit(cache=True)
+def _error(arrays, n, p):
+    """The step's error norm: half the change over the step of the state's rate and of the
+    velocity (backward Euler's local error), in psi, relative to integrator.creep_tol; the slip's
+    error counts as the force it makes (K_ii du) over the law's weakening."""
+    C, W = arrays.creep, arrays.W
+    w = creep_weakening(p.law)
+    err = 0.0
+    for i in range(n):
+        if not creeping(C, i):
+            continue
+        g_end = _rate(p.law, C[i, CR_VN], C[i, CR_PSI])
+        g_start = _rate(p.law, C[i, CR_V], W[i, P])
+        dv = C[i, CR_VN] - C[i, CR_V]
+        e = 0.5 * C[i, CR_H] * (abs(g_end - g_start) + stiffness(i, n, p.l2) * abs(dv) / w) / p.creep_tol
+        err = max(err, e)
+    return err
+
+
+@nb.njit(cache=True)
+def _commit(arrays, n, p, t_new):
+    """The step's end becomes the state: creeping blocks' force, psi, velocity and time; their resting
+    neighbours brought to t_new with the creeping blocks' slip in their force; episode statistics."""
+    C, E, W, since = arrays.creep, arrays.episodes, arrays.W, arrays.since
+    l2 = p.l2
+    for i in range(n):
+        if creeping(C, i):
+            h = C[i, CR_H]
+            du_l = C[i - 1, CR_DU] if i > 0 and creeping(C, i - 1) else 0.0
+            du_r = C[i + 1, CR_DU] if i < n - 1 and creeping(C, i + 1) else 0.0
+            C[i, CR_RES] = W[i, F0] + p.nu * h - stiffness(i, n, l2) * C[i, CR_DU] + l2 * (du_l + du_r)
+    for j in range(n):
+        if not creeping(C, j) and _watched(C, n, j):
+            materialize(W, since, j, t_new, p)
+            for k in (left(j), right(j, n)):
+                if k != j and creeping(C, k):
+                    W[j, F0] += l2 * C[k, CR_DU]
+    for i in range(n):
+        if creeping(C, i):
+            W[i, F0] = C[i, CR_RES]
+            W[i, P] = C[i, CR_PSI]
+            since[i, 0] = t_new[0]
+            since[i, 1] = t_new[1]
+            v = C[i, CR_VN]
+            C[i, CR_V] = v
+            slot = int(C[i, CR_EP]) - 1
+            du = C[i, CR_DU]
+            E[slot, E_BLOCK_STEPS] += 1.0
+            if du > 0.0:
+                E[slot, E_SLIP] += du
+                E[slot, E_FIRST] = min(E[slot, E_FIRST], i)
+                E[slot, E_LAST] = max(E[slot, E_LAST], i)
+            if v > E[slot, E_VMAX]:
+                E[slot, E_VMAX] = v
+
+
+@nb.njit(cache=True)
+def _solve(arrays, n, p, t, h):
+    """The creep step from time t (two floats) by h: Newton, and every block whose velocity comes out
+    negative stops at t (it is at rest instead: an active-set pass), until none does. Returns
+    (converged, work in block-steps)."""
+    C, cs = arrays.creep, arrays.cstate
+    work = 0
+    while cs[CS_NCREEP] > 0.0:
+        _step_sizes(C, arrays.since, n, t, h)
+        work += int(cs[CS_NCREEP])
+        if not _newton(arrays, n, p):
+            return False, work
+        backward = False
+        for i in range(n):
+            if creeping(C, i) and C[i, CR_VN] < 0.0:
+                leave(arrays, n, p, i, t, E_STOPPED)
+                C[i, CR_LEFT] = 1.0
+                backward = True
+        if not backward:
+            break
+    return True, work
+
+
+@nb.njit(cache=True)
+def _fastest(C, n):
+    """The creeping block with the largest velocity (the epicenter of a hand-over by time scale)."""
+    who = -1
+    vmax = -np.inf
+    for i in range(n):
+        if creeping(C, i) and C[i, CR_V] > vmax:
+            who, vmax = i, C[i, CR_V]
+    return who
+
+
+@nb.njit(cache=True)
+def continue_creep(arrays, clock, n, p, budget):
+    """Advance the creeping blocks by steps until something needs the caller. Returns
+    (code, work spent, block): REACHED when the creep has reached the schedule's next onset by
+    loading alone (or nothing creeps), the caller starts that block; ENDED when episodes have ended
+    (cstate[CS_ENDED] of them, their rows wait in the episode table); HANDOVER when `block` starts an
+    inertial event (its cluster too soft, or the creep's steps down to inertia's time scale) at the
+    creep's time; PAUSED when the budget (block-steps, as events count them) ran out before a step.
+    `clock` follows the creep's time."""
+    C, cs, W, since, tree = arrays.creep, arrays.cstate, arrays.W, arrays.since, arrays.tree
+    w = creep_weakening(p.law)
+    inertial = 2.0 * math.pi / math.sqrt(stiffness(min(1, n - 1), n, p.l2))
+    t = np.empty(2)
+    t_new = np.empty(2)
+    used = 0
+    while True:
+        if cs[CS_ENDED] > 0.0:
+            return ENDED, used, -1
+        t[0], t[1] = cs[CS_T_HI], cs[CS_T_LO]
+        if (t[0] - clock[0]) + (t[1] - clock[1]) > 0.0:
+            clock[0], clock[1] = t[0], t[1]
+        if cs[CS_NCREEP] == 0.0:
+            return REACHED, used, -1
+        key, far = tree_min(tree)
+        t_far = np.inf
+        if key != np.inf:
+            t_far = (since[far, 0] - t[0]) + (since[far, 1] - t[1]) + onset_delay(p.law, W[far, F0], W[far, P], p.nu)
+        if t_far < inertial:
+            # the next onset is within one inertial period: creep moves nothing in that time, and
+            # each creeping block steps from its own time later on
+            return REACHED, used, -1
+        if used >= budget:
+            return PAUSED, used, -1
+        # -- the step, retried shorter until its error is accepted
+        h = min(cs[CS_H], t_far)
+        err = 0.0
+        while True:
+            solved, work = _solve(arrays, n, p, t, h)
+            used += work
+            if solved and (cs[CS_NCREEP] == 0.0 or h <= inertial):
+                break
+            err = _error(arrays, n, p) if solved else np.inf
+            if err <= 1.0:
+                break
+            # creep as fast as inertia's time scale is no longer quasi-static: an event
+            h = max(h * max(_SHRINK, 0.9 / math.sqrt(err)), h * 0.25)
+            if h < inertial:
+                return HANDOVER, used, _fastest(C, n)
+        if cs[CS_NCREEP] == 0.0:
+            continue
+        cs[CS_H] = max(h * min(_GROW, max(_SHRINK, 0.9 / math.sqrt(max(err, 1e-10)))), inertial)
+        # -- the earliest onset inside the step: a resting neighbour of a creeping block, or the
+        # schedule's next block by loading alone
+        x_cut = 2.0
+        who = -1
+        for j in range(n):
+            if C[j, CR_LEFT] != 0.0:
+                C[j, CR_LEFT] = 0.0     # stopped in this step: its onset is looked for from the next
+                continue
+            if not creeping(C, j) and _watched(C, n, j) and _excess(W, C, since, n, p, j, t, h, 1.0) > 0.0:
+                x = _locate(W, C, since, n, p, j, t, h)
+                if x < x_cut:
+                    x_cut, who = x, j
+        far_first = False
+        if t_far <= h and t_far / h < x_cut:
+            x_cut, who, far_first = t_far / h, far, True
+        if who >= 0 and x_cut < 1.0:
+            if x_cut == 0.0:
+                h = 0.0
+            else:
+                h *= x_cut
+                solved, work = _solve(arrays, n, p, t, h)
+                used += work
+                if not solved:
+                    return HANDOVER, used, _fastest(C, n)
+        if h > 0.0:
+            t_new[0], t_new[1] = t[0], t[1]
+            advance_clock(t_new, h)
+            _commit(arrays, n, p, t_new)
+            cs[CS_T_HI], cs[CS_T_LO] = t_new[0], t_new[1]
+            clock[0], clock[1] = t_new[0], t_new[1]
+        if who < 0 or far_first:
+            continue
+        # -- a resting neighbour starts: it creeps with its cluster, or the cluster ruptures
+        t[0], t[1] = cs[CS_T_HI], cs[CS_T_LO]
+        lo, hi = run_of(C, n, who)
+        if not stable(n, p.l2, w, lo, hi):
+            return HANDOVER, used, who
+        join(arrays, n, p, who, 0.0, t)
+
+
+@nb.njit(cache=True)
+def slow_enough(arrays, n, p, na):
+    """Every sliding block of the event in progress (act[:na]) could creep instead: each run of
+    sliding blocks is a stable cluster, and each block moves forward no faster than the fastest
+    creep its cluster can sustain ((K_C - b I)^-1 nu, fastest_creep). The event then hands its
+    blocks back to creep; the kinetic energy it drops is at most that of those creep velocities."""
+    W, act, flag, C = arrays.W, arrays.act, arrays.flag, arrays.creep
+    w = creep_weakening(p.law)
+    for k in range(na):
+        if not W[act[k], V] > 0.0:
+            return False
+    for k in range(na):
+        lo = act[k]
+        if lo > 0 and flag[lo - 1] == SLIDING:
+            continue        # not the first block of its run
+        hi = lo
+        while hi < n - 1 and flag[hi + 1] == SLIDING:
+            hi += 1
+        if not stable(n, p.l2, w, lo, hi):
+            return False
+        fastest_creep(C, n, p.l2, w, p.nu, lo, hi)
+        for i in range(lo, hi + 1):
+            if W[i, V] > C[i, CR_RES]:
+                return False
+    return True
+
+
+@nb.njit(cache=True)
+def after_event(arrays, n, p, clock):
+    """The event that just ended (its touched blocks, event.py) meets the creep: creeping blocks it
+    took leave their episodes (RUPTURED), blocks it handed back (CR_HB) start to creep with their
+    velocity, the creep goes on from the event's end, and the blocks around it are rescheduled."""
+    C, cs, touched = arrays.creep, arrays.cstate, arrays.touched
+    nt = int(arrays.event[EV_NT])
+    t = np.empty(2)
+    for k in range(nt):
+        i = touched[k]
+        if creeping(C, i):
+            t[0], t[1] = arrays.since[i, 0], arrays.since[i, 1]
+            leave(arrays, n, p, i, t, E_RUPTURED)
+    for k in range(nt):
+        i = touched[k]
+        if C[i, CR_HB] != 0.0:
+            C[i, CR_HB] = 0.0
+            t[0], t[1] = arrays.since[i, 0], arrays.since[i, 1]
+            join(arrays, n, p, i, C[i, CR_VN], t)
+    if cs[CS_NCREEP] > 0.0:
+        cs[CS_T_HI], cs[CS_T_LO] = clock[0], clock[1]
+    for k in range(nt):
+        i = touched[k]
+        for j in (left(i), i, right(i, n)):
+            rekey(arrays, n, p, j)
+
+
+@nb.njit(cache=True)
+def report(arrays, n, out_t, out_epicenter, out_diag, k):
+    """The next ended episode into row k of the output (kind 1); returns the rows written (0 or 1,
+    an episode that slipped nothing is dropped) and frees its slot."""
+    E, cs = arrays.episodes, arrays.cstate
+    for slot in range(E.shape[0]):
+        state = E[slot, E_STATE]
+        if state == E_STOPPED or state == E_RUPTURED:
+            E[slot, E_STATE] = 0.0
+            cs[CS_ENDED] -= 1.0
+            if not E[slot, E_SLIP] > 0.0:
+                return 0
+            out_t[k] = E[slot, E_START_HI] + E[slot, E_START_LO]
+            out_epicenter[k] = int(E[slot, E_EPICENTER])
+            out_diag[k, :] = 0.0
+            out_diag[k, D_DURATION] = (E[slot, E_END_HI] - E[slot, E_START_HI]) + (E[slot, E_END_LO] - E[slot, E_START_LO])
+            out_diag[k, D_SLIP] = E[slot, E_SLIP]
+            out_diag[k, D_FIRST] = E[slot, E_FIRST]
+            out_diag[k, D_LAST] = E[slot, E_LAST]
+            out_diag[k, D_NSLIP] = E[slot, E_NBLOCKS]
+            out_diag[k, D_VMAX] = E[slot, E_VMAX]
+            out_diag[k, D_BLOCK_STEPS] = E[slot, E_BLOCK_STEPS]
+            out_diag[k, D_KIND] = KIND_CREEP
+            out_diag[k, D_ENDING] = 1.0 if state == E_STOPPED else 2.0
+            return 1
+    return 0
