@@ -63,7 +63,7 @@ from .common import (Clock, ks_distance, minutes, parse_setting, pyplot, rough_e
                      trajectory, wasserstein1, write_outputs)
 
 RUNS = ["rk4:dt=1e-3", "ark3:rtol=1e-5", "ark4:rtol=1e-4", "ark4:rtol=1e-5", "ark4:rtol=1e-6",
-        "ark5:rtol=1e-5"]
+        "ark5:rtol=1e-5", "exp4:rtol=1e-4", "exp4:rtol=1e-3"]
 DISTANCES = {"ks": ks_distance, "w1": wasserstein1}
 SAMPLES = ("mu", "tnu")
 MAX_SPLITS = 10

@@ -33,7 +33,8 @@ from ensemble.model.workspace import F0, NCOLS, P, P0, V, V0, Y, Y0, YS
 from .common import parse_setting, single_event_parser, write_outputs
 from .work_precision import kernel_event, pre_event_states
 
-RUNS = ["rk4:dt=1e-3", "ark4:rtol=3e-5", "ark4:rtol=1e-5", "ark4:rtol=3e-6", "ark5:rtol=3e-5", "ark5:rtol=1e-5"]
+RUNS = ["rk4:dt=1e-3", "ark4:rtol=1e-4", "ark4:rtol=3e-5", "ark4:rtol=1e-5", "ark4:rtol=3e-6", "ark5:rtol=3e-5",
+        "ark5:rtol=1e-5", "exp4:rtol=1e-4", "exp4:rtol=1e-3"]
 SIZES = ["small:-inf:3", "large:4:5", "system-size:5:inf"]
 SLIDING = 4     # blocks sliding in the step-alone timing
 

@@ -30,7 +30,7 @@ from .common import parse_setting, single_event_parser, write_outputs
 from .step_budget import parse_sizes
 from .work_precision import pre_event_states
 
-RUNS = ["ark4:rtol=1e-5", "ark4:rtol=3e-6", "ark5:rtol=3e-5"]
+RUNS = ["ark4:rtol=1e-5", "ark4:rtol=3e-6", "ark5:rtol=3e-5", "ark4:rtol=1e-4", "exp4:rtol=1e-4"]
 SIZES = ["large:4:5", "system-size:5:inf"]
 PARTS = ("slip", "velocity", "psi")
 PHASES = ("onset/knee", "steady", "stopping")

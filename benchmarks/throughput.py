@@ -1,6 +1,6 @@
 """Events per second of a developed chain, one core.
 
-    python benchmarks/throughput.py [--N 800] [--b 20] [--dt 1e-3] [--method rk4|ark3|ark4|ark5]
+    python benchmarks/throughput.py [--N 800] [--b 20] [--dt 1e-3] [--method rk4|ark3|ark4|ark5|exp4]
                                     [--rtol 1e-5] [--transient 1000] [--events 2000]
                                     [--law carlson-langer --alpha 2 --sigma 0.01]
 
@@ -30,7 +30,7 @@ def main():
     p.add_argument("--sigma", type=float, default=0.01, help="carlson-langer's sigma")
     p.add_argument("--nu", type=float, default=Model().nu)
     p.add_argument("--dt", type=float, default=1e-3)
-    p.add_argument("--method", default="rk4", help="rk4, ark3, ark4 or ark5")
+    p.add_argument("--method", default="rk4", help="rk4, ark3, ark4, ark5 or exp4 (the registry, ensemble/model/methods.py)")
     p.add_argument("--rtol", type=float, default=Integrator().rtol,
                    help="tolerance of the adaptive methods (default: the config default)")
     p.add_argument("--transient", type=int, default=1000)

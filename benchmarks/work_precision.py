@@ -39,6 +39,7 @@ RUNS = (["rk4:dt=2e-3", "rk4:dt=1e-3", "rk4:dt=5e-4", "rk4:dt=2.5e-4"]
         + [f"ark3:rtol=1e-{k}" for k in range(4, 9)]
         + [f"ark4:rtol=1e-{k}" for k in range(3, 9)]
         + [f"ark5:rtol=1e-{k}" for k in range(3, 9)]
+        + [f"exp4:rtol=1e-{k}" for k in range(2, 9)]
         + ["numpy-rk4:dt=1e-3", "numpy-rk4:dt=5e-4"]
         + [f"scipy:method=LSODA,rtol=1e-{k}" for k in (4, 6, 8)] + ["scipy:method=BDF,rtol=1e-6"])
 METRICS = ("slip_error", "profile_error")

@@ -21,7 +21,7 @@ from ensemble.model.workspace import D_ENERGY_SCALE, D_RESIDUAL, D_SLIP, D_VMAX
 from ensemble.runner import Trajectory
 from ensemble.tasks import task_list
 
-ADAPTIVE = ["ark3", "ark4"]           # adaptive methods, run at Integrator()'s defaults (a new one is one word here)
+ADAPTIVE = ["ark3", "ark4", "exp4"]           # adaptive methods, run at Integrator()'s defaults (a new one is one word here)
 METHODS = ["rk4", *ADAPTIVE]
 
 # name: (model, RK4 step, events recorded after as many transient events)
