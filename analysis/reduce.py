@@ -1,6 +1,8 @@
 """Catalog -> per-task histograms (streamed) -> per-point statistics with bootstrap intervals.
 
-Each task is cut into `blocks` stretches of consecutive events; histograms and
+The statistics are those of the inertial events (/events/kind 0); a task's creep episodes (kind 1)
+are read and verified with them, and counted in none. Each task is cut into `blocks` stretches of
+consecutive inertial events; histograms and
 sums are kept per (task, stretch). Error bars come from resampling
 independent realisations: the seeds of a parameter point when it has at least
 MIN_UNITS of them, else the stretches of every one of its trajectories (a block
@@ -64,6 +66,7 @@ class TaskHistograms:
     tnu: np.ndarray           # (blocks, n_tnu) counts of T * nu, all large events
     tnu_interior: np.ndarray  # (blocks, n_tnu) counts of T * nu, interior starting events
     numbers: np.ndarray       # (blocks, stats.N_STATS) counts and sums
+    rows: int = 0             # the task's committed rows read, of every kind (analysis/cli.py checks them)
 
 
 def _bin_add(hist, block, values, edges):
@@ -73,13 +76,16 @@ def _bin_add(hist, block, values, edges):
 
 
 def reduce_task(chunks, written, nu, n_blocks_chain, opt):
-    """Stream one task's events (chunks of opt.chunk rows, dicts of columns) into TaskHistograms."""
+    """Stream one task's inertial events (chunks of dicts of columns, `written` rows in all) into
+    TaskHistograms. The chunks are consumed to their end (the catalog checks a task's checksum there)."""
     k = opt.blocks
     out = TaskHistograms(np.zeros((k, len(opt.mu_edges) - 1), np.int64),
                          np.zeros((k, len(opt.tnu_edges) - 1), np.int64),
                          np.zeros((k, len(opt.tnu_edges) - 1), np.int64),
                          np.zeros((k, stats.N_STATS)))
     if written == 0:
+        for _ in chunks:     # (a task of creep episodes alone: still verified)
+            pass
         return out
     scanner = RecurrenceScanner(n_blocks_chain, opt.mu_c, opt.window)
     lo = 0
@@ -115,8 +121,10 @@ def reduce_tasks(path, task_indices, opt):
     with filekind.reading(path, "the event catalog", catalog.CatalogError), catalog.Reader(path) as cat:
         tasks = cat.tasks
         for k in task_indices:
-            out[k] = reduce_task(cat.task_events(k, opt.chunk), int(tasks["events_written"][k]),
-                                 float(tasks["nu"][k]), int(tasks["N"][k]), opt)
+            # the inertial events only: the creep episodes are no events of R(mu) or of the recurrences
+            out[k] = reduce_task(cat.task_events(k, opt.chunk, kind=catalog.KIND_EVENT),
+                                 cat.count(k, catalog.KIND_EVENT), float(tasks["nu"][k]), int(tasks["N"][k]), opt)
+            out[k].rows = int(tasks["events_written"][k])
     return out
 
 

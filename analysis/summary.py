@@ -65,7 +65,7 @@ CURVES = {   # name -> (its bins, its variable, whose variable, the density's un
                      "1/model length"),
 }
 NUMBER_MEANINGS = {   # name -> (unit, meaning), in the order of reduce.NUMBERS
-    "n_events": ("count", "events"),
+    "n_events": ("count", "inertial events (/events/kind 0: creep episodes are in none of these numbers)"),
     "n_large": ("count", "large events (mu >= mu_c)"),
     "fraction_large": ("1", "fraction of the events with mu >= mu_c"),
     "n_recurrences": ("count", "recurrences: large events closed by a later one within `window` blocks"),

@@ -39,7 +39,8 @@ def spins_needed(cfg, tasks, stored=None, rerun=None):
 
 
 def branch_start(cfg, task, spun):
-    """The state a branched task starts from: its point's spun-up state (Checkpoint) with the task's
-    own perturbation, no events done."""
+    """The state a branched task starts from: its point's spun-up state (Checkpoint, its creep state
+    included) with the task's own perturbation, no events done."""
     force = perturb(spun.force, cfg.run.perturbation, branch_rng(cfg, task))
-    return Checkpoint(force, spun.psi.copy(), spun.since.copy(), spun.clock.copy(), 0)
+    return Checkpoint(force, spun.psi.copy(), spun.since.copy(), spun.clock.copy(), 0,
+                      None if spun.creep is None else spun.creep.copy())

@@ -50,18 +50,33 @@ from .config import LAW_KEYS, ConfigError, loads
 from .model import laws
 from .tasks import spinups as spinup_points, task_list
 from .integrity import EventCrc, commit_crc, crc, event_problems
+from .model.workspace import KIND_CREEP, KIND_EVENT, Workspace
 from .tables import FAILED, FINISHED, OPEN, STATUS_NAMES
 
-FORMAT = "bk-catalog-4"
-# formats this version reads: bk-catalog-3 has the same layout without tables_crc and /tasks/record_crc
-# (its tables are checked against its config only); only FORMAT is written and resumed
-READABLE = {"bk-catalog-3", FORMAT}
+FORMAT = "bk-catalog-5"
+# older formats this version reads (not resumes), and what they lack: bk-catalog-4 has no /events/kind and
+# /events/ending (every row an inertial event; the reader supplies kind 0, ending 0) and no creep state in its
+# checkpoints; bk-catalog-3 lacks also tables_crc and /tasks/record_crc (its tables are checked against its
+# config only). Only FORMAT is written and resumed.
+OLDER = {
+    "bk-catalog-4": "written before the creep phase (no /events/kind, no creep state in its checkpoints)",
+    "bk-catalog-3": "written before its tables were checksummed",
+}
+READABLE = {*OLDER, FORMAT}
+CHECKSUMMED = {"bk-catalog-4", FORMAT}      # formats with tables_crc and /tasks/record_crc
 
+# /events/kind: what a row is, KIND_EVENT (0) or KIND_CREEP (1) (ensemble/model/workspace.py, imported above)
+# /events/ending: 0 an inertial event; a creep episode 1 whose blocks all stopped, 2 taken over by an event
+ENDING_EVENT, ENDING_STOPPED, ENDING_TAKEN_OVER = 0, 1, 2
 EVENT_FIELDS = {
     "task": np.int64, "t": np.float64, "epicenter": np.int64, "mu": np.float64,
     "slip": np.float64, "first": np.int64, "last": np.int64, "n_slipped": np.int64,
-    "boundary": np.bool_, "duration": np.float64,
+    "boundary": np.bool_, "duration": np.float64, "kind": np.int8, "ending": np.int8,
 }
+# the columns of the formats before bk-catalog-5 (their events CRC covers these, in this order); the reader
+# supplies the others as SUPPLIED says
+OLDER_EVENT_FIELDS = tuple(EVENT_FIELDS)[:10]
+SUPPLIED = {"kind": KIND_EVENT, "ending": ENDING_EVENT}
 TASK_FIELDS = {
     "point": np.int64, "seed_index": np.int64, "N": np.int64, "l": np.float64, "nu": np.float64,
     # every friction law's keys (model/laws/); NaN for a key of another law than the task's
@@ -82,15 +97,22 @@ _EVENT_ROWS = "(tasks * events_per_task,), task k's rows from k * events_per_tas
 _TASK_ROWS = "(tasks,)"
 DATASETS = {
     "events/task": ("index", _EVENT_ROWS, "task that recorded the event (row of /tasks)"),
-    "events/t": ("model time", _EVENT_ROWS, "onset time of the event"),
-    "events/epicenter": ("index", _EVENT_ROWS, "first block to slide (0-based)"),
+    "events/t": ("model time", _EVENT_ROWS, "onset time of the event (of a creep episode: its start; a task's "
+                                            "events are in time order, its creep episodes in the order they ended)"),
+    "events/epicenter": ("index", _EVENT_ROWS, "first block to slide (0-based; of a creep episode: to creep)"),
     "events/mu": ("log10 model length", _EVENT_ROWS, "magnitude log10(slip)"),
     "events/slip": ("model length", _EVENT_ROWS, "sum of the slips of all blocks"),
     "events/first": ("index", _EVENT_ROWS, "lowest block that slipped"),
     "events/last": ("index", _EVENT_ROWS, "highest block that slipped"),
     "events/n_slipped": ("count", _EVENT_ROWS, "number of blocks that slipped"),
     "events/boundary": ("bool", _EVENT_ROWS, "the rupture reached block 0 or N-1"),
-    "events/duration": ("model time", _EVENT_ROWS, "time from onset until all blocks are at rest"),
+    "events/duration": ("model time", _EVENT_ROWS, "time from onset until all blocks are at rest (of a creep "
+                                                   "episode: from its start until it ended)"),
+    "events/kind": ("code", _EVENT_ROWS, f"{KIND_EVENT} an inertial event, {KIND_CREEP} a creep episode "
+                                         "(quasi-static slip); absent in catalogs before bk-catalog-5: 0"),
+    "events/ending": ("code", _EVENT_ROWS, f"{ENDING_EVENT} an inertial event; a creep episode {ENDING_STOPPED} "
+                                           f"whose blocks all stopped, {ENDING_TAKEN_OVER} taken over by an "
+                                           "inertial event; absent in catalogs before bk-catalog-5: 0"),
     "tasks/point": ("index", _TASK_ROWS, "parameter point (position in the product of the [sweep] lists)"),
     "tasks/seed_index": ("index", _TASK_ROWS, "realisation of its point; task = point * run.seeds + seed_index"),
     "tasks/N": ("count", _TASK_ROWS, "number of blocks of the chain"),
@@ -122,10 +144,14 @@ DATASETS = {
     "spinup/spawn_key": ("index", "(points,)", "the task whose initial state the spin-up started from (its "
                                                 "point's seed 0); it ran run.transient events from there"),
     "spinup/N": ("count", "(points,)", "number of blocks of the spin-up's chain"),
-    "checkpoint/state": ("mixed", "(sum over tasks, then spin-ups, of 2 (4 N + 2),)",
+    "checkpoint/state": ("mixed", "(sum over tasks, then spin-ups, of 2 (4 N + 2 + creep * C(N)),)",
                          "per task two slots of [force (N, model force), psi = ln theta (N), since (2N, model "
-                         "time), clock (2, model time)]: block i's force and psi hold at the two-float time "
-                         "(since[2i], since[2i+1]); clock = (hi, lo) now"),
+                         "time), clock (2, model time), then where /checkpoint/creep is 1 the creep phase's "
+                         "state (C(N) = Workspace.creep_size(N) values, Workspace.creep_state)]: block i's force "
+                         "and psi hold at the two-float time (since[2i], since[2i+1]); clock = (hi, lo) now"),
+    "checkpoint/creep": ("bool", "(tasks + spin-ups,)", "1: the record's chain can creep (model/creep.py "
+                                                         "possible) and its slots hold its creep state; absent in "
+                                                         "catalogs before bk-catalog-5: 0"),
     "checkpoint/offset": ("index", "(tasks + spin-ups,)", "start of each task's (then spin-up's) two slots in "
                                                           "/checkpoint/state"),
     "checkpoint/commit": ("count, CRC-32", "(tasks + spin-ups, 2 slots, 6)",
@@ -157,7 +183,7 @@ def schema(table=None):
 if __doc__:    # (None under python -OO)
     __doc__ += "\nDatasets (DATASETS):\n\n" + schema() + "\n"
 
-_FILL = {np.int64: -1, np.float64: np.nan, np.bool_: False}
+_FILL = {np.int64: -1, np.float64: np.nan, np.bool_: False, np.int8: -1}
 # fields of a commit row (/checkpoint/commit[task, slot])
 C_SEQ, C_DONE, C_WRITTEN, C_STATE_CRC, C_EVENTS_CRC, C_ROW_CRC = range(6)
 NCOMMIT = 6
@@ -196,8 +222,19 @@ def has_parallel_hdf5():
     return bool(h5py.get_config().mpi)
 
 
-def _state_size(n):
-    return 4 * n + 2
+def carries_creep(model):
+    """A record of this model (config.Model) keeps a creep state in its checkpoint slots: some block of its
+    chain can creep (model/creep.py `possible`; not for a law that never creeps, nor above the blocks'
+    stiffness). Fixed at creation in /checkpoint/creep."""
+    from .config import Integrator
+    from .integrators import kernel_params
+    from .model.creep import possible
+    return bool(possible(kernel_params(model, Integrator()), model.N))
+
+
+def _state_size(n, creep=False):
+    """Floats of one checkpoint slot of an n-block record (creep: with its creep state)."""
+    return 4 * n + 2 + (Workspace.creep_size(n) if creep else 0)
 
 
 def _text(value):
@@ -206,19 +243,23 @@ def _text(value):
 
 
 class Checkpoint:
-    """A task's between-events state: forces, psi, their times (N x 2), compensated clock, events done."""
+    """A task's between-events state: forces, psi, their times (N x 2), compensated clock, events done,
+    and for a chain that can creep its creep phase's state (Workspace.creep_state; None: it has none)."""
 
-    def __init__(self, force, psi, since, clock, done):
+    def __init__(self, force, psi, since, clock, done, creep=None):
         self.force, self.psi, self.since, self.clock, self.done = force, psi, since, clock, done
+        self.creep = creep
 
     def pack(self):
-        return np.concatenate([self.force, self.psi, self.since.ravel(), self.clock])
+        return np.concatenate([self.force, self.psi, self.since.ravel(), self.clock,
+                               *(() if self.creep is None else (self.creep,))])
 
     @classmethod
-    def unpack(cls, flat, done):
-        n = (len(flat) - 2) // 4
+    def unpack(cls, flat, done, n):
+        """The inverse of pack for an n-block chain (a creep state if flat is longer than 4 n + 2)."""
+        base = _state_size(n)
         return cls(flat[:n].copy(), flat[n:2 * n].copy(), flat[2 * n:4 * n].reshape(n, 2).copy(),
-                   flat[4 * n:].copy(), int(done))
+                   flat[4 * n:base].copy(), int(done), flat[base:].copy() if len(flat) > base else None)
 
 
 @dataclass(frozen=True)
@@ -254,8 +295,11 @@ class _Layout:
         self.h5 = h5
         self.path = h5.filename
         self.barrier = barrier
+        self.format = h5.attrs.get("format")
+        # the event columns this catalog stores (those of its format), in the order of its events CRC
+        self.event_fields = tuple(EVENT_FIELDS) if self.format == FORMAT else OLDER_EVENT_FIELDS
         try:
-            self.events = {name: h5["events"][name] for name in EVENT_FIELDS}
+            self.events = {name: h5["events"][name] for name in self.event_fields}
             self.tasks = {name: h5["tasks"][name] for name in h5["tasks"]}
             self.state = h5["checkpoint"]["state"]
             self.offset = h5["checkpoint"]["offset"][...]
@@ -266,13 +310,20 @@ class _Layout:
             # spin-ups (run.branch): records n_tasks + point of /checkpoint, after the tasks'
             self.spinup_events = int(h5.attrs.get("spinup", 0))
             self.spinup = {name: ds[...] for name, ds in h5["spinup"].items()} if "spinup" in h5 else {}
+            # which records keep a creep state in their slots (none before bk-catalog-5)
+            self.creep = (h5["checkpoint"]["creep"][...].astype(np.int64) if self.format == FORMAT else None)
         except (KeyError, OSError, ValueError) as err:
             raise CatalogError(f"{self.path}: damaged catalog ({err})") from None
         n_tasks = len(self.n_blocks)
         self.record_blocks = np.concatenate([self.n_blocks, self.spinup.get("N", np.zeros(0, np.int64))])
         n_records = len(self.record_blocks)
-        sizes = 2 * (4 * self.record_blocks + 2)
+        if self.creep is None:
+            self.creep = np.zeros(n_records, dtype=np.int64)
+        self.slot_sizes = np.array([_state_size(int(n), c == 1) for n, c in zip(self.record_blocks, self.creep)],
+                                   dtype=np.int64)
+        sizes = 2 * self.slot_sizes
         if (self.commit.shape != (n_records, 2, NCOMMIT) or len(self.offset) != n_records
+                or self.creep.shape != (n_records,) or np.any((self.creep != 0) & (self.creep != 1))
                 or any(ds.shape[0] != n_tasks * self.per_task for ds in self.events.values())
                 or np.any(self.record_blocks < 1) or self.per_task < 1 or self.transient < 0
                 or self.spinup_events < 0 or (self.spinup_events > 0) != bool(self.spinup)
@@ -281,7 +332,8 @@ class _Layout:
             raise CatalogError(f"{self.path}: damaged catalog (its datasets do not fit together)")
         self.n_tasks = n_tasks
         self.n_records = n_records
-        self.protected = h5.attrs.get("format") == FORMAT      # (bk-catalog-3: no tables_crc, no record_crc)
+        self.protected = self.format in CHECKSUMMED      # (bk-catalog-3: no tables_crc, no record_crc)
+        self._records = None    # the records' Tasks (tasks, then spin-ups) of the stored config, if it parses
         self._verify_tables()
         self._crc = {}    # task -> EventCrc of its rows written so far (on the writing process)
         self._head = {}   # task -> Head in use (on the writing process)
@@ -329,12 +381,15 @@ class _Layout:
             sg.create_dataset("point", data=np.array([t.point for t in spinups], dtype=np.int64))
             sg.create_dataset("spawn_key", data=np.array([t.index for t in spinups], dtype=np.int64))
             sg.create_dataset("N", data=np.array([t.model.N for t in spinups], dtype=np.int64))
-        sizes = np.array([2 * _state_size(t.model.N) for t in list(tasks) + spinups], dtype=np.int64)
+        records = list(tasks) + spinups
+        creep = np.array([carries_creep(t.model) for t in records], dtype=np.int8)
+        sizes = np.array([2 * _state_size(t.model.N, c) for t, c in zip(records, creep)], dtype=np.int64)
         offset = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
         cp = h5.create_group("checkpoint")
         cp.create_dataset("state", shape=(int(sizes.sum()),), dtype=np.float64, fillvalue=np.nan,
                           dcpl=_early_allocation())
         cp.create_dataset("offset", data=offset)
+        cp.create_dataset("creep", data=creep)
         cp.create_dataset("commit", data=np.zeros((len(sizes), 2, NCOMMIT), dtype=np.int64))
         # metadata, written once here like the rest of the layout; under mpio every rank runs
         # this with the same values in the same order, as attribute writes are collective
@@ -364,6 +419,7 @@ class _Layout:
             return
         tasks = task_list(cfg)
         spinups = spinup_points(cfg, tasks)
+        self._records = list(tasks) + spinups
         wrong = tables.config_problems({name: ds[...] for name, ds in self.tasks.items()},
                                        tables.expected_parameters(tasks, spinups, LAW_KEYS))
         if (self.per_task, self.transient, self.spinup_events) != (
@@ -418,26 +474,31 @@ class _Layout:
 
         The CRC comparison happens after the last chunk: consume the whole generator.
         """
-        running = EventCrc(EVENT_FIELDS)
+        running = EventCrc(self.event_fields)
         base = task * self.per_task
         last_t = -np.inf
         for lo in range(0, written, chunk):
             hi = min(lo + chunk, written)
             part = {name: ds[base + lo:base + hi] for name, ds in self.events.items()}
-            running.update(part)
+            running.update(part)     # (the columns stored: an older catalog's CRC covers only those)
+            for name, value in SUPPLIED.items():
+                if name not in part:
+                    part[name] = np.full(hi - lo, value, dtype=EVENT_FIELDS[name])
+            part = {name: part[name] for name in EVENT_FIELDS}
             problems = event_problems(part, int(self.n_blocks[task]), lo, last_t)
             if np.any(part["task"] != task):
                 problems.append(f"event {lo + int(np.argmax(part['task'] != task))}: a row of another task")
             if problems:
                 raise self._fail(task, "; ".join(problems))
-            last_t = part["t"][-1]
+            inertial = part["t"][part["kind"] == KIND_EVENT]
+            last_t = inertial[-1] if len(inertial) else last_t
             yield part
         self._check_events(task, written, running)
         return running
 
     def _check_events(self, task, written, running):
         head = self.head(task)
-        expected = head.events_crc if head is not None else EventCrc(EVENT_FIELDS).combined()
+        expected = head.events_crc if head is not None else EventCrc(self.event_fields).combined()
         if head is not None and head.written != written:
             raise CatalogError(f"{self.path}: task {task}: asked for {written} events, {head.written} committed")
         if running.combined() != expected:
@@ -453,14 +514,14 @@ class _Layout:
                 return stop.value
 
     def read_state(self, task, head):
-        size = _state_size(int(self.record_blocks[task]))
+        size = int(self.slot_sizes[task])
         lo = self.offset[task] + head.slot * size
         flat = self.state[lo:lo + size]
         if crc(flat) != head.state_crc:
             raise self._fail(task, f"checkpoint slot {head.slot} fails its checksum")
         if not np.all(np.isfinite(flat)):
             raise self._fail(task, f"checkpoint slot {head.slot} holds non-finite values")
-        return Checkpoint.unpack(flat, head.done)
+        return Checkpoint.unpack(flat, head.done, int(self.record_blocks[task]))
 
     def record(self, task, restart=False):
         """The task's TaskRecord, its checkpoint and events verified; the writer's state for it set up.
@@ -468,6 +529,7 @@ class _Layout:
         restart: the task is taken up from its start (a failed task rerun): nothing is read back.
         """
         head = self.head(task)
+        self._check_creep_layout(task)
         self._head[task] = head
         if task >= self.n_tasks:     # a spin-up: only its state
             rec = TaskRecord()
@@ -478,12 +540,25 @@ class _Layout:
             if not restart:
                 rec.damaged = self.record_problem(task)
         if head is None or restart or rec.damaged:
-            self._crc[task] = EventCrc(EVENT_FIELDS)
+            self._crc[task] = EventCrc(self.event_fields)
             return rec
         self._crc[task] = self.verify_events(task, head.written)
         rec.checkpoint = self.read_state(task, head)
         rec.written = head.written
         return rec
+
+    def _check_creep_layout(self, task):
+        """A record is continued only if its slots hold a creep state exactly when this version's kernel
+        keeps one for its chain (carries_creep): a checkpoint could not hold the state, or restore it."""
+        if self._records is None:     # (a config this version cannot parse: its tables_crc stands alone)
+            return
+        wants = carries_creep(self._records[task].model)
+        if wants != bool(self.creep[task]):
+            what = f"task {task}" if task < self.n_tasks else f"the spin-up of point {task - self.n_tasks}"
+            raise CatalogError(f"{self.path}: {what}: its checkpoint slots were laid out "
+                               f"{'with' if self.creep[task] else 'without'} a creep state, and this version "
+                               f"{'keeps one' if wants else 'keeps none'} for its chain: finish it with the "
+                               f"version that wrote it, or rerun")
 
     # -- writing ---------------------------------------------------------------------------
 
@@ -514,6 +589,9 @@ class _Layout:
         slot = 0 if head is None else 1 - head.slot
         seq = 1 if head is None else head.seq + 1
         flat = checkpoint.pack()
+        if len(flat) != self.slot_sizes[task]:
+            raise CatalogError(f"{self.path}: task {task}: a checkpoint of {len(flat)} values for slots of "
+                               f"{self.slot_sizes[task]} ({'with' if self.creep[task] else 'without'} a creep state)")
         lo = self.offset[task] + slot * len(flat)
         self._write(task, "checkpoint", lambda: self.state.__setitem__(slice(lo, lo + len(flat)), flat))
         self.barrier()
@@ -578,6 +656,8 @@ def _fixed_digest(h5):
     named = {f"tasks/{name}": ds[...] for name, ds in h5["tasks"].items() if name not in _REWRITTEN}
     named.update({f"spinup/{name}": ds[...] for name, ds in h5["spinup"].items()} if "spinup" in h5 else {})
     named["checkpoint/offset"] = h5["checkpoint"]["offset"][...]
+    if "creep" in h5["checkpoint"]:    # (bk-catalog-5 on)
+        named["checkpoint/creep"] = h5["checkpoint"]["creep"][...]
     named.update({f"@{name}": h5.attrs[name] for name in tables.FIXED_ATTRS if name in h5.attrs})
     return tables.digest(named)
 
@@ -605,8 +685,8 @@ def estimate_bytes(cfg, tasks):
     """An upper bound of the size of the catalog of `tasks` (what space.check_fits asks for)."""
     records = list(tasks) + spinup_points(cfg, tasks)
     data = (len(tasks) * cfg.run.events * sum(np.dtype(t).itemsize for t in EVENT_FIELDS.values())
-            + 8 * sum(2 * _state_size(t.model.N) for t in records)            # checkpoint slots
-            + len(records) * 8 * (2 * NCOMMIT + 1)                            # commit rows, offsets
+            + 8 * sum(2 * _state_size(t.model.N, carries_creep(t.model)) for t in records)   # checkpoint slots
+            + len(records) * (8 * (2 * NCOMMIT + 1) + 1)                      # commit rows, offsets, creep
             + len(tasks) * (8 * (len(TASK_FIELDS) + len(PROVENANCE_FIELDS) + 5) + 2 * TEXT_BYTES + LAW_BYTES))
     metadata = 4096 * (len(DATASETS) + 4) + 2 * len(cfg.to_toml()) + 64 * 1024
     return int(data * 1.01) + metadata
@@ -909,9 +989,9 @@ def _check_format(h5, path, writing=False):
     if found == FORMAT or (found in READABLE and not writing):
         return
     h5.close()
-    if found in READABLE:
-        raise CatalogError(f"{path}: catalog format {found}, written before its tables were checksummed: this "
-                           f"version reads it but does not continue it (finish it with the older version, or rerun)")
+    if found in OLDER:
+        raise CatalogError(f"{path}: catalog format {found}, {OLDER[found]}: this version reads it but does not "
+                           f"continue it (finish it with the older version, or rerun)")
     if isinstance(found, str) and found.startswith("bk-catalog-"):
         raise CatalogError(f"{path}: catalog format {found}, this version reads {', '.join(sorted(READABLE))} "
                            "(the checkpoint layout changed; rerun, or read it with the older version)")
@@ -989,9 +1069,24 @@ class Reader:
         for name in ("error", "integrator", "law"):
             self.tasks[name] = np.array([x.decode(errors="replace") for x in self.tasks[name]])
 
-    def task_events(self, task, chunk=READ_CHUNK):
-        """The task's committed events in chunks; raises CatalogError if they are corrupt."""
-        return self.layout.task_events(task, int(self.tasks["events_written"][task]), chunk)
+    def task_events(self, task, chunk=READ_CHUNK, kind=None):
+        """The task's committed rows in chunks; raises CatalogError if they are corrupt.
+
+        kind: only the rows of that kind (KIND_EVENT: the inertial events, what today's statistics
+        read), chunks with none left out; every row is still read and verified (consume them all).
+        """
+        parts = self.layout.task_events(task, int(self.tasks["events_written"][task]), chunk)
+        if kind is None:
+            return parts
+        return _of_kind(parts, kind)
+
+    def count(self, task, kind):
+        """The task's committed rows of that kind (/events/kind alone, not verified: task_events verifies)."""
+        written = int(self.tasks["events_written"][task])
+        if "kind" not in self.layout.events:      # (before bk-catalog-5: every row an inertial event)
+            return written if kind == SUPPLIED["kind"] else 0
+        base = task * self.per_task
+        return int(np.count_nonzero(self.layout.events["kind"][base:base + written] == kind))
 
     def events(self):
         """Every committed event (dict of arrays, tasks in order), verified."""
@@ -1008,6 +1103,15 @@ class Reader:
 
     def __exit__(self, *exc):
         self.close()
+
+
+def _of_kind(parts, kind):
+    for part in parts:
+        keep = part["kind"] == kind
+        if keep.all():
+            yield part
+        elif keep.any():
+            yield {name: column[keep] for name, column in part.items()}
 
 
 def read_tasks(path, damaged_ok=False):

@@ -46,10 +46,18 @@ def commit_crc(task, slot, fields):
 
 
 def event_problems(ev, n_blocks, first_row=0, t_before=-np.inf):
-    """Range checks of a run of one task's events (dict of arrays starting at row `first_row`,
-    after an event at time t_before); returns what is wrong, naming the first bad row of each kind."""
+    """Range checks of a run of one task's rows (dict of arrays starting at row `first_row`, after an
+    inertial event at time t_before); returns what is wrong, naming the first bad row of each kind.
+
+    Rows of kind 0 (inertial events) follow each other in time; a creep episode (kind 1) is a row when it
+    ends, with the time it began, so it may come after events that began later: its time is not ordered.
+    """
     epi, first, last, t, mu = ev["epicenter"], ev["first"], ev["last"], ev["t"], ev["mu"]
-    previous = np.concatenate([[t_before], t[:-1]])
+    kind, ending = ev["kind"], ev["ending"]
+    inertial = kind == 0
+    # the onset of the inertial event before each row (t_before for the first ones)
+    before = np.concatenate([[t_before], np.where(inertial, t, -np.inf)[:-1]])
+    previous = np.maximum.accumulate(before) if len(before) else before
     checks = (
         ((epi < 0) | (epi >= n_blocks), lambda i: f"epicenter {int(epi[i])} outside the chain of {n_blocks} blocks"),
         ((first < 0) | (last >= n_blocks) | (first > last),
@@ -59,7 +67,11 @@ def event_problems(ev, n_blocks, first_row=0, t_before=-np.inf):
         (~np.isfinite(mu), lambda i: f"magnitude {float(mu[i])}"),
         (~(ev["slip"] > 0) | ~(ev["duration"] >= 0),
          lambda i: f"slip {float(ev['slip'][i])}, duration {float(ev['duration'][i])}"),
-        (t < previous, lambda i: f"time {float(t[i])!r} before the event ahead of it ({float(previous[i])!r})"),
+        (inertial & (t < previous),
+         lambda i: f"time {float(t[i])!r} before the event ahead of it ({float(previous[i])!r})"),
+        (~(inertial | (kind == 1)), lambda i: f"kind {int(kind[i])}"),
+        (np.where(inertial, ending != 0, (ending != 1) & (ending != 2)),
+         lambda i: f"ending {int(ending[i])} of a row of kind {int(kind[i])}"),
     )
     return [f"event {first_row + int(np.argmax(flags))}: {what(int(np.argmax(flags)))}"
             for flags, what in checks if flags.any()]

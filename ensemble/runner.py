@@ -18,7 +18,7 @@ from .config import ConfigError, from_dict, loads, section_lines
 from .integrators import kernel_params
 from .lock import RunLock
 from .model.chain import simulate
-from .model.workspace import (D_DURATION, D_FIRST, D_LAST, D_NSLIP, D_SLIP, NDIAG, OK, PAUSED,
+from .model.workspace import (D_DURATION, D_ENDING, D_FIRST, D_KIND, D_LAST, D_NSLIP, D_SLIP, NDIAG, OK, PAUSED,
                               STATUS_TEXT, UNLIMITED, Workspace)
 from .parallel import Coordinator
 from .branching import branch_start, spins_needed
@@ -52,20 +52,23 @@ class Trajectory:
         self.discarded = cfg.run.discarded if discarded is None else discarded
         self.integrator = cfg.integrator if integrator is None else integrator
         self.ws = Workspace(task.model.N)
+        # a chain that can creep keeps its creep phase's state in its checkpoints (catalog.carries_creep)
+        self.creeps = catalog.carries_creep(task.model)
         if checkpoint is None:
             self.ws.load(*initial_state(cfg, task))
             self.clock = np.zeros(2)
-            self.done = 0      # events completed, transient included
+            self.done = 0      # rows completed (events and creep episodes), transient included
         else:
-            self.ws.load(checkpoint.force, checkpoint.psi, checkpoint.since)
+            self.ws.load(checkpoint.force, checkpoint.psi, checkpoint.since, creep=checkpoint.creep)
             self.clock = checkpoint.clock.copy()
             self.done = checkpoint.done
         self.params = kernel_params(task.model, self.integrator)
 
     def checkpoint(self):
-        """The state after the last completed event (also while an event is paused)."""
+        """The state after the last completed event (also while an event is paused; the creep state is
+        that of the same moment, Workspace.creep_state)."""
         force, psi, since, clock = self.ws.between_events(self.clock)
-        return Checkpoint(force, psi, since, clock, self.done)
+        return Checkpoint(force, psi, since, clock, self.done, self.ws.creep_state() if self.creeps else None)
 
     def state(self):
         """(force, psi) of every block now (between events), c-free frame."""
@@ -101,6 +104,7 @@ def event_rows(task, t, epicenter, diag):
         "mu": np.log10(diag[:, D_SLIP]), "slip": diag[:, D_SLIP], "first": first, "last": last,
         "n_slipped": diag[:, D_NSLIP].astype(np.int64),
         "boundary": (first == 0) | (last == task.model.N - 1), "duration": diag[:, D_DURATION],
+        "kind": diag[:, D_KIND].astype(np.int8), "ending": diag[:, D_ENDING].astype(np.int8),
     }
 
 

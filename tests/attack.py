@@ -28,6 +28,9 @@ from tests.processes import child_env, run_bounded, wait_for  # noqa: E402
 
 DEADLINE = 120        # seconds for any command: what they take is a few (a hang fails the attack)
 QUICK = 30            # ... for a run that must end at once (a full disk, a failed collective step)
+COMPILE = 600         # ... for a run of an older commit, which compiles its own kernels first
+# the last commit that writes bk-catalog-4 (before the creep phase): its catalogs are real older catalogs
+FORMAT_4_COMMIT = "2383acc5f5f0bb6d46cf41bdfe915c3f0db86193"
 MPIEXEC = shutil.which("mpiexec")
 CONFIG = """[model]
 N = 60
@@ -101,6 +104,24 @@ class Workshop:
         self.crashed = self.root / "crashed.h5"
         res = _python("ensemble", "run", self.cfg, "-o", self.crashed, setup="inject.crash_at_write(60)")
         assert res.returncode == 99, res.stderr
+
+    def older(self):
+        """The finished catalog of this config written by FORMAT_4_COMMIT (bk-catalog-4): its tree taken from
+        git, run with its own numba cache; made once. Its final path."""
+        out = self.root / "format4.h5"
+        if out.exists():
+            return out
+        tree = self.root / "format4-tree"
+        tree.mkdir()
+        archive = subprocess.run(f"git -C '{ROOT}' archive {FORMAT_4_COMMIT} | tar -x -C '{tree}'", shell=True,
+                                 capture_output=True, text=True)
+        assert archive.returncode == 0, (f"the commit {FORMAT_4_COMMIT} (the last to write bk-catalog-4) is not in "
+                                         f"the repository (a shallow clone?): {archive.stderr}")
+        env = child_env(PYTHONPATH=str(tree), NUMBA_CACHE_DIR=str(self.root / "format4-cache"))
+        res = run_bounded([sys.executable, "-m", "ensemble", "run", str(self.cfg), "-o", str(out)], COMPILE,
+                          cwd=tree, env=env)
+        assert res.returncode == 0, res.stdout + res.stderr
+        return out
 
     def copy(self, which, name):
         """A copy of the finished ('full') or interrupted ('crashed': its .partial) catalog; its final path."""
@@ -252,15 +273,54 @@ def changed_config(where):
 
 
 def an_older_format(w):
-    """A catalog of the format before the tables were checksummed (bk-catalog-3) still reads; a run of that
-    format is not continued (it would write records without their checksums)."""
-    old = w.copy("crashed", "old.h5")
-    with h5py.File(catalog.partial_path(old), "r+") as h5:
+    """Catalogs of the formats before this one still read, and a run of them is not continued (it would
+    write rows and checkpoints of another layout, or records without their checksums):
+
+    - bk-catalog-4, written by the last commit of that format (Workshop.older): every row reads as an
+      inertial event (kind 0, ending 0, supplied by the reader; its events checksum covers its own ten
+      columns), the same events as this version's run of the config; reduce and export read it;
+    - bk-catalog-3, that catalog without tables_crc and /tasks/record_crc.
+    """
+    old = w.older()
+    events, tasks, attrs = catalog.read(old)
+    assert attrs["format"] == "bk-catalog-4"
+    with h5py.File(old, "r") as h5:
+        assert "kind" not in h5["events"] and "creep" not in h5["checkpoint"]
+    assert len(events["t"]) == len(tasks["point"]) * int(attrs["events_per_task"])
+    assert np.all(events["kind"] == 0) and np.all(events["ending"] == 0)
+    now, _, _ = catalog.read(w.full)       # (the aging law at b = 20 is unchanged by the creep phase)
+    for column in catalog.EVENT_FIELDS:
+        np.testing.assert_array_equal(events[column], now[column], err_msg=column)
+    res = _python("analysis", "reduce", old, "-o", w.root / "format4.summary.h5")
+    assert res.returncode == 0, res.stderr
+    res = _python("analysis", "export", old, "-o", w.root / "format4-export")
+    assert res.returncode == 0, res.stderr
+    lines = (w.root / "format4-export" / "events.csv").read_text().splitlines()
+    assert next(line for line in lines if not line.startswith("#")).endswith(",kind,ending"), lines[:20]
+    part = w.root / "format4-resume.h5"
+    shutil.copy(old, catalog.partial_path(part))     # (an interrupted run of that format, as far as resume sees)
+    one_line(_python("ensemble", "resume", part), (1,), "bk-catalog-4")
+    three = w.root / "format3.h5"
+    shutil.copy(old, catalog.partial_path(three))
+    with h5py.File(catalog.partial_path(three), "r+") as h5:
         h5.attrs["format"] = "bk-catalog-3"
         del h5.attrs["tables_crc"]
         del h5["tasks/record_crc"]
-    catalog.read(catalog.partial_path(old))
-    one_line(_python("ensemble", "resume", old), (1,), "bk-catalog-3")
+    events, _, _ = catalog.read(catalog.partial_path(three))
+    assert np.all(events["kind"] == 0)
+    one_line(_python("ensemble", "resume", three), (1,), "bk-catalog-3")
+
+
+def flipped_creep_layout(w):
+    """/checkpoint/creep (which records keep a creep state) is fixed at creation: a flipped byte is refused."""
+    bad = w.copy("full", "flip-creep.h5")
+    _flip(bad, "checkpoint/creep", 0, 0)
+    try:
+        catalog.read_tasks(bad)
+    except catalog.CatalogError as err:
+        assert "damaged" in str(err), err
+    else:
+        raise AssertionError("a flipped byte in /checkpoint/creep was read without a word")
 
 
 def status_of_an_unknown_code(w):
@@ -362,6 +422,7 @@ ATTACKS = {
     "changed stored config, partial": changed_config("crashed"),
     "status of an unknown status code": status_of_an_unknown_code,
     "an older catalog format reads, and is not continued": an_older_format,
+    "flip /checkpoint/creep": flipped_creep_layout,
     "resume of a finished catalog with --set": resume_of_a_finished_catalog_with_set,
     "empty config and /dev/null": empty_config,
     "output is the config": output_is_the_config,

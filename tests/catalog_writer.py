@@ -6,13 +6,14 @@ import numpy as np
 
 from ensemble import catalog
 from ensemble.config import loads
+from ensemble.model.workspace import Workspace
 from ensemble.runner import integrator_text
 from ensemble.tasks import task_list
 
 
 def write_events(path, config_text, parts, streams=None):
     """A catalog of the config's tasks; task k gets the events parts[k] (dict of columns, its
-    rows' `task` column k), committed in batches of varying size. Tasks with run.events events
+    rows' `task` column k; without `kind` and `ending`, inertial events), committed in batches of varying size. Tasks with run.events events
     are finished with provenance seed_entropy, spawn_key = streams[k] (default: the runner's,
     run.seed and k); the others are left open (an empty task never committed)."""
     from mpi4py import MPI
@@ -26,10 +27,13 @@ def write_events(path, config_text, parts, streams=None):
         writer.record(task.index)
         start, sizes = 0, itertools.cycle(np.roll([1, 57, 100, 13], task.index))
         N = task.model.N
+        creep = np.zeros(Workspace.creep_size(N)) if catalog.carries_creep(task.model) else None
+        ev = {**{name: np.full(n, value, dtype=catalog.EVENT_FIELDS[name])
+                 for name, value in catalog.SUPPLIED.items()}, **ev}
         while start < n:
             size = min(int(next(sizes)), n - start)
             state = catalog.Checkpoint(np.zeros(N), np.zeros(N), np.zeros((N, 2)), np.zeros(2),
-                                       cfg.run.transient + start + size)
+                                       cfg.run.transient + start + size, creep)
             writer.commit(task.index, start, {c: v[start:start + size] for c, v in ev.items()}, state)
             start += size
         if n == cfg.run.events:

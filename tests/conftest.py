@@ -45,6 +45,7 @@ QUICK = {
                      "test_zero_step_keeps_the_state"],
     "test_schedule.py": ["test_tree_finds_the_smallest_key_after_any_updates"],
     "test_budget.py": ["test_between_events_state_of_a_paused_event"],
+    "test_catalog_creep.py": ["test_a_checkpoint_packs_its_creep_state_and_a_slot_of_another_size_is_refused"],
     "test_laws.py": ["test_a_key_of_another_law_is_an_error_naming_it",
                      "test_single_block_slip_is_the_linearised_oscillation"],
     "test_nonfinite.py": ["test_tree_min_returns_a_block_whatever_the_keys"],

@@ -101,6 +101,24 @@ def signal_when_paused(signum):
     runner.Trajectory.advance = patched
 
 
+def signal_when_creeping(signum, paused=False):
+    """Send this process `signum` when a kernel call first ends with blocks creeping (a creep episode in
+    flight; paused: and an event paused too) after the transient: the stop then checkpoints the creep state."""
+    from ensemble import runner
+    from ensemble.model.workspace import CS_NCREEP
+    advance = runner.Trajectory.advance
+    sent = [False]
+
+    def patched(self, n, *args, **kwargs):
+        out = advance(self, n, *args, **kwargs)
+        if (not sent[0] and self.ws.cstate[CS_NCREEP] > 0 and self.done > self.cfg.run.transient
+                and (self.ws.paused or not paused)):
+            sent[0] = True
+            _signal_self(signum)
+        return out
+    runner.Trajectory.advance = patched
+
+
 def count_pauses(path, first_budget=None):
     """Write to `path`, at exit, how many kernel calls ended inside an event (the work budget spent).
 

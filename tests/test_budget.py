@@ -129,7 +129,7 @@ def test_trajectory_checkpoint_during_a_paused_event():
         parts.append(traj.advance(24 - traj.done, budget=300))
     cp = traj.checkpoint()
     assert cp.done == traj.done and cp.done < 24
-    resumed = Trajectory(cfg, task, Checkpoint(cp.force, cp.psi, cp.since, cp.clock, cp.done))
+    resumed = Trajectory(cfg, task, Checkpoint(cp.force, cp.psi, cp.since, cp.clock, cp.done, cp.creep))
     parts.append(resumed.advance(24 - resumed.done))
     for col, ref in enumerate((t_ref, epi_ref, diag_ref)):
         np.testing.assert_array_equal(np.concatenate([p[col] for p in parts]), ref)

@@ -1,0 +1,204 @@
+"""The catalog of a chain that creeps (bk-catalog-5): inertial events and creep episodes as rows of
+/events (`kind`, `ending`), each record's creep state in its checkpoint slots where its chain can creep
+(/checkpoint/creep), statistics of the inertial events alone, and a run interrupted with creep in flight,
+or run on two ranks, that writes the uninterrupted serial catalog.
+
+The chain is below the block stiffness (b = 15 < 1 + 2 l^2 = 19, N = 50): every block can creep, and
+about three rows in four are creep episodes. A point at b = 25 beside it cannot creep: its records keep
+no creep state, so one catalog holds slots of both sizes.
+"""
+import shutil
+import signal
+import sys
+
+import h5py
+import numpy as np
+import pytest
+
+from analysis import export, summary
+from ensemble import catalog
+from ensemble.model.workspace import CS_NCREEP, NCSTATE, Workspace
+
+from . import reduction_reference as ref
+from .conftest import run_cli, write_config
+from .processes import ROOT, child_env, run_bounded
+from .same_catalogs import assert_same_events
+
+TIMEOUT = 300
+SEEDS, EVENTS, TRANSIENT = 2, 300, 20
+CREEPING, STIFF = 15.0, 25.0      # model.b of the two points: below and above the block stiffness 19
+
+
+def injected(setup, *argv, ranks=None):
+    """`python -m ensemble argv` after `setup` (code using tests.inject), under mpiexec -n ranks if given."""
+    code = (f"import sys; sys.path.insert(0, {str(ROOT)!r}); from tests import inject; {setup}; "
+            f"inject.main({list(map(str, argv))!r})")
+    cmd = [sys.executable, "-c", code]
+    if ranks:
+        cmd = [shutil.which("mpiexec"), "-n", str(ranks), *cmd]
+    return run_bounded(cmd, TIMEOUT, env=child_env())
+
+
+@pytest.fixture(scope="module")
+def creeping(tmp_path_factory):
+    """The config (b = 15 and 25, two seeds each, defaults otherwise) and its uninterrupted serial catalog."""
+    d = tmp_path_factory.mktemp("creep_catalog")
+    cfg = write_config(d / "cfg.toml", model={"N": 50}, sweep={"b": [CREEPING, STIFF]},
+                       run={"seeds": SEEDS, "events": EVENTS, "transient": TRANSIENT},
+                       integrator={"method": "ark4"}, output={"batch": 50, "flush_seconds": 1000.0})
+    res = run_cli("run", cfg, "-o", d / "full.h5", timeout=TIMEOUT)
+    assert res.returncode == 0, res.stdout + res.stderr
+    return d, cfg
+
+
+def tasks_of(tasks, b):
+    return np.flatnonzero(tasks["b"] == b)
+
+
+def test_a_creeping_chain_writes_both_kinds_and_keeps_its_creep_state(creeping):
+    d, _ = creeping
+    events, tasks, attrs = catalog.read(d / "full.h5")
+    assert attrs["format"] == catalog.FORMAT == "bk-catalog-5"
+    kind, ending = events["kind"], events["ending"]
+    assert kind.dtype == ending.dtype == np.int8
+    for k in tasks_of(tasks, CREEPING):
+        mine = events["task"] == k
+        inertial, creep = mine & (kind == 0), mine & (kind == 1)
+        assert np.count_nonzero(inertial) >= 30 and np.count_nonzero(creep) >= 30, (k, np.bincount(kind[mine]))
+        assert np.all(ending[inertial] == 0) and np.all(np.isin(ending[creep], (1, 2)))
+        assert np.all(np.diff(events["t"][inertial]) >= 0)       # events in time order among themselves
+        assert np.all(events["duration"][creep] > 0) and np.all(events["slip"][creep] > 0)
+    stiff = np.isin(events["task"], tasks_of(tasks, STIFF))
+    assert stiff.any() and np.all(kind[stiff] == 0) and np.all(ending[stiff] == 0)
+    # the checkpoint slots: a creep state where the chain can creep, none where it cannot
+    with h5py.File(d / "full.h5", "r") as h5:
+        flags = h5["checkpoint/creep"][...].astype(np.int64)
+        np.testing.assert_array_equal(flags, tasks["b"] == CREEPING)
+        slot = 4 * 50 + 2 + flags * Workspace.creep_size(50)
+        np.testing.assert_array_equal(h5["checkpoint/offset"][...], np.concatenate([[0], np.cumsum(2 * slot)[:-1]]))
+        assert h5["checkpoint/state"].shape == (2 * slot.sum(),)
+        assert "0 an inertial event, 1 a creep episode" in h5["events/kind"].attrs["description"]
+    with catalog.Reader(d / "full.h5") as cat:
+        for k in range(len(tasks["point"])):
+            state = cat.layout.read_state(k, cat.layout.head(k))
+            if flags[k]:
+                assert state.creep is not None and len(state.creep) == Workspace.creep_size(50)
+                assert 0 <= state.creep[-NCSTATE + CS_NCREEP] <= 50
+            else:
+                assert state.creep is None
+    # the export carries both columns, with their meanings
+    table = export.events(d / "full.h5")
+    np.testing.assert_array_equal(table["kind"], kind)
+    np.testing.assert_array_equal(table["ending"], ending)
+    assert export.columns(d / "full.h5", "events")["ending"] == catalog.DATASETS["events/ending"][::2]
+
+
+def test_reduce_counts_the_inertial_events_alone(creeping):
+    """The summary of the catalog equals the reference reduction of its kind-0 rows alone (every dataset:
+    R(mu), recurrence times, GR b, fraction large, per-task stretches and their bootstrap)."""
+    d, _ = creeping
+    out = d / "sum.h5"
+    res = run_bounded([sys.executable, "-m", "analysis", "reduce", d / "full.h5", "-o", out, "--bootstrap", "200",
+                       "--mu-c", "3.5"], TIMEOUT, env=child_env())
+    assert res.returncode == 0, res.stderr
+    events, tasks, _ = catalog.read(d / "full.h5")
+    inertial = {name: column[events["kind"] == catalog.KIND_EVENT] for name, column in events.items()}
+    opt = {"mu_edges": np.linspace(0, 7, 71), "tnu_edges": np.linspace(0, 2000, 81), "mu_c": 3.5,
+           "window": 10, "b_cut": 3.0, "bootstrap": 200, "level": 0.95, "blocks": 20, "seed": 0}
+    expected = ref.expected_summary([(d / "full.h5", inertial, tasks)], opt)
+    ref.check_summary(ref.read_summary(out), expected, opt)
+    # (what that covers: creep rows that would change every statistic of the creeping point)
+    s = summary.read(out)
+    creeping_point = int(np.flatnonzero(s["points/b"] == CREEPING)[0])
+    assert s["points/numbers/n_events"][creeping_point][0] == np.count_nonzero(
+        np.isin(inertial["task"], tasks_of(tasks, CREEPING))) < SEEDS * EVENTS
+    assert s["points/numbers/n_recurrences"][creeping_point][0] > 10
+    creep_mu = events["mu"][events["kind"] == catalog.KIND_CREEP]
+    assert np.count_nonzero((creep_mu >= 0) & (creep_mu < 7)) > 50     # they would land in R(mu)'s bins
+
+
+def test_compare_counts_the_inertial_events_alone(creeping):
+    """`analysis compare`'s units (sizes, magnitudes, recurrences) read the kind-0 rows alone."""
+    from analysis import compare
+    d, _ = creeping
+    events, tasks, _ = catalog.read(d / "full.h5")
+    opt = compare.Options(blocks=5, window=10, n_large=40, n_min=1)
+    for k in tasks_of(tasks, CREEPING):
+        sizes, mu_counts, _ = compare.task_units(str(d / "full.h5"), int(k), opt)
+        inertial = (events["task"] == k) & (events["kind"] == catalog.KIND_EVENT)
+        np.testing.assert_array_equal(sizes.sum(axis=0), np.bincount(events["n_slipped"][inertial], minlength=51))
+        assert mu_counts.sum() == np.count_nonzero(inertial)
+
+
+@pytest.mark.parametrize("paused", [False, True], ids=["creeping", "creeping-and-paused"])
+def test_resume_with_creep_in_flight_gives_the_uninterrupted_catalog(creeping, tmp_path, paused):
+    """SIGTERM when a kernel call ends with blocks creeping (and an event paused): every task checkpoints
+    its creep state, and the resumed catalog is the uninterrupted one, row for row."""
+    d, cfg = creeping
+    out = tmp_path / "cut.h5"
+    # kernel calls of 1000 block-steps (runner.MIN_BUDGET) from the first on: most events pause many times
+    setup = f"from ensemble import runner; runner.FIRST_BUDGET = 1000; inject.signal_when_creeping({int(signal.SIGTERM)}, paused={paused})"
+    res = injected(setup, "run", cfg, "-o", out, "--set", "run.poll_seconds=1e-5")
+    assert res.returncode == 75, res.stdout + res.stderr
+    with catalog.Reader(catalog.partial_path(out)) as cat:
+        states = [cat.layout.read_state(k, cat.layout.head(k)) for k in tasks_of(cat.tasks, CREEPING)
+                  if cat.layout.head(k) is not None]
+        stopped = [k for k in range(len(cat.tasks["point"])) if 0 < cat.tasks["events_done"][k] < TRANSIENT + EVENTS]
+    # the stop came with blocks creeping: some task's checkpoint holds them
+    assert any(s.creep[-NCSTATE + CS_NCREEP] > 0 for s in states), "no checkpoint with creep in flight"
+    assert stopped, "every task had finished or not begun"
+    res = run_cli("resume", out, timeout=TIMEOUT)
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert_same_events(d / "full.h5", out)
+    a, _, _ = catalog.read(d / "full.h5")
+    b, _, _ = catalog.read(out)
+    for name in catalog.EVENT_FIELDS:          # and in the same order of rows
+        np.testing.assert_array_equal(a[name], b[name], err_msg=name)
+
+
+@pytest.mark.mpi
+@pytest.mark.skipif(shutil.which("mpiexec") is None, reason="mpiexec not found")
+@pytest.mark.parametrize("writer", ["rank0", pytest.param("parallel", marks=pytest.mark.parallel_hdf5)])
+def test_two_ranks_write_the_serial_catalog(creeping, tmp_path, writer):
+    d, cfg = creeping
+    out = tmp_path / f"two-{writer}.h5"
+    res = run_bounded([shutil.which("mpiexec"), "-n", "2", sys.executable, "-m", "ensemble", "run", str(cfg),
+                       "-o", str(out), "--set", f'output.writer="{writer}"'], TIMEOUT, env=child_env())
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert_same_events(d / "full.h5", out)
+    _, tasks, _ = catalog.read(out)
+    assert set(tasks["rank"]) == {0, 1}
+    with h5py.File(d / "full.h5", "r") as one, h5py.File(out, "r") as two:
+        np.testing.assert_array_equal(one["checkpoint/creep"][...], two["checkpoint/creep"][...])
+
+
+def test_a_checkpoint_packs_its_creep_state_and_a_slot_of_another_size_is_refused(tmp_path):
+    n = 5
+    rng = np.random.default_rng(3)
+    cp = catalog.Checkpoint(rng.random(n), rng.random(n), rng.random((n, 2)), rng.random(2), 7,
+                            rng.random(Workspace.creep_size(n)))
+    flat = cp.pack()
+    assert len(flat) == 4 * n + 2 + Workspace.creep_size(n)
+    back = catalog.Checkpoint.unpack(flat, 7, n)
+    for name in ("force", "psi", "since", "clock", "creep"):
+        np.testing.assert_array_equal(getattr(back, name), getattr(cp, name), err_msg=name)
+    assert catalog.Checkpoint.unpack(flat[:4 * n + 2], 7, n).creep is None
+    # a writer refuses a checkpoint that does not fit the record's slots (with or without a creep state)
+    from mpi4py import MPI
+
+    from ensemble.config import loads
+    from ensemble.runner import integrator_text
+    from ensemble.tasks import task_list
+    cfg = loads(f"[model]\nN = {n}\nb = 15.0\n[run]\nevents = 4\ntransient = 0\n")
+    assert catalog.carries_creep(cfg.model) and not catalog.carries_creep(loads("[model]\nN = 5\n").model)
+    writer = catalog.Rank0Writer(str(tmp_path / "c.h5"), MPI.COMM_SELF, cfg, task_list(cfg), integrator_text(cfg.integrator))
+    try:
+        writer.record(0)
+        no_creep = catalog.Checkpoint(cp.force, cp.psi, cp.since, cp.clock, 0)
+        with pytest.raises(catalog.CatalogError, match=r"a checkpoint of 22 values for slots of \d+ \(with a creep state\)"):
+            writer.commit(0, 0, None, no_creep)
+        writer.commit(0, 0, None, catalog.Checkpoint(cp.force, cp.psi, cp.since, cp.clock, 0, cp.creep))
+    finally:
+        writer.close()
+    with catalog.Reader(tmp_path / "c.h5") as cat:
+        np.testing.assert_array_equal(cat.layout.read_state(0, cat.layout.head(0)).creep, cp.creep)
