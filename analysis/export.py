@@ -258,7 +258,8 @@ def events(path, frame=False):
     """Every committed event of a catalog (structured array, tasks in order; verified).
 
     Fields: catalog.EVENT_FIELDS (task, t, epicenter, mu, slip, first, last, n_slipped, boundary,
-    duration). Holds the whole catalog in memory: iter_events streams it.
+    duration, kind, ending): inertial events (kind 0) and creep episodes (kind 1) alike. Holds the
+    whole catalog in memory: iter_events streams it.
     """
     return _result(_whole(_events(path)), frame)
 

@@ -9,7 +9,8 @@ objects, no attribute writes), so each rank writes its own task's rows with
 independent writes and nothing collective is left in the hot path; a process
 killed at any moment leaves a file whose metadata is intact.
 
-    /events/*       one row per event; task k owns rows [k * E, (k + 1) * E), E = events_per_task
+    /events/*       one row per inertial event or creep episode (/events/kind; run.events counts both);
+                    task k owns rows [k * E, (k + 1) * E), E = events_per_task
     /tasks/*        one row per task: its parameters, committed count, provenance, status
     /checkpoint/*   per task two slots of its state and a commit row for each; with run.branch
                     then per parameter point its spin-up's (record n_tasks + point)

@@ -5,11 +5,13 @@ protects the rest, so that no damaged table can make a reader or a resume silent
 
 - **Fixed at creation**: every /tasks column but a task's record and the events_written mirror (the
   parameter tables point, seed_index, N, l, nu, law, the law keys, branch_of), /spinup/*,
-  /checkpoint/offset and the root attributes (the stored config among them). One CRC of all of them is
-  stored as the root attribute `tables_crc` at creation and verified on every open; the parameter
-  tables are also recomputed from the stored config, where this version can read it, and compared
-  (`config_problems`), so a config and its tables can never disagree. Catalogs of format bk-catalog-3,
-  written before these checksums, are read with the comparison and the consistency rules only.
+  /checkpoint/offset, /checkpoint/creep (bk-catalog-5: which records keep a creep state) and the root
+  attributes (the stored config among them). One CRC of all of them is stored as the root attribute
+  `tables_crc` at creation and verified on every open; the parameter tables are also recomputed from
+  the stored config, where this version can read it, and compared (`config_problems`), so a config and
+  its tables can never disagree. Catalogs of format bk-catalog-3, written before these checksums, are
+  read with the comparison and the consistency rules only. (Whether /checkpoint/creep is what this
+  version's kernel needs is asked only by a resume: catalog.py.)
 - **A task's record** (`RECORD`): /tasks/status, error, integrator and the provenance columns, written
   when a task finishes, fails or is taken up again. Each write of them ends with /tasks/record_crc[k],
   the CRC of the task's record bound to its index. A reader refuses a record that fails it; a resume

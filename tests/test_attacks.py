@@ -26,7 +26,9 @@ def test_a_flipped_parameter_table_and_record_are_refused(workshop):
 
 @pytest.mark.parametrize("sets", [["run.events=20000"], ["model.N=5000", "run.seeds=50", "run.events=10"],
                                   ["model.N=10", "run.seeds=2000", "run.events=1"],
-                                  ["run.branch=true", "run.seeds=3", "sweep.b=[20, 30, 40]", "run.events=100"]])
+                                  ["run.branch=true", "run.seeds=3", "sweep.b=[20, 30, 40]", "run.events=100"],
+                                  # creep states in the slots (b below the block stiffness), spin-ups too
+                                  ["run.branch=true", "run.seeds=3", "sweep.b=[10, 15]", "run.events=10"]])
 def test_the_size_checked_before_creation_bounds_the_catalog(tmp_path, sets):
     """space.check_fits asks for catalog.estimate_bytes: it must not be below the file HDF5 makes (then a
     disk that passed the check could still fill inside HDF5's collective create), nor far above it."""

@@ -202,3 +202,61 @@ def test_a_checkpoint_packs_its_creep_state_and_a_slot_of_another_size_is_refuse
         writer.close()
     with catalog.Reader(tmp_path / "c.h5") as cat:
         np.testing.assert_array_equal(cat.layout.read_state(0, cat.layout.head(0)).creep, cp.creep)
+
+
+def test_unperturbed_branches_carry_the_spun_up_creep_state(tmp_path):
+    """run.branch with perturbation 0: every seed records what its seed 0 records without branching. The
+    spin-up is made to end with a block creeping (the first such row count, found by running the chain
+    here), so the branches need its creep state, not only its forces and states."""
+    from ensemble.config import loads
+    from ensemble.runner import Trajectory
+    from ensemble.tasks import task_list
+    run = {"seeds": 2, "events": 100, "transient": 40, "branch": True, "decorrelation": 20, "perturbation": 0.0}
+    cfg = write_config(tmp_path / "branch.toml", model={"N": 50, "b": CREEPING}, run=run,
+                       integrator={"method": "ark4"})
+    chain = Trajectory(loads(cfg.read_text()), task_list(loads(cfg.read_text()))[0])
+    while chain.ws.cstate[CS_NCREEP] == 0 or chain.done < 20:
+        chain.advance(1)
+        assert chain.done < 1000, "no row count after which a block creeps"
+    cfg = write_config(tmp_path / "branch.toml", model={"N": 50, "b": CREEPING}, run={**run, "transient": chain.done},
+                       integrator={"method": "ark4"})
+    res = run_cli("run", cfg, "-o", tmp_path / "zero.h5", timeout=TIMEOUT)
+    assert res.returncode == 0, res.stdout + res.stderr
+    res = run_cli("run", cfg, "-o", tmp_path / "plain.h5", "--set", "run.branch=false",
+                  "--set", f"run.transient={chain.done + 20}", timeout=TIMEOUT)
+    assert res.returncode == 0, res.stdout + res.stderr
+    zero, _, _ = catalog.read(tmp_path / "zero.h5")
+    plain, _, _ = catalog.read(tmp_path / "plain.h5")
+    seed0 = plain["task"] == 0
+    assert np.count_nonzero(plain["kind"][seed0] == catalog.KIND_CREEP) > 10
+    with catalog.Reader(tmp_path / "zero.h5") as cat:     # the spin-up (record 2) ended with a block creeping
+        spun = cat.layout.read_state(2, cat.layout.head(2))
+    assert spun.creep is not None and spun.creep[-NCSTATE + CS_NCREEP] > 0
+    for k in range(2):
+        mine = zero["task"] == k
+        for name in catalog.EVENT_FIELDS:
+            if name != "task":
+                np.testing.assert_array_equal(zero[name][mine], plain[name][seed0], err_msg=f"task {k} {name}")
+
+
+def test_a_record_laid_out_for_another_kernel_is_not_continued(tmp_path, monkeypatch):
+    """A resume asks whether each record's slots hold a creep state exactly where this version's kernel
+    keeps one (a kernel whose creep criterion changed could not restore, or store, the state)."""
+    from mpi4py import MPI
+
+    from ensemble.config import loads
+    from ensemble.runner import integrator_text
+    from ensemble.tasks import task_list
+    cfg = loads("[model]\nN = 5\nb = 15.0\n[run]\nevents = 4\ntransient = 0\n")
+    path = str(tmp_path / "c.h5")
+    catalog.Rank0Writer(path, MPI.COMM_SELF, cfg, task_list(cfg), integrator_text(cfg.integrator)).close()
+    catalog.read(path)                                   # a reader does not ask
+    monkeypatch.setattr(catalog, "carries_creep", lambda model: False)
+    catalog.read(path)
+    writer = catalog.Rank0Writer(path, MPI.COMM_SELF)
+    try:
+        with pytest.raises(catalog.CatalogError, match="task 0: its checkpoint slots were laid out with a creep "
+                                                       "state, and this version keeps none"):
+            writer.record(0)
+    finally:
+        writer.close()

@@ -97,7 +97,7 @@ def synthetic_events(rng, task, n, gridded):
     return {"task": np.full(n, task, dtype=np.int64), "t": t, "epicenter": epi.astype(np.int64), "mu": mu,
             "slip": 10.0 ** mu, "first": first.astype(np.int64), "last": last.astype(np.int64),
             "n_slipped": (last - first + 1).astype(np.int64), "boundary": (first == 0) | (last == N_CHAIN - 1),
-            "duration": rng.random(n) + 0.1}
+            "duration": rng.random(n) + 0.1, "kind": np.zeros(n, np.int8), "ending": np.zeros(n, np.int8)}
 
 
 def write_catalog(path, config_text, written, seed):
