@@ -13,9 +13,10 @@ from ensemble.tasks import task_list
 
 def write_events(path, config_text, parts, streams=None):
     """A catalog of the config's tasks; task k gets the events parts[k] (dict of columns, its
-    rows' `task` column k; without `kind` and `ending`, inertial events), committed in batches of varying size. Tasks with run.events events
-    are finished with provenance seed_entropy, spawn_key = streams[k] (default: the runner's,
-    run.seed and k); the others are left open (an empty task never committed)."""
+    rows' `task` column k; without `kind` and `ending`: inertial events), committed in batches of
+    varying size. Tasks with run.events events are finished with provenance seed_entropy, spawn_key =
+    streams[k] (default: the runner's, run.seed and k); the others are left open (an empty task never
+    committed)."""
     from mpi4py import MPI
     cfg = loads(config_text)
     tasks = task_list(cfg)

@@ -137,7 +137,8 @@ def test_resume_with_creep_in_flight_gives_the_uninterrupted_catalog(creeping, t
     d, cfg = creeping
     out = tmp_path / "cut.h5"
     # kernel calls of 1000 block-steps (runner.MIN_BUDGET) from the first on: most events pause many times
-    setup = f"from ensemble import runner; runner.FIRST_BUDGET = 1000; inject.signal_when_creeping({int(signal.SIGTERM)}, paused={paused})"
+    setup = (f"from ensemble import runner; runner.FIRST_BUDGET = 1000; "
+             f"inject.signal_when_creeping({int(signal.SIGTERM)}, paused={paused})")
     res = injected(setup, "run", cfg, "-o", out, "--set", "run.poll_seconds=1e-5")
     assert res.returncode == 75, res.stdout + res.stderr
     with catalog.Reader(catalog.partial_path(out)) as cat:
@@ -191,11 +192,13 @@ def test_a_checkpoint_packs_its_creep_state_and_a_slot_of_another_size_is_refuse
     from ensemble.tasks import task_list
     cfg = loads(f"[model]\nN = {n}\nb = 15.0\n[run]\nevents = 4\ntransient = 0\n")
     assert catalog.carries_creep(cfg.model) and not catalog.carries_creep(loads("[model]\nN = 5\n").model)
-    writer = catalog.Rank0Writer(str(tmp_path / "c.h5"), MPI.COMM_SELF, cfg, task_list(cfg), integrator_text(cfg.integrator))
+    writer = catalog.Rank0Writer(str(tmp_path / "c.h5"), MPI.COMM_SELF, cfg, task_list(cfg),
+                                 integrator_text(cfg.integrator))
     try:
         writer.record(0)
         no_creep = catalog.Checkpoint(cp.force, cp.psi, cp.since, cp.clock, 0)
-        with pytest.raises(catalog.CatalogError, match=r"a checkpoint of 22 values for slots of \d+ \(with a creep state\)"):
+        with pytest.raises(catalog.CatalogError,
+                           match=r"a checkpoint of 22 values for slots of \d+ \(with a creep state\)"):
             writer.commit(0, 0, None, no_creep)
         writer.commit(0, 0, None, catalog.Checkpoint(cp.force, cp.psi, cp.since, cp.clock, 0, cp.creep))
     finally:
