@@ -353,6 +353,10 @@ def from_dict(raw, overridden=None):
     if cfg.integrator.method not in _integrator_names():
         raise ConfigError(f"integrator.method must be one of {', '.join(_integrator_names())}, "
                           f"got {cfg.integrator.method!r}")
+    from .integrators import INTEGRATORS
+    refusal = INTEGRATORS[cfg.integrator.method].refusal(laws.get(cfg.model.law))
+    if refusal:
+        raise ConfigError(refusal)
     _check_overflow(cfg)
     return cfg
 

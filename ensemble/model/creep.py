@@ -36,7 +36,7 @@ from .geometry import left, right
 from .laws import creep_state, creep_weakening, creeps, friction, friction_slopes, onset_delay, rest_state, state_rate, threshold
 from .schedule import advance_clock, elapsed, materialize, onset_key, tree_min, tree_set
 from .workspace import (CR_DIAG, CR_DPSI, CR_DU, CR_EP, CR_H, CR_HB, CR_LEFT, CR_PSI, CR_RES, CR_SERIAL, CR_UPPER, CR_V,
-                        CR_VN, CS_ENDED, CS_H, CS_NCREEP, CS_SERIAL, CS_T_HI, CS_T_LO, E_ACTIVE, E_BLOCK_STEPS,
+                        CR_VN, CS_ENDED, CS_FRESH, CS_H, CS_NCREEP, CS_SERIAL, CS_T_HI, CS_T_LO, E_ACTIVE, E_BLOCK_STEPS,
                         E_END_HI, E_END_LO, E_EPICENTER, E_FIRST, E_LAST, E_NBLOCKS, E_RUNNING, E_RUPTURED,
                         E_SERIAL, E_SLIP, E_START_HI, E_START_LO, E_STATE, E_STOPPED, E_VMAX, F0, P,
                         D_BLOCK_STEPS, D_DURATION, D_ENDING, D_FIRST, D_KIND, D_LAST, D_NSLIP, D_SLIP, D_VMAX,
@@ -174,10 +174,12 @@ def join(arrays, n, p, j, v0, t):
     into the episode of a creeping neighbour (the left one first), or a new episode."""
     C, E, cs, W, since = arrays.creep, arrays.episodes, arrays.cstate, arrays.W, arrays.since
     if cs[CS_NCREEP] == 0.0:
-        # a new creep phase: its clock starts here, its first step from the state's own time scale
+        # a new creep phase: its first step from the state's own time scale
+        cs[CS_H] = p.creep_tol * math.exp(W[j, P]) + 2.0 * math.pi / math.sqrt(stiffness(min(1, n - 1), n, p.l2))
+    if cs[CS_NCREEP] == 0.0 or (t[0] - cs[CS_T_HI]) + (t[1] - cs[CS_T_LO]) > 0.0:
+        # the creep's clock: never behind a creeping block's own time (the others step from theirs)
         cs[CS_T_HI] = t[0]
         cs[CS_T_LO] = t[1]
-        cs[CS_H] = p.creep_tol * math.exp(W[j, P]) + 2.0 * math.pi / math.sqrt(stiffness(min(1, n - 1), n, p.l2))
     if j > 0 and creeping(C, j - 1):
         slot = int(C[j - 1, CR_EP]) - 1
     elif j < n - 1 and creeping(C, j + 1):
@@ -186,6 +188,7 @@ def join(arrays, n, p, j, v0, t):
         slot = _new_episode(E, cs, t, j)
     C[j, CR_EP] = slot + 1
     C[j, CR_V] = v0
+    cs[CS_FRESH] = 1.0
     E[slot, E_ACTIVE] += 1.0
     if C[j, CR_SERIAL] != E[slot, E_SERIAL]:
         C[j, CR_SERIAL] = E[slot, E_SERIAL]
@@ -405,6 +408,18 @@ def _solve(arrays, n, p, t, h):
 
 
 @nb.njit(cache=True)
+def _accelerating(C, n, h, inertial):
+    """A creeping block whose velocity grows by e within an inertial period over the step just
+    solved (v / (dv/dt) < inertial), or -1."""
+    for i in range(n):
+        if creeping(C, i):
+            grow = C[i, CR_VN] - C[i, CR_V]
+            if grow > 0.0 and C[i, CR_VN] * h < inertial * grow:
+                return i
+    return -1
+
+
+@nb.njit(cache=True)
 def _fastest(C, n):
     """The creeping block with the largest velocity (the epicenter of a hand-over by time scale)."""
     who = -1
@@ -448,24 +463,43 @@ def continue_creep(arrays, clock, n, p, budget):
             return REACHED, used, -1
         if used >= budget:
             return PAUSED, used, -1
+        if cs[CS_FRESH] != 0.0:
+            # a block joined (from rest, or handed back by an event): every creeping velocity from a
+            # step of inertia's time scale, so that the error estimate starts from the creep's own
+            # velocities and not from the jump of a block's velocity to them
+            cs[CS_FRESH] = 0.0
+            solved, work = _solve(arrays, n, p, t, inertial)
+            used += work
+            if not solved:
+                return HANDOVER, used, _fastest(C, n)
+            for i in range(n):
+                if creeping(C, i):
+                    C[i, CR_V] = C[i, CR_VN]
+            continue
         # -- the step, retried shorter until its error is accepted
         h = min(cs[CS_H], t_far)
         err = 0.0
         while True:
             solved, work = _solve(arrays, n, p, t, h)
             used += work
-            if solved and (cs[CS_NCREEP] == 0.0 or h <= inertial):
+            if h <= inertial or (solved and cs[CS_NCREEP] == 0.0):
                 break
             err = _error(arrays, n, p) if solved else np.inf
             if err <= 1.0:
                 break
-            # creep as fast as inertia's time scale is no longer quasi-static: an event
-            h = max(h * max(_SHRINK, 0.9 / math.sqrt(err)), h * 0.25)
-            if h < inertial:
-                return HANDOVER, used, _fastest(C, n)
+            # never below inertia's time scale, which the quasi-static equations do not resolve
+            h = max(h * max(_SHRINK, 0.9 / math.sqrt(err)), h * 0.25, inertial)
+        if not solved:
+            return HANDOVER, used, _fastest(C, n)
+        # creep that accelerates on inertia's time scale is no longer quasi-static: an event
+        who = _accelerating(C, n, h, inertial)
+        if who >= 0:
+            return HANDOVER, used, who
         if cs[CS_NCREEP] == 0.0:
             continue
-        cs[CS_H] = max(h * min(_GROW, max(_SHRINK, 0.9 / math.sqrt(max(err, 1e-10)))), inertial)
+        # at most the time the loader takes to move one unit of length (steady creep has no error
+        # to bound its step)
+        cs[CS_H] = min(max(h * min(_GROW, max(_SHRINK, 0.9 / math.sqrt(max(err, 1e-10)))), inertial), 1.0 / p.nu)
         # -- the earliest onset inside the step: a resting neighbour of a creeping block, or the
         # schedule's next block by loading alone
         x_cut = 2.0

@@ -169,7 +169,8 @@ CS_H = 1        # the next creep step
 CS_SERIAL = 2   # episodes begun so far (serial numbers)
 CS_ENDED = 3    # episodes ended and not yet reported
 CS_T_HI, CS_T_LO = 4, 5   # two-float time up to which the creep is integrated
-NCSTATE = 6
+CS_FRESH = 6    # 1: blocks joined since the last step, the velocities are made consistent first
+NCSTATE = 7
 
 # values of EV_PHASE
 BETWEEN, IN_EVENT = 0, 1

@@ -1,0 +1,178 @@
+"""The creep phase of the kernel (ensemble/model/creep.py; docs/numerics.md, "Quasi-static creep"): against the
+full inertial equations solved independently (tests/creep_reference.py), the single block's steady creep, the
+hand-over to an event and back, its tolerance, and a checkpoint inside a creep phase."""
+import numpy as np
+import pytest
+
+from ensemble.config import Model, Integrator
+from ensemble.integrators import kernel_params
+from ensemble.model import creep
+from ensemble.model.chain import simulate
+from ensemble.model.workspace import (CR_V, D_ENDING, D_KIND, D_NSLIP, D_SLIP, F0, KIND_CREEP, KIND_EVENT, NDIAG,
+                                      OK, P, UNLIMITED, Workspace)
+
+from .creep_reference import inertial, on_the_manifold, stiffness
+
+L = 3.0
+
+
+def creep_path(n, b, nu, state, t_end, tol=1e-6, creeping=(1, 2, 3), budget=3, a=0.0):
+    """Run the kernel from `state` (force, psi) in calls of a small work budget (about one creep step
+    each) until the time t_end; returns the creep's time at each call's end and, there, the slips of the creeping blocks
+    (from their forces: nothing else moves), their psi and creep velocities. No event may happen."""
+    K = stiffness(n, L)
+    C = list(creeping)
+    force0, psi0 = state
+    p = kernel_params(Model(N=n, l=L, b=b, a=a, nu=nu), Integrator(creep_tol=tol))
+    ws = Workspace(n)
+    ws.load(force0, psi0)
+    clock = np.zeros(2)
+    t, e, d = np.empty(1), np.empty(1, dtype=np.int64), np.empty((1, NDIAG))
+    times, slips, psis, vs = [], [], [], []
+    while not times or times[-1] < t_end:
+        status, k = simulate(ws.arrays, clock, p, 1, budget, t, e, d)
+        assert (status, k) == (OK, 0), "an event or an episode's end: this path is creep alone"
+        now = ws.since[C[0]].sum()
+        if times and now == times[-1]:
+            continue
+        times.append(now)
+        slips.append(np.linalg.solve(K[np.ix_(C, C)], force0[C] + nu * now - ws.W[C, F0]))
+        psis.append(ws.W[C, P].copy())
+        vs.append(ws.creep[C, CR_V].copy())
+    return np.array(times), np.array(slips), np.array(psis), np.array(vs)
+
+
+def against_the_full_equations(nu, tol):
+    """The kernel's creep of blocks 1..3 of 5 (b = 5: the cluster's K_C - b I has lambda_min 1.27) against
+    scipy's Radau solution of the full inertial equations from the same state on the quasi-static manifold
+    (neighbours 0 and 4 at rest, far below their thresholds). Returns the largest relative error of the
+    slips and velocities and the largest error of psi."""
+    n, b = 5, 5.0
+    K = stiffness(n, L)
+    C = [1, 2, 3]
+    u, v, psi = on_the_manifold(K, C, b, nu, np.log(b / nu) + np.array([1.0, 1.5, 1.0]), np.zeros(2))
+    times, slips, psis, vs = creep_path(n, b, nu, (-(K @ u), psi), 0.5 / nu, tol)
+    _, ur, vr, pr, rest = inertial(K, C, 0.0, b, nu, u, v, psi, times[-1], times)
+    assert np.all(rest < b * psi[[0, 4]]), "a neighbour would have started"
+    assert times[-1] > 0.3 / nu, "long enough for psi to relax visibly"
+    assert abs(pr[-1, 1] - pr[0, 1]) > 0.2 and abs(vr[-1, 1] / vr[0, 1] - 1) > 0.1, "the comparison is not trivial"
+    slip_err = np.max(np.abs(slips - (ur - u[C]))) / np.max(np.abs(ur - u[C]))
+    late = slice(len(times) // 10, None)        # the kernel starts from rest, the reference on the manifold
+    v_err = np.max(np.abs(vs[late] / vr[late] - 1))
+    return slip_err, v_err, np.max(np.abs(psis - pr))
+
+
+@pytest.mark.parametrize("nu", [1e-3, pytest.param(1e-4, marks=pytest.mark.slow)])
+def test_a_creeping_cluster_follows_the_full_equations(nu):
+    """Slips, velocities and states of a creeping cluster of three blocks match the full inertial equations
+    to a few 1e-4 over the time psi takes to relax: the quasi-static creep neglects inertia only (relative
+    order nu) and the backward-Euler steps keep their local error in psi below integrator.creep_tol."""
+    slip_err, v_err, psi_err = against_the_full_equations(nu, 1e-6)
+    assert slip_err < 5e-4 and v_err < 1e-3 and psi_err < 1.5e-4, (slip_err, v_err, psi_err)
+
+
+def test_creep_converges_in_its_tolerance():
+    """The error of psi against the full equations falls with integrator.creep_tol (first order: a tenth of
+    the tolerance, several times smaller errors; at 1e-6 well below the quasi-static model's own error)."""
+    errs = [against_the_full_equations(1e-3, tol)[2] for tol in (1e-4, 1e-5, 1e-6)]
+    assert errs[0] > 3 * errs[1] > 9 * errs[2], errs
+
+
+def test_a_single_block_below_the_loader_stiffness_creeps_at_the_plate_rate():
+    """N = 1 and the aging law with b below the loader's stiffness 1: the block creeps for ever, towards
+    steady sliding at the plate's rate, v = nu and theta = 1 / nu (the creep phase has no inertial
+    oscillation). It starts at its threshold with theta 100 times the steady one."""
+    nu, b = 1e-6, 0.5
+    p = kernel_params(Model(N=1, l=L, b=b, nu=nu), Integrator())
+    ws = Workspace(1)
+    psi = np.log(100.0 / nu)
+    ws.load(np.array([b * psi]), np.array([psi]))
+    clock = np.zeros(2)
+    t, e, d = np.empty(1), np.empty(1, dtype=np.int64), np.empty((1, NDIAG))
+    status, k = simulate(ws.arrays, clock, p, 1, 100_000, t, e, d)
+    assert (status, k) == (OK, 0)
+    elapsed = ws.since[0].sum()
+    assert elapsed > 20 / nu, "the relaxation (about 1 / nu) is long past"
+    assert ws.creep[0, CR_V] == pytest.approx(nu, rel=1e-4)
+    assert np.exp(ws.W[0, P]) == pytest.approx(1 / nu, rel=1e-3)
+    assert ws.W[0, F0] == pytest.approx(b * ws.W[0, P], abs=1e-9), "force on the friction"
+
+
+def rows(n, b, events, budget=UNLIMITED, reload=False, seed=1, nu=1e-8):
+    """(t, epicenter, diag) of `events` rows of a chain of n blocks from a random state, in calls of `budget`;
+    with `reload`, every call continues from a fresh workspace loaded from the previous one's checkpoint
+    (between_events and creep_state), as a resumed run does."""
+    p = kernel_params(Model(N=n, l=L, b=b, nu=nu), Integrator())
+    rng = np.random.default_rng(seed)
+    ws = Workspace(n)
+    ws.load(rng.uniform(0, 1, n) * b * 20, np.full(n, 20.0))
+    clock = np.zeros(2)
+    t, e, d = np.empty(events), np.empty(events, dtype=np.int64), np.empty((events, NDIAG))
+    done = 0
+    while done < events:
+        status, k = simulate(ws.arrays, clock, p, events - done, budget, t[done:], e[done:], d[done:])
+        assert status in (OK, 4), status
+        done += k
+        if reload and not ws.paused:    # (a paused event would start again from its onset)
+            force, psi, since, clock = ws.between_events(clock)
+            state = ws.creep_state()
+            ws = Workspace(n)
+            ws.load(force, psi, since, creep=state)
+    return t, e, d
+
+
+def test_pause_and_resume_inside_creep_are_bit_identical():
+    """Kernel calls of a small budget, paused in the middle of creep phases and events, and continued from a
+    checkpoint (a fresh workspace) wherever no event is in progress, creep in flight included, give the
+    rows of one uninterrupted call, bit for bit."""
+    whole = rows(60, 15.0, 150)
+    kinds = whole[2][:, D_KIND]
+    assert np.sum(kinds == KIND_CREEP) > 20 and np.sum(kinds == KIND_EVENT) > 20
+    for reload in (False, True):
+        pieces = rows(60, 15.0, 150, budget=3000, reload=reload)
+        for a, b in zip(whole, pieces):
+            np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("b", [10.0, 12.0, 15.0, 18.5])
+def test_below_the_block_stiffness_the_chain_creeps_and_ruptures(b):
+    """Below the block stiffness 1 + 2 l^2 = 19 onsets of single interior blocks creep; events still happen
+    (a cluster of two is softer than b from 10 on, and the free ends, of stiffness 10, rupture from b = 10)."""
+    t, e, d = rows(100, b, 400)
+    kinds = d[:, D_KIND]
+    creeps, events = d[kinds == KIND_CREEP], d[kinds == KIND_EVENT]
+    assert len(creeps) > 50 and len(events) > 20
+    assert np.all(creeps[:, D_SLIP] > 0) and np.all(np.isin(creeps[:, D_ENDING], (1, 2)))
+    assert np.all(events[:, D_ENDING] == 0)
+    # creep episodes are slow and small beside the largest events
+    assert np.max(creeps[:, D_SLIP]) < 0.1 * np.max(events[:, D_SLIP])
+
+
+def test_a_cluster_too_soft_to_creep_hands_over_to_an_event():
+    """Blocks 1 and 2 of 4 (b = 15): block 1 creeps alone (K - b = 4 > 0), block 2 reaches its threshold
+    beside it, and the pair (lambda_min(K_C) = 10 < 15) ruptures: the episode ends taken by the event
+    (ending 2), whose epicenter is block 2 (it slides both, and the rupture spreads)."""
+    n, b, nu = 4, 15.0, 1e-8
+    psi = np.full(n, np.log(b / nu) + 2.0)
+    force = b * psi - np.array([500.0, 0.0, 1e-3, 500.0])
+    p = kernel_params(Model(N=n, l=L, b=b, nu=nu), Integrator())
+    ws = Workspace(n)
+    ws.load(force, psi)
+    clock = np.zeros(2)
+    t, e, d = np.empty(2), np.empty(2, dtype=np.int64), np.empty((2, NDIAG))
+    assert simulate(ws.arrays, clock, p, 2, UNLIMITED, t, e, d) == (OK, 2)
+    assert d[0, D_KIND] == KIND_EVENT and e[0] == 2 and d[0, D_NSLIP] >= 2
+    assert d[1, D_KIND] == KIND_CREEP and e[1] == 1 and d[1, D_ENDING] == 2 and d[1, D_NSLIP] == 1
+    assert t[1] == 0.0 < t[0], "the episode began at the start, the event later"
+
+
+def test_above_the_block_stiffness_nothing_creeps():
+    """b >= 1 + 2 l^2: no block can creep (creep.possible is False), the kernels run as without a creep
+    phase (the kernel identity test holds them to the reference bit for bit)."""
+    p = kernel_params(Model(N=100, l=L, b=19.0), Integrator())
+    assert not creep.possible(p, 100)
+    assert creep.possible(kernel_params(Model(N=100, l=L, b=18.99), Integrator()), 100)
+    assert creep.possible(kernel_params(Model(N=1, l=L, b=0.99), Integrator()), 1)
+    assert not creep.possible(kernel_params(Model(N=1, l=L, b=1.0), Integrator()), 1)
+    cl = Model(N=100, law="carlson-langer", alpha=2.0, sigma=0.01)
+    assert not creep.possible(kernel_params(cl, Integrator()), 100)
