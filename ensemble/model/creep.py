@@ -36,7 +36,7 @@ from .geometry import left, right
 from .laws import creep_state, creep_weakening, creeps, friction, friction_slopes, onset_delay, rest_state, state_rate, threshold
 from .schedule import advance_clock, elapsed, materialize, onset_key, tree_min, tree_set
 from .workspace import (CR_DIAG, CR_DPSI, CR_DU, CR_EP, CR_H, CR_HB, CR_LEFT, CR_PSI, CR_RES, CR_SERIAL, CR_UPPER, CR_V,
-                        CR_VN, CS_ENDED, CS_FRESH, CS_H, CS_NCREEP, CS_SERIAL, CS_T_HI, CS_T_LO, E_ACTIVE, E_BLOCK_STEPS,
+                        CR_VN, CS_DIRTY, CS_ENDED, CS_FRESH, CS_H, CS_NCREEP, CS_SERIAL, CS_T_HI, CS_T_LO, E_ACTIVE, E_BLOCK_STEPS,
                         E_END_HI, E_END_LO, E_EPICENTER, E_FIRST, E_LAST, E_NBLOCKS, E_RUNNING, E_RUPTURED,
                         E_SERIAL, E_SLIP, E_START_HI, E_START_LO, E_STATE, E_STOPPED, E_VMAX, F0, P,
                         D_BLOCK_STEPS, D_DURATION, D_ENDING, D_FIRST, D_KIND, D_LAST, D_NSLIP, D_SLIP, D_VMAX,
@@ -134,6 +134,30 @@ def _watched(C, n, j):
 
 
 @nb.njit(cache=True)
+def creeping_list(arrays, n):
+    """The number m of creeping blocks, arrays.crept[:m] holding them in increasing order (made again
+    after blocks joined or left: O(n) per change of the set, not per step)."""
+    cs = arrays.cstate
+    if cs[CS_DIRTY] != 0.0:
+        m = 0
+        for i in range(n):
+            if arrays.creep[i, CR_EP] != 0.0:
+                arrays.crept[m] = i
+                m += 1
+        cs[CS_DIRTY] = 0.0
+    return int(cs[CS_NCREEP])
+
+
+@nb.njit(cache=True, inline="always")
+def _first_visit(C, n, i, j):
+    """Resting block j beside creeping block i is met here first in a pass over the creeping blocks
+    in increasing order (a block between two creeping ones is met once)."""
+    if j == i or creeping(C, j):
+        return False
+    return j > i or j == 0 or not creeping(C, j - 1)
+
+
+@nb.njit(cache=True)
 def rekey(arrays, n, p, j):
     """Block j's onset key: inf while creep watches it, else its onset by loading alone."""
     if _watched(arrays.creep, n, j):
@@ -194,6 +218,7 @@ def join(arrays, n, p, j, v0, t):
         C[j, CR_SERIAL] = E[slot, E_SERIAL]
         E[slot, E_NBLOCKS] += 1.0
     cs[CS_NCREEP] += 1.0
+    cs[CS_DIRTY] = 1.0
     for k in (left(j), j, right(j, n)):
         if k != j and not creeping(C, k):
             materialize(W, since, k, t, p)      # a watched neighbour stays at the creep's time
@@ -209,6 +234,7 @@ def leave(arrays, n, p, i, t, outcome):
     C[i, CR_EP] = 0.0
     C[i, CR_V] = 0.0
     cs[CS_NCREEP] -= 1.0
+    cs[CS_DIRTY] = 1.0
     E[slot, E_ACTIVE] -= 1.0
     if E[slot, E_ACTIVE] == 0.0:
         E[slot, E_STATE] = outcome
@@ -220,11 +246,11 @@ def leave(arrays, n, p, i, t, outcome):
 
 
 @nb.njit(cache=True)
-def _step_sizes(C, since, n, t, h):
-    """CR_H of every creeping block: from its own time to t + h (they differ after an event)."""
-    for i in range(n):
-        if creeping(C, i):
-            C[i, CR_H] = h + ((t[0] - since[i, 0]) + (t[1] - since[i, 1]))
+def _step_sizes(C, since, lst, m, t, h):
+    """CR_H of every creeping block (lst[:m]): from its own time to t + h (they differ after an event)."""
+    for k in range(m):
+        i = lst[k]
+        C[i, CR_H] = h + ((t[0] - since[i, 0]) + (t[1] - since[i, 1]))
 
 
 @nb.njit(cache=True)
@@ -234,24 +260,24 @@ def _newton(arrays, n, p):
     equation (creep_state). Tridiagonal Newton from CR_V. Returns False if it does not converge or
     a pivot is not negative (the step's system is no longer that of a creeping cluster)."""
     C, W = arrays.creep, arrays.W
+    lst = arrays.crept
+    m_c = creeping_list(arrays, n)
     l2 = p.l2
-    for i in range(n):
-        if creeping(C, i):
-            C[i, CR_VN] = C[i, CR_V]
-            C[i, CR_PSI] = W[i, P]
+    for k in range(m_c):
+        i = lst[k]
+        C[i, CR_VN] = C[i, CR_V]
     for _ in range(_NEWTON):
-        for i in range(n):
-            if creeping(C, i):
-                h = C[i, CR_H]
-                v = C[i, CR_VN]
-                psi, dpsi = creep_state(p.law, W[i, P], v, h)
-                C[i, CR_PSI] = psi
-                C[i, CR_DPSI] = dpsi
-                C[i, CR_DU] = h * v
+        for k in range(m_c):
+            i = lst[k]
+            h = C[i, CR_H]
+            v = C[i, CR_VN]
+            psi, dpsi = creep_state(p.law, W[i, P], v, h)
+            C[i, CR_PSI] = psi
+            C[i, CR_DPSI] = dpsi
+            C[i, CR_DU] = h * v
         done = True
-        for i in range(n):
-            if not creeping(C, i):
-                continue
+        for k in range(m_c):
+            i = lst[k]
             h = C[i, CR_H]
             v = C[i, CR_VN]
             psi = C[i, CR_PSI]
@@ -269,9 +295,8 @@ def _newton(arrays, n, p):
                 return False
             C[i, CR_DIAG] = d
             C[i, CR_RES] = r
-        for i in range(n - 1, -1, -1):
-            if not creeping(C, i):
-                continue
+        for k in range(m_c - 1, -1, -1):
+            i = lst[k]
             r = C[i, CR_RES]
             if i < n - 1 and creeping(C, i + 1):
                 r -= l2 * C[i + 1, CR_H] * C[i + 1, CR_UPPER]
@@ -284,10 +309,10 @@ def _newton(arrays, n, p):
             if not (abs(delta) <= 1e-12 * abs(v) + 1e-14 * (abs(W[i, F0]) + 1.0) / abs(C[i, CR_DIAG])):
                 done = False
         if done:
-            for i in range(n):
-                if creeping(C, i):
-                    C[i, CR_PSI], C[i, CR_DPSI] = creep_state(p.law, W[i, P], C[i, CR_VN], C[i, CR_H])
-                    C[i, CR_DU] = C[i, CR_H] * C[i, CR_VN]
+            for k in range(m_c):
+                i = lst[k]
+                C[i, CR_PSI], C[i, CR_DPSI] = creep_state(p.law, W[i, P], C[i, CR_VN], C[i, CR_H])
+                C[i, CR_DU] = C[i, CR_H] * C[i, CR_VN]
             return True
     return False
 
@@ -336,9 +361,9 @@ def _error(arrays, n, p):
     C, W = arrays.creep, arrays.W
     w = creep_weakening(p.law)
     err = 0.0
-    for i in range(n):
-        if not creeping(C, i):
-            continue
+    lst = arrays.crept
+    for k in range(creeping_list(arrays, n)):
+        i = lst[k]
         g_end = _rate(p.law, C[i, CR_VN], C[i, CR_PSI])
         g_start = _rate(p.law, C[i, CR_V], W[i, P])
         dv = C[i, CR_VN] - C[i, CR_V]
@@ -352,80 +377,91 @@ def _commit(arrays, n, p, t_new):
     """The step's end becomes the state: creeping blocks' force, psi, velocity and time; their resting
     neighbours brought to t_new with the creeping blocks' slip in their force; episode statistics."""
     C, E, W, since = arrays.creep, arrays.episodes, arrays.W, arrays.since
+    lst = arrays.crept
+    m = creeping_list(arrays, n)
     l2 = p.l2
-    for i in range(n):
-        if creeping(C, i):
-            h = C[i, CR_H]
-            du_l = C[i - 1, CR_DU] if i > 0 and creeping(C, i - 1) else 0.0
-            du_r = C[i + 1, CR_DU] if i < n - 1 and creeping(C, i + 1) else 0.0
-            C[i, CR_RES] = W[i, F0] + p.nu * h - stiffness(i, n, l2) * C[i, CR_DU] + l2 * (du_l + du_r)
-    for j in range(n):
-        if not creeping(C, j) and _watched(C, n, j):
-            materialize(W, since, j, t_new, p)
-            for k in (left(j), right(j, n)):
-                if k != j and creeping(C, k):
-                    W[j, F0] += l2 * C[k, CR_DU]
-    for i in range(n):
-        if creeping(C, i):
-            W[i, F0] = C[i, CR_RES]
-            W[i, P] = C[i, CR_PSI]
-            since[i, 0] = t_new[0]
-            since[i, 1] = t_new[1]
-            v = C[i, CR_VN]
-            C[i, CR_V] = v
-            slot = int(C[i, CR_EP]) - 1
-            du = C[i, CR_DU]
-            E[slot, E_BLOCK_STEPS] += 1.0
-            if du > 0.0:
-                E[slot, E_SLIP] += du
-                E[slot, E_FIRST] = min(E[slot, E_FIRST], i)
-                E[slot, E_LAST] = max(E[slot, E_LAST], i)
-            if v > E[slot, E_VMAX]:
-                E[slot, E_VMAX] = v
+    for k in range(m):
+        i = lst[k]
+        h = C[i, CR_H]
+        du_l = C[i - 1, CR_DU] if i > 0 and creeping(C, i - 1) else 0.0
+        du_r = C[i + 1, CR_DU] if i < n - 1 and creeping(C, i + 1) else 0.0
+        C[i, CR_RES] = W[i, F0] + p.nu * h - stiffness(i, n, l2) * C[i, CR_DU] + l2 * (du_l + du_r)
+    for k in range(m):
+        i = lst[k]
+        for j in (left(i), right(i, n)):
+            if _first_visit(C, n, i, j):
+                materialize(W, since, j, t_new, p)
+                for q in (left(j), right(j, n)):
+                    if q != j and creeping(C, q):
+                        W[j, F0] += l2 * C[q, CR_DU]
+    for k in range(m):
+        i = lst[k]
+        W[i, F0] = C[i, CR_RES]
+        W[i, P] = C[i, CR_PSI]
+        since[i, 0] = t_new[0]
+        since[i, 1] = t_new[1]
+        v = C[i, CR_VN]
+        C[i, CR_V] = v
+        slot = int(C[i, CR_EP]) - 1
+        du = C[i, CR_DU]
+        E[slot, E_BLOCK_STEPS] += 1.0
+        if du > 0.0:
+            E[slot, E_SLIP] += du
+            E[slot, E_FIRST] = min(E[slot, E_FIRST], i)
+            E[slot, E_LAST] = max(E[slot, E_LAST], i)
+        if v > E[slot, E_VMAX]:
+            E[slot, E_VMAX] = v
 
 
 @nb.njit(cache=True)
 def _solve(arrays, n, p, t, h):
     """The creep step from time t (two floats) by h: Newton, and every block whose velocity comes out
     negative stops at t (it is at rest instead: an active-set pass), until none does. Returns
-    (converged, work in block-steps)."""
+    (converged, work in block-steps, blocks stopped)."""
     C, cs = arrays.creep, arrays.cstate
     work = 0
+    stopped = 0
     while cs[CS_NCREEP] > 0.0:
-        _step_sizes(C, arrays.since, n, t, h)
-        work += int(cs[CS_NCREEP])
+        m = creeping_list(arrays, n)
+        _step_sizes(C, arrays.since, arrays.crept, m, t, h)
+        work += m
         if not _newton(arrays, n, p):
-            return False, work
+            return False, work, stopped
         backward = False
-        for i in range(n):
-            if creeping(C, i) and C[i, CR_VN] < 0.0:
+        for k in range(m):
+            i = arrays.crept[k]     # (leave changes the set, not this list, until it is made again)
+            if C[i, CR_VN] < 0.0:
                 leave(arrays, n, p, i, t, E_STOPPED)
                 C[i, CR_LEFT] = 1.0
+                stopped += 1
                 backward = True
         if not backward:
             break
-    return True, work
+    return True, work, stopped
 
 
 @nb.njit(cache=True)
-def _accelerating(C, n, h, inertial):
+def _accelerating(arrays, n, h, inertial):
     """A creeping block whose velocity grows by e within an inertial period over the step just
     solved (v / (dv/dt) < inertial), or -1."""
-    for i in range(n):
-        if creeping(C, i):
-            grow = C[i, CR_VN] - C[i, CR_V]
-            if grow > 0.0 and C[i, CR_VN] * h < inertial * grow:
-                return i
+    C = arrays.creep
+    for k in range(creeping_list(arrays, n)):
+        i = arrays.crept[k]
+        grow = C[i, CR_VN] - C[i, CR_V]
+        if grow > 0.0 and C[i, CR_VN] * h < inertial * grow:
+            return i
     return -1
 
 
 @nb.njit(cache=True)
-def _fastest(C, n):
+def _fastest(arrays, n):
     """The creeping block with the largest velocity (the epicenter of a hand-over by time scale)."""
+    C = arrays.creep
     who = -1
     vmax = -np.inf
-    for i in range(n):
-        if creeping(C, i) and C[i, CR_V] > vmax:
+    for k in range(creeping_list(arrays, n)):
+        i = arrays.crept[k]
+        if C[i, CR_V] > vmax:
             who, vmax = i, C[i, CR_V]
     return who
 
@@ -463,25 +499,29 @@ def continue_creep(arrays, clock, n, p, budget):
             return REACHED, used, -1
         if used >= budget:
             return PAUSED, used, -1
+        stopped = 0      # blocks stopped in this step (their CR_LEFT is scratch of the step)
         if cs[CS_FRESH] != 0.0:
             # a block joined (from rest, or handed back by an event): every creeping velocity from a
             # step of inertia's time scale, so that the error estimate starts from the creep's own
             # velocities and not from the jump of a block's velocity to them
             cs[CS_FRESH] = 0.0
-            solved, work = _solve(arrays, n, p, t, inertial)
+            solved, work, stopped = _solve(arrays, n, p, t, inertial)
             used += work
             if not solved:
-                return HANDOVER, used, _fastest(C, n)
-            for i in range(n):
-                if creeping(C, i):
-                    C[i, CR_V] = C[i, CR_VN]
+                return HANDOVER, used, _fastest(arrays, n)
+            for k in range(creeping_list(arrays, n)):
+                i = arrays.crept[k]
+                C[i, CR_V] = C[i, CR_VN]
+        if cs[CS_NCREEP] == 0.0:
+            C[:, CR_LEFT] = 0.0
             continue
         # -- the step, retried shorter until its error is accepted
         h = min(cs[CS_H], t_far)
         err = 0.0
         while True:
-            solved, work = _solve(arrays, n, p, t, h)
+            solved, work, gone = _solve(arrays, n, p, t, h)
             used += work
+            stopped += gone
             if h <= inertial or (solved and cs[CS_NCREEP] == 0.0):
                 break
             err = _error(arrays, n, p) if solved else np.inf
@@ -490,12 +530,13 @@ def continue_creep(arrays, clock, n, p, budget):
             # never below inertia's time scale, which the quasi-static equations do not resolve
             h = max(h * max(_SHRINK, 0.9 / math.sqrt(err)), h * 0.25, inertial)
         if not solved:
-            return HANDOVER, used, _fastest(C, n)
+            return HANDOVER, used, _fastest(arrays, n)
         # creep that accelerates on inertia's time scale is no longer quasi-static: an event
-        who = _accelerating(C, n, h, inertial)
+        who = _accelerating(arrays, n, h, inertial)
         if who >= 0:
             return HANDOVER, used, who
         if cs[CS_NCREEP] == 0.0:
+            C[:, CR_LEFT] = 0.0
             continue
         # at most the time the loader takes to move one unit of length (steady creep has no error
         # to bound its step)
@@ -504,14 +545,21 @@ def continue_creep(arrays, clock, n, p, budget):
         # schedule's next block by loading alone
         x_cut = 2.0
         who = -1
-        for j in range(n):
-            if C[j, CR_LEFT] != 0.0:
-                C[j, CR_LEFT] = 0.0     # stopped in this step: its onset is looked for from the next
-                continue
-            if not creeping(C, j) and _watched(C, n, j) and _excess(W, C, since, n, p, j, t, h, 1.0) > 0.0:
-                x = _locate(W, C, since, n, p, j, t, h)
-                if x < x_cut:
-                    x_cut, who = x, j
+        lst = arrays.crept
+        for k in range(creeping_list(arrays, n)):
+            i = lst[k]
+            for j in (left(i), right(i, n)):
+                if not _first_visit(C, n, i, j):
+                    continue
+                if C[j, CR_LEFT] != 0.0:
+                    C[j, CR_LEFT] = 0.0     # stopped in this step: its onset is looked for from the next
+                    continue
+                if _excess(W, C, since, n, p, j, t, h, 1.0) > 0.0:
+                    x = _locate(W, C, since, n, p, j, t, h)
+                    if x < x_cut:
+                        x_cut, who = x, j
+        if stopped > 0:
+            C[:, CR_LEFT] = 0.0         # (scratch of this step only)
         far_first = False
         if t_far <= h and t_far / h < x_cut:
             x_cut, who, far_first = t_far / h, far, True
@@ -520,10 +568,10 @@ def continue_creep(arrays, clock, n, p, budget):
                 h = 0.0
             else:
                 h *= x_cut
-                solved, work = _solve(arrays, n, p, t, h)
+                solved, work, _ = _solve(arrays, n, p, t, h)
                 used += work
                 if not solved:
-                    return HANDOVER, used, _fastest(C, n)
+                    return HANDOVER, used, _fastest(arrays, n)
         if h > 0.0:
             t_new[0], t_new[1] = t[0], t[1]
             advance_clock(t_new, h)

@@ -170,7 +170,8 @@ CS_SERIAL = 2   # episodes begun so far (serial numbers)
 CS_ENDED = 3    # episodes ended and not yet reported
 CS_T_HI, CS_T_LO = 4, 5   # two-float time up to which the creep is integrated
 CS_FRESH = 6    # 1: blocks joined since the last step, the velocities are made consistent first
-NCSTATE = 7
+CS_DIRTY = 7    # 1: blocks joined or left since the list `crept` was made (Workspace.load sets it)
+NCSTATE = 8
 
 # values of EV_PHASE
 BETWEEN, IN_EVENT = 0, 1
@@ -215,6 +216,7 @@ WorkArrays = namedtuple("WorkArrays", [
     "creep",    # (n, NCREEP) float64: per block, the creep phase (CR_*, creep.py)
     "episodes", # (2 n, NEPISODE) float64: creep episodes running or waiting to be reported (E_*)
     "cstate",   # (NCSTATE,) float64: the creep phase's scalars (CS_*)
+    "crept",    # (n,) int: the creeping blocks in increasing order, crept[:cstate[CS_NCREEP]] (creep.py)
 ])
 
 
@@ -247,13 +249,14 @@ class Workspace:
         self.creep = np.zeros((n, NCREEP))
         self.episodes = np.zeros((2 * n, NEPISODE))
         self.cstate = np.zeros(NCSTATE)
+        self.crept = np.zeros(n, dtype=np.int64)
 
     @property
     def arrays(self):
         """The work arrays as the kernels take them (WorkArrays)."""
         return WorkArrays(W=self.W, act=self.act, flag=self.flag, touched=self.touched, stuck=self.stuck,
                           since=self.since, tree=self.tree, diag=self.diag, event=self.event, undo=self.undo,
-                          creep=self.creep, episodes=self.episodes, cstate=self.cstate)
+                          creep=self.creep, episodes=self.episodes, cstate=self.cstate, crept=self.crept)
 
     def load(self, force, psi, since=None, creep=None):
         """Set the between-events state: force and psi of every block (at time since, default 0),
@@ -277,6 +280,7 @@ class Workspace:
             self.creep[:, :CR_KEEP] = creep[:k].reshape(n, CR_KEEP)
             self.episodes[:] = creep[k:k + self.episodes.size].reshape(self.episodes.shape)
             self.cstate[:] = creep[k + self.episodes.size:]
+        self.cstate[CS_DIRTY] = 1.0
 
     @staticmethod
     def creep_size(n):
