@@ -6,7 +6,8 @@
 
 Runs the transient (not timed, includes compilation), then times `events`
 recorded events and prints events/s, cost per block-step, the magnitude range
-and the largest relative energy residual.
+and the largest relative energy residual. Below the block stiffness the rows are inertial events and
+creep episodes: it prints the rate of each, and the event statistics of the inertial events alone.
 """
 import argparse
 import time
@@ -15,7 +16,8 @@ import numpy as np
 
 from ensemble.config import Config, Integrator, Model, Run
 from ensemble.events import relative_energy_residual
-from ensemble.model.workspace import D_BLOCK_STEPS, D_ENERGY_SCALE, D_NSLIP, D_RESIDUAL, D_SLIP, D_STEPS
+from ensemble.model.workspace import (D_BLOCK_STEPS, D_DURATION, D_ENERGY_SCALE, D_KIND, D_NSLIP, D_RESIDUAL, D_SLIP,
+                                      D_STEPS, KIND_CREEP, KIND_EVENT)
 from ensemble.runner import Trajectory
 from ensemble.tasks import task_list
 
@@ -46,14 +48,22 @@ def main():
     start = time.perf_counter()
     _, _, diag = traj.advance(args.events)
     elapsed = time.perf_counter() - start
+    block_steps = diag[:, D_BLOCK_STEPS].sum()      # (creep steps count their creeping blocks alike)
+    creep = diag[diag[:, D_KIND] == KIND_CREEP]
+    diag = diag[diag[:, D_KIND] == KIND_EVENT]      # the event statistics below: inertial events alone
     mu = np.log10(diag[:, D_SLIP])
     residual = relative_energy_residual(diag[:, D_RESIDUAL], diag[:, D_ENERGY_SCALE])
     how = f"dt={args.dt}" if args.method == "rk4" else f"rtol={args.rtol:g}"
     point = " ".join(f"{k}={v:g}" for k, v in keys.items())
     print(f"N={args.N} {args.law} {point} {args.method} {how}: {args.events / elapsed:.1f} events/s "
           f"({args.events} events in {elapsed:.1f} s after {args.transient} transient)")
+    if len(creep):
+        print(f"  rows: {len(diag)} inertial events ({len(diag) / elapsed:.1f}/s) and {len(creep)} creep episodes "
+              f"({len(creep) / elapsed:.1f}/s; median slip {np.median(creep[:, D_SLIP]):.3g}, median duration "
+              f"{np.median(creep[:, D_DURATION]):.3g}, {creep[:, D_BLOCK_STEPS].mean():.0f} block-steps each); "
+              f"aseismic slip fraction {creep[:, D_SLIP].sum() / (creep[:, D_SLIP].sum() + diag[:, D_SLIP].sum()):.2e}")
     print(f"  {diag[:, D_STEPS].mean():.0f} steps and {diag[:, D_BLOCK_STEPS].mean():.0f} block-steps per event, "
-          f"{elapsed / diag[:, D_BLOCK_STEPS].sum() * 1e9:.0f} ns per block-step")
+          f"{elapsed / block_steps * 1e9:.0f} ns per block-step")
     print(f"  mu in [{mu.min():.2f}, {mu.max():.2f}], fraction mu >= 4: {np.mean(mu >= 4):.3f}, "
           f"fraction of events slipping >= 50 blocks: {np.mean(diag[:, D_NSLIP] >= 50):.3f}, "
           f"max relative energy residual {residual.max():.1e}")
