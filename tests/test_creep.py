@@ -176,3 +176,25 @@ def test_above_the_block_stiffness_nothing_creeps():
     assert not creep.possible(kernel_params(Model(N=1, l=L, b=1.0), Integrator()), 1)
     cl = Model(N=100, law="carlson-langer", alpha=2.0, sigma=0.01)
     assert not creep.possible(kernel_params(cl, Integrator()), 100)
+
+
+def test_a_block_that_stuck_on_its_threshold_does_not_creep_in_place():
+    """With a strong velocity strengthening (a = 30, b = 15) events leave blocks stuck on their threshold
+    while it outruns the loader. Such a block is on its threshold for an instant only: it must not start a
+    creep that stops at once, again and again, at the same time (the run stood still). Kernel calls of a
+    bounded budget make progress: 600 rows within 300 calls."""
+    n, b = 100, 15.0
+    p = kernel_params(Model(N=n, l=L, b=b, a=30.0, nu=1e-8), Integrator())
+    ws = Workspace(n)
+    ws.load(np.random.default_rng(1).uniform(0, 1, n) * b * 20, np.full(n, 20.0))
+    clock = np.zeros(2)
+    t, e, d = np.empty(600), np.empty(600, dtype=np.int64), np.empty((600, NDIAG))
+    done = 0
+    for _ in range(300):
+        status, k = simulate(ws.arrays, clock, p, 600 - done, 200_000, t[done:], e[done:], d[done:])
+        assert status in (OK, 4)
+        done += k
+        if done == 600:
+            break
+    assert done == 600
+    assert np.sum(d[:, D_KIND] == KIND_CREEP) > 20

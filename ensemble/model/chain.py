@@ -19,9 +19,10 @@ import math
 import numba as nb
 import numpy as np
 
-from .creep import ENDED, HANDOVER, after_event, continue_creep, join, off_schedule, possible, report, stable
+from .creep import (ENDED, HANDOVER, after_event, continue_creep, join, loaded_past_threshold, off_schedule,
+                    possible, report, stable)
 from .event import begin_event, begin_handover, continue_event
-from .laws import creep_weakening, loader_moves, onset_delay, threshold
+from .laws import creep_weakening, loader_moves, onset_delay, rest_state, threshold
 from .schedule import advance_clock, build_schedule, finite_state, materialize, tree_min
 from .undo import log_block
 from .workspace import (BETWEEN, CS_ENDED, CS_NCREEP, D_DURATION, D_ENDING, D_KIND, D_SLIP, EV_CLOCK_HI,
@@ -108,7 +109,8 @@ def simulate(arrays, clock, p, n_events, budget, out_t, out_epicenter, out_diag)
             onset[0] = since[epicenter, 0]
             onset[1] = since[epicenter, 1]
             advance_clock(onset, delay)
-            if creep_on and stable(n, p.l2, creep_weakening(p.law), epicenter, epicenter):
+            if (creep_on and stable(n, p.l2, creep_weakening(p.law), epicenter, epicenter)
+                    and loaded_past_threshold(p, n, rest_state(p.law, W[epicenter, P], delay))):
                 # a block stiffer than its law's weakening creeps instead of rupturing
                 if (onset[0] - clock[0]) + (onset[1] - clock[1]) > 0.0:
                     clock[0] = onset[0]

@@ -71,6 +71,16 @@ def possible(p, n):
     return creep_weakening(p.law) < k_max
 
 
+@nb.njit(cache=True)
+def loaded_past_threshold(p, n, psi):
+    """A block on its threshold, at rest with state psi, is loaded faster than its threshold grows
+    over an inertial period: it starts to move (creep). Otherwise it is on its threshold only for an
+    instant (an event's block that stuck on it, its threshold then outrunning the loader), and the
+    kernels treat it as they always have: an event, in which it stays pressed without slipping."""
+    dt = 2.0 * math.pi / math.sqrt(stiffness(min(1, n - 1), n, p.l2))
+    return p.nu * dt > threshold(p.law, rest_state(p.law, psi, dt)) - threshold(p.law, psi)
+
+
 @nb.njit(cache=True, inline="always")
 def creeping(C, i):
     return C[i, CR_EP] != 0.0
