@@ -29,8 +29,8 @@ from ensemble import checks, filekind
 from ensemble.catalog import CatalogError
 
 from . import merge, summary
-from .reduce import NUMBERS, Options, parse_bins
-from .stats import N_STATS
+from .reduce import CREEP_DURATION_BINS, CREEP_MU_BINS, NUMBERS, Options, parse_bins
+from .stats import N_CREEP_STATS, N_STATS
 
 # errors that reduce's rank 0 finds before the work starts and every rank then raises alike
 # (ensemble.abort.on_root), with their exit codes; any other error on any rank aborts them all
@@ -48,6 +48,8 @@ NUMERIC = {
     "b_cut": lambda v: checks.number("--b-cut", v, *MAGNITUDE),
     "mu_bins": lambda v: _bins("--mu-bins", v),
     "tnu_bins": lambda v: _bins("--tnu-bins", v),
+    "creep_mu_bins": lambda v: _bins("--creep-mu-bins", v),
+    "creep_duration_bins": lambda v: _bins("--creep-duration-bins", v),
     "window": lambda v: checks.count("--window", v, lo=0, hi=10 ** 9),
     "bootstrap": lambda v: checks.count("--bootstrap", v, lo=1, hi=10 ** 6),
     "level": lambda v: checks.number("--level", v, 0.0, 1.0, exclusive=True),
@@ -86,6 +88,12 @@ def _parser():
     # being the paper's axes; catalogs of several laws need them given
     r.add_argument("--mu-bins", help="magnitude bins lo:hi:n (default: the law's; aging 0:7:70)")
     r.add_argument("--tnu-bins", help="T*nu bins lo:hi:n (default: the law's; aging 0:2000:80)")
+    r.add_argument("--creep-mu-bins", default=CREEP_MU_BINS,
+                   help=f"bins lo:hi:n of the creep episodes' mu = log10(slip) (default {CREEP_MU_BINS}; "
+                        "a negative lo after '=': --creep-mu-bins=-8:2:50)")
+    r.add_argument("--creep-duration-bins", default=CREEP_DURATION_BINS,
+                   help="bins lo:hi:n of the creep episodes' log10(duration nu), duration in units of the "
+                        f"loading time 1/nu (default {CREEP_DURATION_BINS})")
     r.add_argument("--mu-c", help="large-event magnitude (default: the law's; aging 4)")
     r.add_argument("--window", default=10, help="epicenter window in blocks (default 10)")
     r.add_argument("--b-cut", help="magnitude cut of the GR b fit (default: the law's; aging 3)")
@@ -101,7 +109,9 @@ def _parser():
     pl.add_argument("summaries", nargs="+", metavar="summary",
                     help="one or more summaries: their points in one figure, labelled by the "
                          "parameters that differ between them")
-    pl.add_argument("--figure", choices=("magnitude", "recurrence"), required=True)
+    pl.add_argument("--figure", choices=("magnitude", "recurrence", "creep"), required=True,
+                    help="creep: the creep episodes' size and duration densities and the aseismic slip "
+                         "fraction (points with creep episodes; an error if none has any)")
     pl.add_argument("-o", "--output", required=True, help="FILE.png or FILE.pdf")
     pl.add_argument("--title", default=None)
     pl.add_argument("--force", action="store_true", help="overwrite an existing figure")
@@ -203,10 +213,11 @@ def _memory(opt, n_tasks):
     (stretches, bins) counts and stacks them for the summary; a point's bootstrap keeps every
     resample's curves and T nu counts."""
     n_mu, n_tnu = len(opt.mu_edges) - 1, len(opt.tnu_edges) - 1
-    per_task = opt.blocks * (n_mu + 2 * n_tnu + N_STATS)
-    resamples = opt.bootstrap * (n_mu + 3 * n_tnu + len(NUMBERS) + n_tasks * opt.blocks)
-    checks.memory(f"--blocks {opt.blocks}, --bootstrap {opt.bootstrap} and {n_mu} + 2 x {n_tnu} bins over "
-                  f"{n_tasks} tasks", 8 * (2 * n_tasks * per_task + resamples))
+    n_creep = len(opt.creep_mu_edges) + len(opt.creep_duration_edges) - 2
+    per_task = opt.blocks * (n_mu + 2 * n_tnu + n_creep + N_STATS + N_CREEP_STATS)
+    resamples = opt.bootstrap * (n_mu + 3 * n_tnu + n_creep + len(NUMBERS) + n_tasks * opt.blocks)
+    checks.memory(f"--blocks {opt.blocks}, --bootstrap {opt.bootstrap} and {n_mu} + 2 x {n_tnu} + {n_creep} bins "
+                  f"over {n_tasks} tasks", 8 * (2 * n_tasks * per_task + resamples))
 
 
 def _prepare(args):
@@ -216,7 +227,9 @@ def _prepare(args):
     inputs = merge.read(args.catalogs, allow_partial=args.partial)   # checks each file's kind first
     scale = _scales(args, inputs)
     opt = Options(parse_bins(scale["mu_bins"], "--mu-bins"), parse_bins(scale["tnu_bins"], "--tnu-bins"),
-                  scale["mu_c"], args.window, scale["b_cut"], args.bootstrap, args.level, args.blocks, args.seed)
+                  scale["mu_c"], args.window, scale["b_cut"], args.bootstrap, args.level, args.blocks, args.seed,
+                  creep_mu_edges=parse_bins(args.creep_mu_bins, "--creep-mu-bins"),
+                  creep_duration_edges=parse_bins(args.creep_duration_bins, "--creep-duration-bins"))
     _memory(opt, len(inputs.tasks["point"]))
     return opt, out, inputs
 

@@ -1,5 +1,7 @@
 """Figures from one or more summaries: R(mu) of every point overlaid, with bootstrap bands;
-recurrence-time distributions, one panel per point, each with its main peak enlarged in an inset.
+recurrence-time distributions, one panel per point, each with its main peak enlarged in an inset;
+the slow side (creep episodes): their size and duration densities, of the points that have any,
+and the aseismic slip fraction against the swept parameter.
 Points of several summaries are labelled by the parameters that differ between all the plotted
 points (legend_labels).
 
@@ -18,6 +20,7 @@ from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.ticker import MaxNLocator  # noqa: E402
 from matplotlib.transforms import Bbox  # noqa: E402
 
+from . import summary as summary_file  # noqa: E402
 from .reduce import PARAMS  # noqa: E402
 from .report import level_text, partial_text, size_text  # noqa: E402
 from .stats import centers  # noqa: E402
@@ -236,6 +239,61 @@ def place_insets(summaries, fig):
             place_inset(ax, _zoom(s, i, centers(s["bins/tnu"]), peak), renderer)
 
 
+CREEP_PANELS = (   # curve, x label, y label
+    ("creep_mu", r"creep episode size $\mu = \log_{10}$ slip", r"density of $\mu$"),
+    ("creep_duration", r"creep episode duration $\log_{10}(\mathrm{duration}\;\nu)$", "density"),
+)
+
+
+def creep(summaries, fig, keys, labels, names):
+    """Three panels: the creep episodes' size and duration densities of every point that has any
+    (overlaid, bands), and the aseismic slip fraction of every point of a summary that reduced the
+    creep episodes against the first varying parameter (b if it varies), with its interval."""
+    points = _points(summaries)
+    colors = _colors(len(points))
+    shown = [(s, i, label, color) for (s, i), label, color in zip(points, labels, colors)
+             if summary_file.creeping(s)[i]]
+    if not shown:
+        raise summary_file.SummaryError(
+            f"{', '.join(map(str, names))}: no creep episodes in any point, no creep figure (a summary of "
+            "format 2 did not reduce them: reduce its catalogs again)")
+    axes = fig.subplots(1, 3)
+    opened = False
+    for ax, (curve, xlabel, ylabel) in zip(axes, CREEP_PANELS):
+        for s, i, label, color in shown:
+            opened |= _band(ax, centers(s[f"bins/{curve}"]), s[f"points/{curve}_density"][i],
+                            s[f"points/{curve}_lo"][i], s[f"points/{curve}_hi"][i], label, color,
+                            log=True, open_ends=True)
+        ax.set_yscale("log")
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(ylabel)
+    x_key = "b" if "b" in keys else keys[0]
+    others = [k for k in keys if k != x_key]
+    ax = axes[2]
+    series = {}
+    for s, i in points:
+        if summary_file.has_creep(s):
+            group = ", ".join(f"{k} = {s[f'points/{k}'][i]:g}" for k in others)
+            series.setdefault(group, []).append((s[f"points/{x_key}"][i], *s["points/numbers/aseismic_fraction"][i]))
+    for n, (group, rows) in enumerate(series.items()):
+        x, y, lo, hi = np.array(sorted(rows)).T
+        err = np.where(np.isfinite(lo), [y - lo, hi - y], 0.0)
+        ax.errorbar(x, y, yerr=err, fmt="o-", color=f"C{n % 10}", ms=4, capsize=3, lw=1.2, clip_on=False,
+                    label=group or None)
+    ax.set_ylim(0, ax.get_ylim()[1])
+    ax.set_xlabel(x_key)
+    ax.set_ylabel("aseismic slip fraction")
+    ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 3))
+    if len(series) > 1:
+        ax.legend(fontsize=FONT, loc="upper center", bbox_to_anchor=(0.5, -0.22), frameon=False)
+    handles, texts = axes[0].get_legend_handles_labels()
+    if opened:
+        handles.append(Line2D([], [], marker=OPEN, color="0.3", mfc="none", ls="none"))
+        texts.append(OPEN_NOTE)
+    fig.legend(handles, texts, title="varying " + ", ".join(keys), loc="lower center", fontsize=FONT,
+               title_fontsize=FONT + 1, ncol=min(len(texts), 4), frameon=False)
+
+
 def _values(values, fmt="{}"):
     """Distinct values, " / " between them."""
     return " / ".join(dict.fromkeys(fmt.format(v) for v in values))
@@ -268,7 +326,7 @@ def title_text(summaries, names, title=None):
 
 
 def figure(summaries, kind, title=None, names=None):
-    """The figure `kind` ("magnitude" or "recurrence") of the points of one summary (a dict from
+    """The figure `kind` ("magnitude", "recurrence" or "creep") of the points of one summary (a dict from
     summary.read) or several (a list), laid out and ready to save. names: the summaries' paths
     or names (to tell points of equal parameters apart)."""
     if isinstance(summaries, dict):
@@ -282,6 +340,10 @@ def figure(summaries, kind, title=None, names=None):
         fig, ax = plt.subplots(figsize=(8 + 1.6 * (_legend_columns(n) - 1), 4.8), dpi=DPI)
         magnitude(summaries, ax, keys, labels)
         _layout(fig, text, 0.0)
+    elif kind == "creep":
+        fig = plt.figure(figsize=(13, 4.6 + 0.25 * math.ceil((n + 1) / 4)), dpi=DPI)
+        creep(summaries, fig, keys, labels, names)
+        _layout(fig, text, 0.45 + 0.2 * math.ceil((n + 1) / 4))   # the figure legend below the panels
     else:
         rows, cols = _grid(n)
         fig = plt.figure(figsize=(5.5 * cols, 4 * rows + 0.4), dpi=DPI)

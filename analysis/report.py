@@ -1,8 +1,8 @@
 """The summary numbers of every parameter point as a text table."""
 import numpy as np
 
-from . import reduce
-from .reduce import NUMBERS, PARAMS
+from . import reduce, summary
+from .reduce import CREEP_NUMBERS, NUMBERS, PARAMS
 from .stats import N_EVENTS
 
 LABELS = {
@@ -10,6 +10,8 @@ LABELS = {
     "n_recurrences": "recurrences", "mean_tnu": "mean T*nu", "mode_tnu": "mode T*nu",
     "mean_tnu_interior": "mean T*nu (int.)", "gr_b": "GR b", "gr_b_se": "GR b std. error",
     "ks_gr": "KS to GR",
+    "n_creep": "creep episodes", "creep_share": "creep share (rows)", "taken_over_share": "taken over",
+    "aseismic_fraction": "aseismic fraction",
 }
 
 
@@ -80,6 +82,16 @@ def partial_text(s):
     return str(s["attrs"].get("partial", ""))
 
 
+def creep_lines(s, i):
+    """The slow side of point i: its creep numbers with intervals, one line saying it has no creep
+    episodes, or nothing for a summary that did not reduce them (format 2)."""
+    if not summary.has_creep(s):
+        return []
+    if not summary.creeping(s)[i]:
+        return [f"    {'creep episodes':>18s}  none"]
+    return [f"    {LABELS[name]:>18s}  {_fmt(*s[f'points/numbers/{name}'][i])}" for name in CREEP_NUMBERS]
+
+
 def table(s):
     """The report; a partial reduction says so on its first line."""
     a = s["attrs"]
@@ -93,9 +105,11 @@ def table(s):
         if unreliable(s, i):
             lines.append(f"    WARNING: {unreliable(s, i)}")
         for name in NUMBERS:
-            est, lo, hi = s[f"points/numbers/{name}"][i]
-            lines.append(f"    {LABELS[name]:>18s}  {_fmt(est, lo, hi)}")
+            if name not in CREEP_NUMBERS:
+                est, lo, hi = s[f"points/numbers/{name}"][i]
+                lines.append(f"    {LABELS[name]:>18s}  {_fmt(est, lo, hi)}")
         peaks = [row for row in s["points/peaks"][i] if np.isfinite(row[0])]
         lines.append(f"    {'T*nu peaks':>18s}  " + ("; ".join(_fmt(*row) for row in peaks) or "-"))
+        lines += creep_lines(s, i)
         lines.append("")
     return "\n".join(lines)

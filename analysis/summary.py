@@ -1,6 +1,7 @@
 """The summary HDF5 written by `python -m analysis reduce`.
 
     /bins/mu, /bins/tnu                         bin edges
+    /bins/creep_mu, /bins/creep_duration        bin edges of the creep episodes' mu and log10(duration nu)
     /tasks/*                                    the task tables of the catalogs, one after the other
                                                 (in the order given), one row per task, with
     /tasks/catalog, /tasks/catalog_task         its catalog (index into the attribute `catalogs`)
@@ -11,10 +12,13 @@
                                                 the one the runner uses: analysis/merge.py)
     /per_task/{mu, tnu, tnu_interior}           (tasks, stretches, bins) counts
     /per_task/numbers                           (tasks, stretches, 9) counts and sums (analysis.stats)
+    /per_task/{creep_mu, creep_duration}        (tasks, stretches, bins) counts of the creep episodes
+    /per_task/creep                             (tasks, stretches, 4) counts and sums of the slow side
     /points/{N, l, nu, <law keys>}              parameters of each point (first appearance order;
                                                 the keys of every friction law, NaN if not its law's)
     /points/method, /points/units               resampling used ("seeds" or "blocks") and unit count
     /points/{mu, tnu, tnu_interior}_density     (points, bins): estimate; *_lo, *_hi: interval
+    /points/{creep_mu, creep_duration}_density  the same for the creep episodes (format 3)
     /points/numbers/<name>                      (points, 3): estimate, lo, hi (see reduce.NUMBERS)
     /points/peaks                               (points, max peaks, 3): T*nu position, lo, hi (NaN pad)
     attributes: format; catalogs (the catalogs' paths, in the order given: /tasks/catalog indexes
@@ -30,9 +34,12 @@ spawn_key); its bootstrap draws from SeedSequence(seed, spawn_key from its param
 which order they were given.
 
 `format` tells a summary from a catalog (ensemble/filekind.py); summaries written before it
-existed are known by their attributes and groups. Format 2 (GR b and its standard error, 9
-per-task sums, peaks by prominence; catalogs, configs, partial and the /tasks columns catalog,
-catalog_task and catalog_point) is the only one read: reduce the catalogs again for older ones.
+existed are known by their attributes and groups. Format 3 adds the creep episodes (the slow side:
+/bins/creep_*, /per_task/creep*, /points/creep_*, the numbers of reduce.CREEP_NUMBERS). Format 2
+(GR b and its standard error, 9 per-task sums, peaks by prominence; catalogs, configs, partial and
+the /tasks columns catalog, catalog_task and catalog_point) still reads, without those datasets
+(`has_creep` is False: its creep episodes, if any, were not reduced); older ones do not: reduce
+the catalogs again.
 
 Every dataset carries a one-line `description` attribute (meaning, unit, shape) from the table
 DATASETS below (`python -c "from analysis import summary; print(summary.schema())"` prints it),
@@ -48,10 +55,13 @@ import numpy as np
 from ensemble import catalog, checks, filekind
 
 from . import stats
+from . import reduce
 from .reduce import MIN_UNITS, NUMBERS, PARAMS
 
-FORMAT = filekind.SUMMARY_FORMAT_PREFIX + "2"   # 2: GR b and its standard error, 9 per-task sums, peaks by
-# prominence; several catalogs (catalogs, configs, partial, /tasks/catalog, catalog_task, catalog_point)
+FORMAT = filekind.SUMMARY_FORMAT_PREFIX + "3"   # 3: the creep episodes (bins, per-task counts and sums,
+# densities, CREEP_NUMBERS). 2: GR b and its standard error, 9 per-task sums, peaks by prominence; several
+# catalogs (catalogs, configs, partial, /tasks/catalog, catalog_task, catalog_point)
+READS = (FORMAT, filekind.SUMMARY_FORMAT_PREFIX + "2")   # format 2: without the creep datasets
 
 # Every dataset, one line each: (unit, shape, meaning), units as in ensemble/catalog.py's DATASETS
 # (T nu, the plate's displacement during a recurrence time, is a model length).
@@ -63,7 +73,12 @@ CURVES = {   # name -> (its bins, its variable, whose variable, the density's un
     "tnu": ("tnu", "T nu", "all recurrences", "1/model length"),
     "tnu_interior": ("tnu", "T nu", "the recurrences starting at an interior event (boundary false)",
                      "1/model length"),
+    "creep_mu": ("creep_mu", "mu", "the creep episodes (/events/kind 1; mu = log10 of the slip creep released)",
+                 "1/mu"),
+    "creep_duration": ("creep_duration", "log10(duration nu)",
+                       "the creep episodes (duration in units of the loading time 1/nu)", "1/log10 unit"),
 }
+assert tuple(CURVES) == tuple(reduce.CURVES)   # the order of reduce.point_statistics' curves
 NUMBER_MEANINGS = {   # name -> (unit, meaning), in the order of reduce.NUMBERS
     "n_events": ("count", "inertial events (/events/kind 0: creep episodes are in none of these numbers)"),
     "n_large": ("count", "large events (mu >= mu_c)"),
@@ -75,11 +90,22 @@ NUMBER_MEANINGS = {   # name -> (unit, meaning), in the order of reduce.NUMBERS
     "gr_b": ("1", "Aki's maximum-likelihood Gutenberg-Richter b (not the model's b) above mu = b_cut"),
     "gr_b_se": ("1", "Shi & Bolt standard error of gr_b (assumes independent events; trust the interval)"),
     "ks_gr": ("1", "Kolmogorov-Smirnov distance of the binned mu >= b_cut from the fitted GR law"),
+    "n_creep": ("count", "creep episodes (/events/kind 1, below the block stiffness 1 + 2 l^2)"),
+    "creep_share": ("1", "share of the rows that are creep episodes: n_creep / (n_creep + n_events)"),
+    "taken_over_share": ("1", "share of the creep episodes taken over by an inertial event (/events/ending 2); "
+                              "NaN without creep episodes"),
+    "aseismic_fraction": ("1", "aseismic slip fraction (1 - seismic coupling): the slip of the creep episodes "
+                               "over all slip (creep episodes and inertial events) after the transient"),
 }
 DATASETS = {
     "bins/mu": ("log10 model length", "(mu bins + 1,)",
                 "edges of the magnitude bins, half-open [lo, hi), the last one too"),
     "bins/tnu": ("model length", "(T nu bins + 1,)", "edges of the T nu bins, half-open [lo, hi), the last one too"),
+    "bins/creep_mu": ("log10 model length", "(creep mu bins + 1,)",
+                      "edges of the creep episodes' mu bins (reduce --creep-mu-bins), half-open [lo, hi)"),
+    "bins/creep_duration": ("log10(duration nu)", "(creep duration bins + 1,)",
+                            "edges of the creep episodes' log10(duration nu) bins (reduce --creep-duration-bins), "
+                            "half-open [lo, hi)"),
     **{name: entry for name, entry in catalog.DATASETS.items() if name.startswith("tasks/")},
     **{f"tasks/{name}": entry for name, entry in catalog.READER_TASKS.items()},
     # the columns a summary of one or more catalogs (analysis/merge.py) sets or adds
@@ -100,6 +126,13 @@ DATASETS = {
     "per_task/numbers": ("count or sum", f"(tasks, stretches, {stats.N_STATS})",
                          "n_events, n_large, n_rec, sum_tnu, n_rec_int, sum_tnu_int, n_gr, sum_mu_gr, "
                          "sum_mu2_gr (analysis/stats.py) per task and stretch"),
+    "per_task/creep_mu": ("count", "(tasks, stretches, creep mu bins)",
+                          "creep episodes per mu bin, per task and stretch (of the inertial events before them)"),
+    "per_task/creep_duration": ("count", "(tasks, stretches, creep duration bins)",
+                                "creep episodes per log10(duration nu) bin, per task and stretch"),
+    "per_task/creep": ("count or sum", f"(tasks, stretches, {stats.N_CREEP_STATS})",
+                       "n_creep, n_creep_taken_over, sum_slip_creep, sum_slip_events (the inertial events' slip) "
+                       "(analysis/stats.py) per task and stretch"),
     **{f"points/{name}": (unit, _POINTS, f"{meaning}, of the point's tasks")
        for name, (unit, _, meaning) in ((n, catalog.DATASETS[f"tasks/{n}"]) for n in PARAMS)},
     "points/method": ("text", _POINTS, "resampling units of the intervals: 'seeds' (the point's tasks, "
@@ -151,31 +184,31 @@ def _source_attrs(inputs):
 def write(path, inputs, per_task, points, opt, force=False):
     """inputs: analysis.merge.Inputs (the catalogs and their task table)."""
     checks.output(path, force=force, what="summary")   # again: one could have appeared during the work
-    n_mu, n_tnu = len(opt.mu_edges) - 1, len(opt.tnu_edges) - 1
     tmp = str(path) + ".partial"
     with h5py.File(tmp, "w") as h5:
         h5.attrs.update({"format": FORMAT, **_source_attrs(inputs),
                          "mu_c": opt.mu_c, "window": opt.window, "b_cut": opt.b_cut,
                          "bootstrap": opt.bootstrap, "level": opt.level, "blocks": opt.blocks,
                          "seed": opt.seed})
-        h5["bins/mu"] = opt.mu_edges
-        h5["bins/tnu"] = opt.tnu_edges
+        edges = reduce.bin_edges(opt)
+        for name, values in edges.items():
+            h5[f"bins/{name}"] = values
         for name, values in inputs.tasks.items():
             # text columns (a task's error, its integrator) are stored as UTF-8 bytes
             h5[f"tasks/{name}"] = np.char.encode(values) if values.dtype.kind == "U" else values
         order = sorted(per_task)
-        for name in ("mu", "tnu", "tnu_interior", "numbers"):
+        for name in reduce.UNIT_ARRAYS:
             h5[f"per_task/{name}"] = np.stack([getattr(per_task[k], name) for k in order])
         for name in PARAMS:
             h5[f"points/{name}"] = np.array([p["params"][name] for p in points])
         h5["points/method"] = np.array([p["method"] for p in points], dtype="S")
         h5["points/units"] = np.array([p["units"] for p in points])
-        for i, name in enumerate(("mu", "tnu", "tnu_interior")):
-            lo_idx = [0, n_mu, n_mu + n_tnu][i]
-            n = [n_mu, n_tnu, n_tnu][i]
+        start = 0
+        for name, (bins, *_) in CURVES.items():   # the curves one after the other, in this order
+            n = len(edges[bins]) - 1
             for suffix, j in (("density", 0), ("lo", 1), ("hi", 2)):
-                key = f"points/{name}_density" if suffix == "density" else f"points/{name}_{suffix}"
-                h5[key] = np.stack([p["curves"][j][lo_idx:lo_idx + n] for p in points])
+                h5[f"points/{name}_{suffix}"] = np.stack([p["curves"][j][start:start + n] for p in points])
+            start += n
         for i, name in enumerate(NUMBERS):
             h5[f"points/numbers/{name}"] = np.stack([p["numbers"][i] for p in points])
         most = max([len(p["peaks"]) for p in points] + [1])
@@ -198,10 +231,22 @@ def read(path):
                     out[name] = obj[...]
             h5.visititems(visit)
             out["attrs"] = {k: h5.attrs[k] for k in h5.attrs}
-        if out["attrs"].get("format") != FORMAT:
+        if out["attrs"].get("format") not in READS:
             raise SummaryError(f"{path}: summary format {out['attrs'].get('format', '(none)')}, this version "
-                               f"reads {FORMAT}; reduce the catalog again")
+                               f"reads {' and '.join(READS)}; reduce the catalog again")
         out["points/method"] = np.array([m.decode() for m in out["points/method"]])
     for name in PARAMS:   # a summary from before the friction-law registry: aging points, no other keys
         out.setdefault(f"points/{name}", np.full(len(out["points/N"]), np.nan))
     return out
+
+
+def has_creep(s):
+    """Whether summary `s` (read) holds the creep statistics (format 3; format 2 reduced none)."""
+    return "points/numbers/n_creep" in s
+
+
+def creeping(s):
+    """(points,) bool: the points with creep episodes (none in a summary without the creep statistics)."""
+    if not has_creep(s):
+        return np.zeros(len(s["points/N"]), dtype=bool)
+    return s["points/numbers/n_creep"][:, 0] > 0

@@ -63,6 +63,7 @@ QUICK = {
                           "test_peak_finder_follows_its_documented_rule", "test_unfinished_runs_need_partial_and_say_so",
                           "test_report_states_every_number_and_the_level"],
     "test_figures.py": ["test_synthetic_figures_cover_no_data"],
+    "test_creep_statistics.py": ["test_a_summary_of_format_2_reads_reports_exports_without_creep"],
     "test_paper.py": ["test_bad_input_is_one_line_naming_the_file"],
     "test_export.py": ["test_catalog_csv_round_trips_exactly", "test_export_of_a_wrong_file_is_one_line"],
     "test_compare.py": ["test_power_law_fit_recovers_the_exponent", "test_dip_is_one_without_a_hump_and_the_ratio_with_one",

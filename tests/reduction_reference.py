@@ -35,6 +35,14 @@ here the slow and obvious way, from the raw events:
   of the smoothed bootstrap resamples (drawn after those of the numbers, when there are >= 2 units
   and recurrences); each peak's interval from the nearest peak of every resample within
   PEAK_RULE["match_bins"];
+- the inertial events are the rows of kind 0 (every row where there is no `kind`); all of the above
+  is of them alone. The creep episodes are the rows of kind 1; a creep row belongs to the stretch
+  floor(j k / n) of the number j of inertial events before it among the task's rows (k - 1 when j = n),
+  or with no inertial event floor(r k / rows) of its row r. Their densities: of mu (creep_mu bins)
+  and of log10(duration nu) (creep_duration bins), each over all creep episodes; the numbers
+  n_creep, creep_share = n_creep / (n_creep + n_events), taken_over_share = (ending 2) / n_creep
+  and aseismic_fraction = creep slip / (creep slip + inertial slip), NaN where nothing is shared;
+  per stretch: n_creep, n_taken_over, creep slip, inertial slip;
 - a reduction is partial if a catalog's name ends in .partial or one of its tasks is not
   finished (status 1) or holds fewer than events_per_task events; the summary then states the
   events reduced of those expected and names those catalogs.
@@ -52,9 +60,14 @@ import numpy as np
 LOG10_E = math.log10(math.e)
 NUMBERS = ("n_events", "n_large", "fraction_large", "n_recurrences", "mean_tnu", "mode_tnu",
            "mean_tnu_interior", "gr_b", "gr_b_se", "ks_gr")
+CREEP_NUMBERS = ("n_creep", "creep_share", "taken_over_share", "aseismic_fraction")   # the summary's numbers too
+CURVES = ("mu", "tnu", "tnu_interior", "creep_mu", "creep_duration")
+# the documented defaults of reduce --creep-mu-bins -12:3:75 and --creep-duration-bins -7:3:50
+CREEP_EDGES = {"creep_mu_edges": np.linspace(-12, 3, 76), "creep_duration_edges": np.linspace(-7, 3, 51)}
 # columns of /per_task/numbers, in the order analysis/stats.py documents
 PER_TASK_COLUMNS = ("n_events", "n_large", "n_rec", "sum_tnu", "n_rec_int", "sum_tnu_int",
                     "n_gr", "sum_mu_gr", "sum_mu2_gr")
+CREEP_COLUMNS = ("n_creep", "n_taken_over", "sum_slip_creep", "sum_slip_events")   # of /per_task/creep
 # the chain's parameters and every friction law's keys (NaN where a key is not the task's law's)
 PARAMS = ("N", "l", "nu", "a", "b", "c", "alpha", "sigma")
 MIN_SEEDS = 10
@@ -137,7 +150,7 @@ def percentile(values, q):
 def histogram(values, edges):
     """Counts in half-open bins [e_k, e_k+1), the last one too."""
     v = np.asarray(values, dtype=float)
-    return np.histogram(v[v < edges[-1]], bins=edges)[0]
+    return np.histogram(v[np.isfinite(v) & (v < edges[-1])], bins=edges)[0]
 
 
 def density(counts, edges, total):
@@ -197,8 +210,18 @@ def ks_distance(mu, edges, cut, b):
     return max(gaps)
 
 
-def statistics(mu, tnu, interior, opt):
-    """Curves and numbers of pooled raw data: mu (all events), tnu and interior (recurrences)."""
+def edges_of(opt, name):
+    return opt[name] if name in opt else CREEP_EDGES[name]
+
+
+def quotient(a, b):
+    return a / b if b else math.nan
+
+
+def statistics(mu, tnu, interior, event_slip, creep_mu, creep_log_duration, creep_taken, creep_slip, opt):
+    """Curves and numbers of pooled raw data: mu (all inertial events), tnu and interior
+    (recurrences), event_slip (the inertial events' slips) and the creep episodes' mu, log10(duration
+    nu), taken over (ending 2) and slip."""
     mu = np.asarray(mu, dtype=float)
     tnu = np.asarray(tnu, dtype=float)
     interior = np.asarray(interior, dtype=bool)
@@ -220,9 +243,17 @@ def statistics(mu, tnu, interior, opt):
         "mean_tnu_interior": tnu[interior].sum() / interior.sum() if interior.any() else math.nan,
         "gr_b": b, "gr_b_se": gr_b_se(mu, opt["b_cut"]), "ks_gr": ks_distance(mu, me, opt["b_cut"], b),
     }
+    m = len(creep_mu)
+    creep_sum = sum(float(x) for x in creep_slip)
+    numbers.update({"n_creep": m, "creep_share": quotient(m, m + n),
+                    "taken_over_share": quotient(int(np.count_nonzero(creep_taken)), m),
+                    "aseismic_fraction": quotient(creep_sum, creep_sum + sum(float(x) for x in event_slip))})
+    ce, de = edges_of(opt, "creep_mu_edges"), edges_of(opt, "creep_duration_edges")
     curves = {"mu": density(histogram(mu, me), me, n),
               "tnu": density(h_t, te, len(tnu)),
-              "tnu_interior": density(histogram(tnu[interior], te), te, int(interior.sum()))}
+              "tnu_interior": density(histogram(tnu[interior], te), te, int(interior.sum())),
+              "creep_mu": density(histogram(creep_mu, ce), ce, m),
+              "creep_duration": density(histogram(creep_log_duration, de), de, m)}
     return curves, numbers
 
 
@@ -232,8 +263,25 @@ class Task:
     """One task's raw events and its recurrences (T nu), each with its stretch."""
 
     def __init__(self, ev, nu, opt):
-        n = len(ev["t"])
+        rows = len(ev["t"])
+        kind = np.asarray(ev["kind"]) if "kind" in ev else np.zeros(rows, dtype=np.int8)
         k = opt["blocks"]
+        inertial = [r for r in range(rows) if kind[r] == 0]
+        creep = [r for r in range(rows) if kind[r] == 1]
+        n = len(inertial)
+        self.creep_stretch = np.zeros(len(creep), dtype=np.int64)
+        for c, r in enumerate(creep):
+            before = sum(1 for q in inertial if q < r)
+            self.creep_stretch[c] = min(before * k // n, k - 1) if n else r * k // rows
+        column = {name: np.asarray(ev[name]) for name in ev}
+        self.event_slip = column["slip"][inertial].astype(float) if n else np.zeros(0)
+        self.creep_mu = column["mu"][creep].astype(float) if creep else np.zeros(0)
+        with np.errstate(divide="ignore"):
+            self.creep_log_duration = (np.log10(column["duration"][creep].astype(float) * nu) if creep
+                                       else np.zeros(0))
+        self.creep_taken = column["ending"][creep] == 2 if creep else np.zeros(0, dtype=bool)
+        self.creep_slip = column["slip"][creep].astype(float) if creep else np.zeros(0)
+        ev = {name: column[name][inertial] for name in ("t", "mu", "epicenter", "boundary")}
         self.n = n
         self.mu = np.asarray(ev["mu"], dtype=float)
         self.stretch = np.array([i * k // n for i in range(n)], dtype=np.int64)
@@ -245,11 +293,13 @@ class Task:
         self.rec_stretch = self.stretch[self.rec_start] if len(rec) else np.zeros(0, dtype=np.int64)
 
     def unit(self, stretch=None):
-        """(mu, tnu, interior) of the whole task or of one stretch."""
+        """(mu, tnu, interior, event slip, creep mu, creep log10(duration nu), creep taken over,
+        creep slip) of the whole task or of one stretch."""
+        creep = (self.creep_mu, self.creep_log_duration, self.creep_taken, self.creep_slip)
         if stretch is None:
-            return self.mu, self.tnu, self.interior
-        e, r = self.stretch == stretch, self.rec_stretch == stretch
-        return self.mu[e], self.tnu[r], self.interior[r]
+            return (self.mu, self.tnu, self.interior, self.event_slip, *creep)
+        e, r, c = self.stretch == stretch, self.rec_stretch == stretch, self.creep_stretch == stretch
+        return (self.mu[e], self.tnu[r], self.interior[r], self.event_slip[e], *(x[c] for x in creep))
 
     def per_stretch(self, opt):
         k, me, te = opt["blocks"], opt["mu_edges"], opt["tnu_edges"]
@@ -257,17 +307,23 @@ class Task:
         t_h = np.zeros((k, len(te) - 1), dtype=np.int64)
         ti_h = np.zeros((k, len(te) - 1), dtype=np.int64)
         numbers = np.zeros((k, len(PER_TASK_COLUMNS)))
+        ce, de = edges_of(opt, "creep_mu_edges"), edges_of(opt, "creep_duration_edges")
+        cm_h = np.zeros((k, len(ce) - 1), dtype=np.int64)
+        cd_h = np.zeros((k, len(de) - 1), dtype=np.int64)
+        creep = np.zeros((k, len(CREEP_COLUMNS)))
         for s in range(k):
-            mu, tnu, interior = self.unit(s)
+            mu, tnu, interior, event_slip, creep_mu, creep_log_duration, taken, creep_slip = self.unit(s)
             mu_h[s], t_h[s], ti_h[s] = histogram(mu, me), histogram(tnu, te), histogram(tnu[interior], te)
+            cm_h[s], cd_h[s] = histogram(creep_mu, ce), histogram(creep_log_duration, de)
+            creep[s] = [len(creep_mu), np.count_nonzero(taken), creep_slip.sum(), event_slip.sum()]
             gr = mu[mu >= opt["b_cut"]]
             numbers[s] = [len(mu), np.count_nonzero(mu >= opt["mu_c"]), len(tnu), tnu.sum(),
                           interior.sum(), tnu[interior].sum(), len(gr), gr.sum(), (gr ** 2).sum()]
-        return mu_h, t_h, ti_h, numbers
+        return mu_h, t_h, ti_h, numbers, cm_h, cd_h, creep
 
 
 def _pool(units, pick):
-    return tuple(np.concatenate([units[p][c] for p in pick]) for c in range(3))
+    return tuple(np.concatenate([units[p][c] for p in pick]) for c in range(len(units[0])))
 
 
 def bits(x):
@@ -409,11 +465,13 @@ def expected_summary(catalogs, opt):
     table, points = expected_tasks(catalogs)
     per_task = []
     for path, events, tasks in catalogs:
-        per_task += [Task({c: events[c][events["task"] == k] for c in ("t", "mu", "epicenter", "boundary")},
+        per_task += [Task({c: events[c][events["task"] == k] for c in events if c != "task"},
                           float(tasks["nu"][k]), opt) for k in range(len(tasks["point"]))]
-    exp = {"bins/mu": opt["mu_edges"], "bins/tnu": opt["tnu_edges"]}
+    exp = {"bins/mu": opt["mu_edges"], "bins/tnu": opt["tnu_edges"],
+           "bins/creep_mu": edges_of(opt, "creep_mu_edges"),
+           "bins/creep_duration": edges_of(opt, "creep_duration_edges")}
     stacks = [t.per_stretch(opt) for t in per_task]
-    for j, name in enumerate(("mu", "tnu", "tnu_interior", "numbers")):
+    for j, name in enumerate(("mu", "tnu", "tnu_interior", "numbers", "creep_mu", "creep_duration", "creep")):
         exp[f"per_task/{name}"] = np.stack([s[j] for s in stacks])
     results = []
     for params, rows in points:
@@ -424,10 +482,10 @@ def expected_summary(catalogs, opt):
         exp[f"points/{name}"] = np.array([r["params"][name] for r in results])
     exp["points/method"] = np.array([r["method"] for r in results])
     exp["points/units"] = np.array([r["units"] for r in results])
-    for name in ("mu", "tnu", "tnu_interior"):
+    for name in CURVES:
         for j, suffix in enumerate(("density", "lo", "hi")):
             exp[f"points/{name}_{suffix}"] = np.stack([r["curves"][name][j] for r in results])
-    for name in NUMBERS:
+    for name in NUMBERS + CREEP_NUMBERS:
         exp[f"points/numbers/{name}"] = np.array([r["numbers"][name] for r in results], dtype=float)
     most = max([len(r["peaks"]) for r in results] + [1])
     peaks = np.full((len(results), most, 3), np.nan)
@@ -469,10 +527,12 @@ def check_summary(s, expected, opt):
     """Every dataset and attribute of summary `s` (read_summary) against expected_summary."""
     tasks = expected["tasks"]
     tasks_keys = {f"tasks/{k}" for k in tasks}
-    numbers = {f"points/numbers/{n}" for n in NUMBERS}
-    curves = {f"points/{c}_{x}" for c in ("mu", "tnu", "tnu_interior") for x in ("density", "lo", "hi")}
-    known = ({"bins/mu", "bins/tnu", "points/method", "points/units", "points/peaks", "attrs"}
-             | {f"per_task/{k}" for k in ("mu", "tnu", "tnu_interior", "numbers")}
+    numbers = {f"points/numbers/{n}" for n in NUMBERS + CREEP_NUMBERS}
+    curves = {f"points/{c}_{x}" for c in CURVES for x in ("density", "lo", "hi")}
+    known = ({"bins/mu", "bins/tnu", "bins/creep_mu", "bins/creep_duration", "points/method", "points/units",
+              "points/peaks", "attrs"}
+             | {f"per_task/{k}" for k in ("mu", "tnu", "tnu_interior", "numbers",
+                                          "creep_mu", "creep_duration", "creep")}
              | {f"points/{p}" for p in PARAMS} | tasks_keys | numbers | curves)
     # a new output must get its brute-force check here
     assert set(s) == known, f"unchecked {set(s) - known}, missing {known - set(s)}"
@@ -498,6 +558,7 @@ def check_summary(s, expected, opt):
         want = np.char.encode(v) if v.dtype.kind == "U" else v
         np.testing.assert_array_equal(got, want, err_msg=k)
     for key in ("bins/mu", "bins/tnu", "per_task/mu", "per_task/tnu", "per_task/tnu_interior",
+                "bins/creep_mu", "bins/creep_duration", "per_task/creep_mu", "per_task/creep_duration",
                 "points/units", *(f"points/{p}" for p in PARAMS)):
         np.testing.assert_array_equal(s[key], expected[key], err_msg=key)
     assert [m.decode() for m in s["points/method"]] == list(expected["points/method"])
@@ -505,11 +566,14 @@ def check_summary(s, expected, opt):
     counts = [PER_TASK_COLUMNS.index(c) for c in ("n_events", "n_large", "n_rec", "n_rec_int", "n_gr")]
     np.testing.assert_array_equal(got[..., counts], want[..., counts], err_msg="per_task/numbers counts")
     np.testing.assert_allclose(got, want, rtol=RTOL, atol=0, err_msg="per_task/numbers sums")
+    got, want = s["per_task/creep"], expected["per_task/creep"]
+    np.testing.assert_array_equal(got[..., :2], want[..., :2], err_msg="per_task/creep counts")
+    np.testing.assert_allclose(got, want, rtol=RTOL, atol=0, err_msg="per_task/creep sums")
     for key in sorted(curves):
         np.testing.assert_allclose(s[key], expected[key], rtol=RTOL, atol=0, err_msg=key)
     for key in sorted(numbers):
         np.testing.assert_allclose(s[key], expected[key], rtol=RTOL, atol=0, err_msg=key)
-    for name in ("n_events", "n_large", "n_recurrences", "fraction_large", "mode_tnu"):
+    for name in ("n_events", "n_large", "n_recurrences", "fraction_large", "mode_tnu", "n_creep"):
         np.testing.assert_array_equal(s[f"points/numbers/{name}"][:, 0], expected[f"points/numbers/{name}"][:, 0])
     assert s["points/peaks"].shape == expected["points/peaks"].shape
     np.testing.assert_array_equal(s["points/peaks"][..., 0], expected["points/peaks"][..., 0])

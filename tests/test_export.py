@@ -152,7 +152,7 @@ def test_api_curves_numbers_peaks_are_the_summarys(files):
             np.testing.assert_array_equal(rows["center"], 0.5 * (edges[1:] + edges[:-1]))
             for part, column in (("density", "density"), ("lo", "density_lo"), ("hi", "density_hi")):
                 np.testing.assert_array_equal(rows[column], s[f"points/{curve}_{part}"][point], err_msg=column)
-    assert len(cu) == len(s["points/N"]) * (len(s["bins/mu"]) + 2 * len(s["bins/tnu"]) - 3)
+    assert len(cu) == len(s["points/N"]) * sum(len(s[f"bins/{bins}"]) - 1 for bins, *_ in summary.CURVES.values())
     nb = export.numbers(files / "cat.summary.h5")
     np.testing.assert_array_equal(nb["point"], np.arange(len(s["points/N"])))
     for name in ("N", "l", "nu", "a", "b", "c", "method", "units"):

@@ -39,6 +39,8 @@ BAD = {
     "mu_bins": ["nan:7:70", "0:inf:70", "-inf:7:70", "0:7:nan", "0:7:0", "7:0:70", "0:7", "0:7:1e400",
                 "0:1e308:10000000000", "-1e308:1e308:10"],
     "tnu_bins": ["nan:2000:80", "0:inf:80", "0:2000:inf", "0:1e308:10000000000", "2000:0:80", "0:0:80"],
+    "creep_mu_bins": ["nan:3:75", "-12:inf:75", "-12:3:0", "3:-12:75", "-12:3", "-1e308:1e308:10"],
+    "creep_duration_bins": ["-7:nan:50", "-inf:3:50", "-7:3:1e400", "-7:-7:50", "0:1e308:10000000000"],
 }
 ENV = child_env(PYTHONPATH=str(ROOT))   # this checkout's packages, wherever the command runs
 OPTION = {dest: "--" + dest.replace("_", "-") for dest in BAD}
