@@ -6,22 +6,25 @@
 # Each panel has its own root seed, so the points that panels share (b = 20, c = 1e3, N = 800 in fig1_b,
 # fig1_c and fig2) are independent trajectories that `analysis reduce` can pool.
 # Reduce and plot afterwards with examples/paper/reduce_full.sh.
+# Another folder of configs: CONF=examples/slow OUT=runs/slow bash examples/paper/run_full.sh 2 b_sweep b18 b15
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 RANKS=${1:-2}
 shift || true
 PANELS=${*:-fig1_b fig1_a fig1_c fig2 large_b}
+CONF=${CONF:-examples/paper}
+OUT=${OUT:-runs/paper}
 PY=.venv/bin/python
 export NUMBA_CACHE_DIR=${NUMBA_CACHE_DIR:-$PWD/.numba_cache} OMP_NUM_THREADS=1 NUMBA_NUM_THREADS=1
-mkdir -p runs/paper
+mkdir -p "$OUT"
 for name in $PANELS; do
-  out=runs/paper/$name.h5
+  out=$OUT/$name.h5
   if [ -f "$out" ]; then
     echo "$name: $out is complete"
   elif [ -f "$out.partial" ]; then
-    mpiexec -n "$RANKS" $PY -m ensemble resume "$out" --set output.progress_seconds=300 2>&1 | tee -a runs/paper/$name.log
+    mpiexec -n "$RANKS" $PY -m ensemble resume "$out" --set output.progress_seconds=300 2>&1 | tee -a "$OUT/$name.log"
   else
-    mpiexec -n "$RANKS" $PY -m ensemble run examples/paper/$name.toml -o "$out" \
-      --set output.progress_seconds=300 2>&1 | tee -a runs/paper/$name.log
+    mpiexec -n "$RANKS" $PY -m ensemble run "$CONF/$name.toml" -o "$out" \
+      --set output.progress_seconds=300 2>&1 | tee -a "$OUT/$name.log"
   fi
 done
