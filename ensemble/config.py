@@ -357,6 +357,11 @@ def from_dict(raw, overridden=None):
     refusal = INTEGRATORS[cfg.integrator.method].refusal(laws.get(cfg.model.law))
     if refusal:
         raise ConfigError(refusal)
+    law = laws.get(cfg.model.law)
+    if not law.creeps and cfg.integrator.creep_tol != Integrator.creep_tol:
+        # a tolerance for a phase this law never enters: a mistake about the model, not a no-op
+        raise ConfigError(f"integrator.creep_tol = {cfg.integrator.creep_tol!r}: model.law = {law.name!r} has no creep "
+                          f"phase (its blocks always start inertial events; docs/laws.md)")
     _check_overflow(cfg)
     return cfg
 
