@@ -15,6 +15,7 @@ from ensemble.model.exponential import phis
 from ensemble.model.methods import METHODS
 
 from .conftest import developed_state
+from .test_convergence import assert_order_at_least
 
 
 def exact_phis(x):
@@ -53,23 +54,13 @@ def test_event_slip_converges_with_order_4():
     (slip and profile, three events). An error in one coefficient of the state's rows (b4 = -phi2 +
     3 phi3 instead of 4 phi3) drops it to 0.85 .. 1.0 (tried)."""
     model = Model(N=50, b=20.0)
-    force, psi = developed_state(model, 300)
     hs = [1e-3, 5e-4, 2.5e-4]
-    orders = []
-    for _ in range(3):
+
+    def events_at(force, psi):
         epicenter, _, f, p = advance_to_onset(force, psi, model)
         f[epicenter] = model.b * p[epicenter]
-        events = [check(run_event(f, p, epicenter, model, fixed(h))) for h in hs]
-        slips = np.array([ev.slip for ev in events])
-        profiles = np.array([ev.profile for ev in events])
-        d = np.abs(np.diff(slips))
-        dp = np.linalg.norm(np.diff(profiles, axis=0), axis=1)
-        orders.append((np.log2(d[:-1] / d[1:]), np.log2(dp[:-1] / dp[1:])))
-        force, psi = events[-1].force, events[-1].psi
-    print("measured orders (slip, profile):", orders)
-    for slip_order, profile_order in orders:
-        assert np.all(slip_order >= 3.5)
-        assert np.all(profile_order >= 3.5)
+        return [check(run_event(f, p, epicenter, model, fixed(h))) for h in hs]
+    assert_order_at_least(3.5, *developed_state(model, 300), events_at)
 
 
 def test_errors_follow_the_tolerance_and_the_energy_balance_holds(events):

@@ -109,29 +109,25 @@ def simulate(arrays, clock, p, n_events, budget, out_t, out_epicenter, out_diag)
             onset[0] = since[epicenter, 0]
             onset[1] = since[epicenter, 1]
             advance_clock(onset, delay)
-            if (creep_on and stable(n, p.l2, creep_weakening(p.law), epicenter, epicenter)
-                    and loaded_past_threshold(p, n, rest_state(p.law, W[epicenter, P], delay))):
-                # a block stiffer than its law's weakening creeps instead of rupturing
-                if (onset[0] - clock[0]) + (onset[1] - clock[1]) > 0.0:
-                    clock[0] = onset[0]
-                    clock[1] = onset[1]
-                materialize(W, since, epicenter, clock, p)
-                if W[epicenter, F0] < threshold(p.law, W[epicenter, P]):
-                    W[epicenter, F0] = threshold(p.law, W[epicenter, P])
-                join(arrays, n, p, epicenter, 0.0, clock)
-                continue
-            # from here on the event changes the between-events state: keep what it was
-            event[EV_CLOCK_HI] = clock[0]
-            event[EV_CLOCK_LO] = clock[1]
-            log_block(W, since, event, undo, epicenter)
+            # a block stiffer than its law's weakening creeps instead of rupturing
+            creeps_here = (creep_on and stable(n, p.l2, creep_weakening(p.law), epicenter, epicenter)
+                           and loaded_past_threshold(p, n, rest_state(p.law, W[epicenter, P], delay)))
+            if not creeps_here:
+                # from here on the event changes the between-events state: keep what it was
+                event[EV_CLOCK_HI] = clock[0]
+                event[EV_CLOCK_LO] = clock[1]
+                log_block(W, since, event, undo, epicenter)
             if (onset[0] - clock[0]) + (onset[1] - clock[1]) > 0.0:
                 clock[0] = onset[0]
                 clock[1] = onset[1]
             materialize(W, since, epicenter, clock, p)
-            # Put the epicenter on its threshold, not a round-off below it, so the
-            # event starts without a false stick (a force above it stays as it is).
+            # Put the epicenter on its threshold, not a round-off below it, so the event starts
+            # without a false stick and creep from the threshold (a force above it stays as it is).
             if W[epicenter, F0] < threshold(p.law, W[epicenter, P]):
                 W[epicenter, F0] = threshold(p.law, W[epicenter, P])
+            if creeps_here:
+                join(arrays, n, p, epicenter, 0.0, clock)
+                continue
             begin_event(arrays, clock, n, epicenter, 0.0, p)
             spent += EVENT_WORK
         status, used = continue_event(arrays, clock, n, p, no_profile, no_trace, budget - spent)

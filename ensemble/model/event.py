@@ -319,13 +319,7 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
                 # but could not move keeps its slip.
                 if W[i, Y] < W[i, Y0]:
                     W[i, Y] = W[i, Y0]
-                W[i, V] = 0.0
-                W[i, TR] = tau
-                W[i, YS] = W[i, Y]
-                flag[i] = STOPPED
-                yrest += W[i, Y]
-                stuck[nstuck] = i
-                nstuck += 1
+                nstuck, yrest = _stop(W, flag, stuck, nstuck, i, tau, yrest)
             else:
                 act[m] = i
                 m += 1
@@ -345,13 +339,7 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
                 i = act[k]
                 arrays.creep[i, CR_HB] = 1.0
                 arrays.creep[i, CR_VN] = W[i, V]
-                W[i, V] = 0.0
-                W[i, TR] = tau
-                W[i, YS] = W[i, Y]
-                flag[i] = STOPPED
-                yrest += W[i, Y]
-                stuck[nstuck] = i
-                nstuck += 1
+                nstuck, yrest = _stop(W, flag, stuck, nstuck, i, tau, yrest)
             na = 0
         # -- rescheduling, once the set of watched blocks has changed
         if kind != NO_CUT or nstuck > 0 or na != m:
@@ -373,6 +361,19 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
     clear_log(W, event, arrays.undo)
     event[EV_PHASE] = BETWEEN
     return status, used
+
+
+@nb.njit(cache=True, inline="always")
+def _stop(W, flag, stuck, nstuck, i, tau, yrest):
+    """Sliding block i comes to rest at local time tau (a stick, or the hand-back to creep): at rest
+    where it is, its slip counted in yrest, and on the list `stuck` of the blocks whose neighbours
+    are rescheduled. Returns (nstuck, yrest)."""
+    W[i, V] = 0.0
+    W[i, TR] = tau
+    W[i, YS] = W[i, Y]
+    flag[i] = STOPPED
+    stuck[nstuck] = i
+    return nstuck + 1, yrest + W[i, Y]
 
 
 @nb.njit(cache=True, inline="always")

@@ -24,9 +24,9 @@ import numba as nb
 import numpy as np
 
 from .laws import has_state, linear_state
-from .steppers import _error_norms, stage_rates
-from .workspace import (ARK_A, ARK_G, ARK_V, K1V, KV, KY, P, P0, PS, V, V0, VS, X_EH, X_P1, X_P1H, X_P2, X_P2H,
-                        X_P3, X_RATE0, X_THETA, X_THETA0, Y, Y0, YS)
+from .steppers import _error_norms, stage_columns
+from .workspace import (ARK_A, ARK_G, ARK_V, K1V, P, P0, PS, V, V0, VS, X_EH, X_P1, X_P1H, X_P2, X_P2H, X_P3,
+                        X_RATE0, X_THETA, X_THETA0, Y, Y0, YS)
 
 
 class ExponentialScheme(NamedTuple):
@@ -86,7 +86,7 @@ def exp_step(W, act, na, n, tau, h, p, yrest):
         for k in range(na):
             i = act[k]
             theta0 = math.exp(W[i, P0])
-            r0 = linear_state(p.law, W[i, V0])[1]
+            r0 = _linear_state(p.law, W[i, V0])[1]
             x = -0.5 * h * r0
             em1h = math.expm1(x)
             p1h, p2h, _ = phis(x, em1h)
@@ -119,16 +119,12 @@ def exp_step(W, act, na, n, tau, h, p, yrest):
                     theta = _stage_theta(W, i, s, h)
                     W[i, PS] = math.log(theta)
                 W[i, X_THETA] = theta
-        power, ysum = stage_rates(W, act, na, n, tau + _C[s] * h, p, yrest, False)
-        pw += _B[s] * power
-        ys += _B[s] * ysum
-        for k in range(na):
-            i = act[k]
-            W[i, ARK_V + s] = W[i, KY]
-            W[i, ARK_A + s] = W[i, KV]
-            if state:
-                sr = linear_state(p.law, W[i, VS])
-                W[i, ARK_G + s] = sr[0] - (sr[1] - W[i, X_RATE0]) * W[i, X_THETA]
+                # the stage's remainder: a function of its v and theta alone, not of its rates
+                sr = linear_state(p.law, v)
+                W[i, ARK_G + s] = sr[0] - (sr[1] - W[i, X_RATE0]) * theta
+        power, ysum = stage_columns(W, act, na, n, tau + _C[s] * h, p, yrest, s, _B[s], False, False)
+        pw += power
+        ys += ysum
     err = 0.0
     for k in range(na):
         i = act[k]
@@ -152,6 +148,13 @@ def exp_step(W, act, na, n, tau, h, p, yrest):
         # or a blow-up is an infinite error, and the step is retried shorter
         err = max(err, e1, e2, e3) if math.isfinite(e) else math.inf
     return pw * h, ys * h, err
+
+
+@nb.njit(cache=True)
+def _linear_state(law, v):
+    """The law's linear_state (a call of its own, as creep._rate: numba's inliner, which inlines
+    linear_state into a lambda, mislabels a variable when it is inlined twice in one function)."""
+    return linear_state(law, v)
 
 
 @nb.njit(cache=True, inline="always")

@@ -50,6 +50,22 @@ def stage_rates(W, act, na, n, tau, p, yrest, with_state=True):
     return power, ysum
 
 
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def stage_columns(W, act, na, n, tau, p, yrest, s, weight, with_state, keep_state):
+    """Stage s of a Runge-Kutta step, at the stage state (YS, VS, PS) and time tau: its rates
+    (stage_rates, with_state as there) kept in the stage's columns ARK_V + s, ARK_A + s, and the
+    state's rate KP in ARK_G + s if keep_state. Returns the stage's friction power and total slip
+    times its quadrature weight."""
+    power, ysum = stage_rates(W, act, na, n, tau, p, yrest, with_state)
+    for k in range(na):
+        i = act[k]
+        W[i, ARK_V + s] = W[i, KY]
+        W[i, ARK_A + s] = W[i, KV]
+        if keep_state:
+            W[i, ARK_G + s] = W[i, KP]
+    return weight * power, weight * ysum
+
+
 @nb.njit(cache=True, error_model="numpy")
 def rk4_step(W, act, na, n, tau, h, p, yrest):
     """Classical RK4: advance the active blocks from the step-start values (Y0, V0, P0) by h.
@@ -135,15 +151,9 @@ def ark_step(W, act, na, n, tau, h, p, yrest, c, ae, ai, bw, bd, gamma):
         if s > 0 and has_state(p.law):
             # the stiff state: psi - hg * state_rate(v, psi) = r, one scalar equation per block
             implicit_state(p.law, W, act, na, hg)
-        power, ysum = stage_rates(W, act, na, n, tau + c[s] * h, p, yrest, s == 0)
-        pw += bw[s] * power
-        ys += bw[s] * ysum
-        for k in range(na):
-            i = act[k]
-            W[i, ARK_V + s] = W[i, KY]
-            W[i, ARK_A + s] = W[i, KV]
-            if has_state(p.law):
-                W[i, ARK_G + s] = W[i, KP]
+        power, ysum = stage_columns(W, act, na, n, tau + c[s] * h, p, yrest, s, bw[s], s == 0, has_state(p.law))
+        pw += power
+        ys += ysum
     err = 0.0
     for k in range(na):
         i = act[k]
