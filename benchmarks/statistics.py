@@ -54,6 +54,7 @@ import numpy as np
 
 from analysis.recurrence import RecurrenceScanner
 from ensemble import catalog
+from ensemble.catalog import KIND_EVENT
 from ensemble.config import LAW_KEYS, Integrator, Model
 from ensemble.integrators import INTEGRATORS
 from ensemble.model import laws
@@ -95,11 +96,14 @@ def run_seed(job):
 
 
 def seed_samples(chunks, N, nu, mu_c, window):
-    """One trajectory's recorded events (dicts of columns t, epicenter, mu, boundary, in time
-    order) -> {"mu": its magnitudes, "tnu": the local recurrence times T nu of its large events}."""
+    """One trajectory's recorded rows (dicts of columns t, epicenter, mu, boundary, kind) -> {"mu": the
+    magnitudes of its inertial events, "tnu": the local recurrence times T nu of its large events}
+    (creep episodes, kind 1, are no events here, as in analysis/reduce.py)."""
     scanner = RecurrenceScanner(N, mu_c, window)
     mu, T = [np.zeros(0)], [np.zeros(0)]
-    for chunk in chunks:
+    for rows in chunks:
+        keep = rows["kind"] == KIND_EVENT
+        chunk = {name: rows[name][keep] for name in ("t", "epicenter", "mu", "boundary")}
         mu.append(chunk["mu"])
         T.append(scanner.feed(chunk["t"], chunk["epicenter"], chunk["mu"], chunk["boundary"])[1])
     return {"mu": np.concatenate(mu), "tnu": np.concatenate(T) * nu}
