@@ -122,9 +122,7 @@ def exp_step(W, act, na, n, tau, h, p, yrest):
                 # the stage's remainder: a function of its v and theta alone, not of its rates
                 sr = linear_state(p.law, v)
                 W[i, ARK_G + s] = sr[0] - (sr[1] - W[i, X_RATE0]) * theta
-        power, ysum = stage_columns(W, act, na, n, tau + _C[s] * h, p, yrest, s, _B[s], False, False)
-        pw += power
-        ys += ysum
+        pw, ys = stage_columns(W, act, na, n, tau + _C[s] * h, p, yrest, s, _B[s], False, False, pw, ys)
     err = 0.0
     for k in range(na):
         i = act[k]

@@ -51,11 +51,11 @@ def stage_rates(W, act, na, n, tau, p, yrest, with_state=True):
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
-def stage_columns(W, act, na, n, tau, p, yrest, s, weight, with_state, keep_state):
+def stage_columns(W, act, na, n, tau, p, yrest, s, weight, with_state, keep_state, pw, ys):
     """Stage s of a Runge-Kutta step, at the stage state (YS, VS, PS) and time tau: its rates
     (stage_rates, with_state as there) kept in the stage's columns ARK_V + s, ARK_A + s, and the
-    state's rate KP in ARK_G + s if keep_state. Returns the stage's friction power and total slip
-    times its quadrature weight."""
+    state's rate KP in ARK_G + s if keep_state. Returns the quadratures (pw, ys) of the friction
+    power and the total slip with the stage's terms, times its weight, added."""
     power, ysum = stage_rates(W, act, na, n, tau, p, yrest, with_state)
     for k in range(na):
         i = act[k]
@@ -63,7 +63,7 @@ def stage_columns(W, act, na, n, tau, p, yrest, s, weight, with_state, keep_stat
         W[i, ARK_A + s] = W[i, KV]
         if keep_state:
             W[i, ARK_G + s] = W[i, KP]
-    return weight * power, weight * ysum
+    return pw + weight * power, ys + weight * ysum
 
 
 @nb.njit(cache=True, error_model="numpy")
@@ -151,9 +151,7 @@ def ark_step(W, act, na, n, tau, h, p, yrest, c, ae, ai, bw, bd, gamma):
         if s > 0 and has_state(p.law):
             # the stiff state: psi - hg * state_rate(v, psi) = r, one scalar equation per block
             implicit_state(p.law, W, act, na, hg)
-        power, ysum = stage_columns(W, act, na, n, tau + c[s] * h, p, yrest, s, bw[s], s == 0, has_state(p.law))
-        pw += power
-        ys += ysum
+        pw, ys = stage_columns(W, act, na, n, tau + c[s] * h, p, yrest, s, bw[s], s == 0, has_state(p.law), pw, ys)
     err = 0.0
     for k in range(na):
         i = act[k]
