@@ -22,7 +22,7 @@ done
   echo "# Creep statistics against the integrators' tolerances"
   echo
   echo "\`bash examples/slow/convergence.sh\`: b = 15, N = 100, 4 seeds x 5000 rows after 1000 (examples/slow/convergence.toml);"
-  echo "defaults creep_tol = 1e-6, rtol = 1e-4. 95% bootstrap intervals over seeds (analysis reduce)."
+  echo "defaults creep_tol = 1e-6, rtol = 1e-4. 95% bootstrap intervals (analysis reduce: below 10 seeds, over stretches of each trajectory)."
   echo
   $PY examples/slow/convergence.py "${labels[@]}"
 } > docs/slow/convergence.md
