@@ -22,7 +22,7 @@ from matplotlib.transforms import Bbox  # noqa: E402
 
 from . import summary as summary_file  # noqa: E402
 from .reduce import PARAMS  # noqa: E402
-from .report import level_text, partial_text, size_text  # noqa: E402
+from .report import count_text, level_text, partial_text, size_text  # noqa: E402
 from .stats import centers  # noqa: E402
 
 FONT = 8            # the smallest text of a figure, points
@@ -308,15 +308,29 @@ def _units(s):
         for n in [[int(u) for u, k in zip(s["points/units"], s["points/method"]) if k == m]]))
 
 
-def title_text(summaries, names, title=None):
+def _creep_sizes(summaries):
+    """The creep episodes per point, over the points that have any: "15380-16492 creep episodes per point"."""
+    counts = [c for s in summaries if summary_file.has_creep(s)
+              for c, creeps in zip(s["points/numbers/n_creep"][:, 0], summary_file.creeping(s)) if creeps]
+    if not counts:
+        return "no creep episodes"      # (the creep figure then stops with its one-line error)
+    lo, hi = min(counts), max(counts)
+    return f"{count_text(lo)}{'' if lo == hi else f'-{count_text(hi)}'} creep episodes per point"
+
+
+def title_text(summaries, names, title=None, kind=None):
     """The figure's title: `title` (then the description below) or by default the description
-    alone: events per point, mu_c, window and the bands (never the file names); then one line
-    for each partial reduction (events reduced of expected), whatever the title."""
+    alone: events per point, mu_c, window and the bands (never the file names; for the creep
+    figure the creep episodes per point and the bands); then one line for each partial reduction
+    (events reduced of expected), whatever the title."""
     levels = " / ".join(dict.fromkeys(level_text(s["attrs"]["level"]) for s in summaries))
-    description = (f"{_values(size_text(s) for s in summaries)}, "
-                   f"mu_c = {_values((s['attrs']['mu_c'] for s in summaries), '{:g}')}, "
-                   f"window = {_values((s['attrs']['window'] for s in summaries), '{:g}')} blocks; "
-                   f"bands: {levels} bootstrap over {_values(_units(s) for s in summaries)}")
+    bands = f"bands: {levels} bootstrap over {_values(_units(s) for s in summaries)}"
+    if kind == "creep":
+        description = f"{_creep_sizes(summaries)}; {bands}"
+    else:
+        description = (f"{_values(size_text(s) for s in summaries)}, "
+                       f"mu_c = {_values((s['attrs']['mu_c'] for s in summaries), '{:g}')}, "
+                       f"window = {_values((s['attrs']['window'] for s in summaries), '{:g}')} blocks; {bands}")
     partials = []
     for s, name in zip(summaries, names):
         partial = partial_text(s).split(";")[0]
@@ -335,7 +349,7 @@ def figure(summaries, kind, title=None, names=None):
              else [f"summary {j + 1}" for j in range(len(summaries))])
     keys, labels = legend_labels(summaries, names)
     n = len(labels)
-    text = title_text(summaries, names, title)
+    text = title_text(summaries, names, title, kind)
     if kind == "magnitude":
         fig, ax = plt.subplots(figsize=(8 + 1.6 * (_legend_columns(n) - 1), 4.8), dpi=DPI)
         magnitude(summaries, ax, keys, labels)

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The creep statistics against integrator.creep_tol (1e-5, 1e-6, 1e-7) and the event integrator's rtol
 # (1e-4, 1e-6): five runs of examples/slow/convergence.toml into runs/slow/convergence/, reduced, and the
-# table docs/slow/convergence.md. About 15 minutes of one core.
+# table docs/slow/convergence.md. 1184 s of one core here (74 to 502 s per run, a shared machine).
 #   bash examples/slow/convergence.sh
 set -euo pipefail
 cd "$(dirname "$0")/../.."
