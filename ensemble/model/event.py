@@ -334,7 +334,7 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
                     na, nt, yrest = _start(arrays, na, nt, t0, p, j, tau, yrest)
         # -- the hand-back: sliding blocks slow enough to creep stop here and creep from here on
         # (creep.slow_enough, creep.after_event)
-        if creep_on and na > 0 and slow_enough(arrays, n, p, na):
+        if creep_on and na > 0 and slow_enough(arrays, n, p, na, vmax):
             for k in range(na):
                 i = act[k]
                 arrays.creep[i, CR_HB] = 1.0
