@@ -554,14 +554,15 @@ def continue_creep(arrays, clock, n, p, budget):
             solved, work, gone = _solve(arrays, n, p, t, h)
             used += work
             stopped += gone
-            if h <= inertial or (solved and cs[CS_NCREEP] == 0.0):
+            if solved and cs[CS_NCREEP] == 0.0:
                 break
             err = _error(arrays, n, p) if solved else np.inf
-            if err <= 1.0:
+            if err <= 1.0 or h <= inertial:
                 break
             # never below inertia's time scale, which the quasi-static equations do not resolve
             h = max(h * max(_SHRINK, 0.9 / math.sqrt(err)), h * 0.25, inertial)
-        if not solved:
+        if not solved or err > 1.0:
+            # no creep, or creep whose error wants steps shorter than inertia's time scale: an event
             return HANDOVER, used, _fastest(arrays, n)
         # creep that accelerates on inertia's time scale is no longer quasi-static: an event
         who = _accelerating(arrays, n, h, inertial)
