@@ -278,16 +278,18 @@ def _newton(arrays, n, p):
     equation (creep_state). Tridiagonal Newton from CR_V, and if that fails from rest: a law whose
     friction first rises and then falls with v (the slip law) has a second, fast root, and the
     creep's is the one next to rest, which Newton reaches from v = 0 (its residual is convex in v
-    there). Returns False if neither converges with every pivot negative (the step's system is no
-    longer that of a creeping cluster)."""
+    there). Returns -1, or if neither converges with every pivot negative (the step's system is no
+    longer that of a creeping cluster) the block where the iteration from rest failed: the first
+    whose pivot is not negative (where the cluster became too soft), else the last that had not
+    converged."""
     C = arrays.creep
     lst = arrays.crept
     m_c = creeping_list(arrays, n)
     for k in range(m_c):
         i = lst[k]
         C[i, CR_VN] = C[i, CR_V]
-    if _newton_from(arrays, n, p, m_c):
-        return True
+    if _newton_from(arrays, n, p, m_c) < 0:
+        return -1
     for k in range(m_c):
         C[lst[k], CR_VN] = 0.0
     return _newton_from(arrays, n, p, m_c)
@@ -295,11 +297,19 @@ def _newton(arrays, n, p):
 
 @nb.njit(cache=True)
 def _newton_from(arrays, n, p, m_c):
-    """_newton's iteration from CR_VN."""
+    """_newton's iteration from CR_VN: -1 if it converged, else the block where it failed."""
     C, W = arrays.creep, arrays.W
     lst = arrays.crept
     l2 = p.l2
-    for _ in range(_NEWTON):
+    # the rounding of the cluster's forces (~1e-14 of the largest) reaches every block through the
+    # springs: the scale of the convergence test
+    scale = 1.0
+    for k in range(m_c):
+        scale = max(scale, abs(W[lst[k], F0]))
+    for it in range(_NEWTON):
+        # near the fold of a cluster about to become too soft Newton converges only linearly: the
+        # last iterations accept an update below 1e-9 of v
+        rel = 1e-12 if it < _NEWTON - 5 else 1e-9
         for k in range(m_c):
             i = lst[k]
             h = C[i, CR_H]
@@ -308,7 +318,7 @@ def _newton_from(arrays, n, p, m_c):
             C[i, CR_PSI] = psi
             C[i, CR_DPSI] = dpsi
             C[i, CR_DU] = h * v
-        done = True
+        worst = -1
         for k in range(m_c):
             i = lst[k]
             h = C[i, CR_H]
@@ -325,7 +335,7 @@ def _newton_from(arrays, n, p, m_c):
                 d -= m * l2 * h                                   # J[i-1, i] = l2 h_i
                 r -= m * C[i - 1, CR_RES]
             if not d < 0.0:
-                return False
+                return i
             C[i, CR_DIAG] = d
             C[i, CR_RES] = r
         for k in range(m_c - 1, -1, -1):
@@ -337,17 +347,17 @@ def _newton_from(arrays, n, p, m_c):
             C[i, CR_UPPER] = delta          # the step of block i, read by block i - 1
             v = C[i, CR_VN] + delta
             C[i, CR_VN] = v
-            # converged: the update is below 1e-12 of v, or below what the rounding of the force
-            # (~1e-14 of its size) moves v by
-            if not (abs(delta) <= 1e-12 * abs(v) + 1e-14 * (abs(W[i, F0]) + 1.0) / abs(C[i, CR_DIAG])):
-                done = False
-        if done:
+            # converged: the update is below 1e-12 of v, or below what the rounding of the forces
+            # moves v by
+            if not (abs(delta) <= rel * abs(v) + 1e-14 * scale / abs(C[i, CR_DIAG])):
+                worst = i
+        if worst < 0:
             for k in range(m_c):
                 i = lst[k]
                 C[i, CR_PSI], C[i, CR_DPSI] = creep_state(p.law, W[i, P], C[i, CR_VN], C[i, CR_H])
                 C[i, CR_DU] = C[i, CR_H] * C[i, CR_VN]
-            return True
-    return False
+            return -1
+    return worst
 
 
 @nb.njit(cache=True)
@@ -378,6 +388,19 @@ def _locate(W, C, since, n, p, j, t, h):
         else:
             lo = mid
     return hi
+
+
+@nb.njit(cache=True)
+def _overrun(arrays, n, p, t, h):
+    """A block that stopped creeping in this step (CR_LEFT) is past its threshold again by the step's
+    end: the step is too long for the active set that stopped it (its onset is looked for only from the
+    next step, so this step must not carry it past its threshold)."""
+    C = arrays.creep
+    for j in range(n):
+        if C[j, CR_LEFT] != 0.0 and not creeping(C, j):
+            if _excess(arrays.W, C, arrays.since, n, p, j, t, h, 1.0) > 0.0:
+                return True
+    return False
 
 
 @nb.njit(cache=True)
@@ -450,7 +473,7 @@ def _commit(arrays, n, p, t_new):
 def _solve(arrays, n, p, t, h):
     """The creep step from time t (two floats) by h: Newton, and every block whose velocity comes out
     negative stops at t (it is at rest instead: an active-set pass), until none does. Returns
-    (converged, work in block-steps, blocks stopped)."""
+    (converged, work in block-steps, blocks stopped, the block where Newton failed or -1)."""
     C, cs = arrays.creep, arrays.cstate
     work = 0
     stopped = 0
@@ -458,8 +481,9 @@ def _solve(arrays, n, p, t, h):
         m = creeping_list(arrays, n)
         _step_sizes(C, arrays.since, arrays.crept, m, t, h)
         work += m
-        if not _newton(arrays, n, p):
-            return False, work, stopped
+        bad = _newton(arrays, n, p)
+        if bad >= 0:
+            return False, work, stopped, bad
         backward = False
         for k in range(m):
             i = arrays.crept[k]     # (leave changes the set, not this list, until it is made again)
@@ -470,7 +494,7 @@ def _solve(arrays, n, p, t, h):
                 backward = True
         if not backward:
             break
-    return True, work, stopped
+    return True, work, stopped, -1
 
 
 @nb.njit(cache=True)
@@ -537,10 +561,10 @@ def continue_creep(arrays, clock, n, p, budget):
             # step of inertia's time scale, so that the error estimate starts from the creep's own
             # velocities and not from the jump of a block's velocity to them
             cs[CS_FRESH] = 0.0
-            solved, work, stopped = _solve(arrays, n, p, t, inertial)
+            solved, work, stopped, bad = _solve(arrays, n, p, t, inertial)
             used += work
             if not solved:
-                return HANDOVER, used, _fastest(arrays, n)
+                return HANDOVER, used, bad
             for k in range(creeping_list(arrays, n)):
                 i = arrays.crept[k]
                 C[i, CR_V] = C[i, CR_VN]
@@ -551,18 +575,26 @@ def continue_creep(arrays, clock, n, p, budget):
         h = min(cs[CS_H], t_far)
         err = 0.0
         while True:
-            solved, work, gone = _solve(arrays, n, p, t, h)
+            solved, work, gone, bad = _solve(arrays, n, p, t, h)
             used += work
             stopped += gone
             if solved and cs[CS_NCREEP] == 0.0:
                 break
             err = _error(arrays, n, p) if solved else np.inf
-            if err <= 1.0 or h <= inertial:
+            if h <= inertial:
                 break
+            if err <= 1.0:
+                if stopped == 0 or not _overrun(arrays, n, p, t, h):
+                    break
+                h = max(0.5 * h, inertial)
+                continue
             # never below inertia's time scale, which the quasi-static equations do not resolve
             h = max(h * max(_SHRINK, 0.9 / math.sqrt(err)), h * 0.25, inertial)
-        if not solved or err > 1.0:
-            # no creep, or creep whose error wants steps shorter than inertia's time scale: an event
+        if not solved:
+            # no creep: the cluster became too soft where Newton failed
+            return HANDOVER, used, bad
+        if err > 1.0:
+            # creep whose error wants steps shorter than inertia's time scale: an event
             return HANDOVER, used, _fastest(arrays, n)
         # creep that accelerates on inertia's time scale is no longer quasi-static: an event
         who = _accelerating(arrays, n, h, inertial)
@@ -601,10 +633,10 @@ def continue_creep(arrays, clock, n, p, budget):
                 h = 0.0
             else:
                 h *= x_cut
-                solved, work, _ = _solve(arrays, n, p, t, h)
+                solved, work, _, bad = _solve(arrays, n, p, t, h)
                 used += work
                 if not solved:
-                    return HANDOVER, used, _fastest(arrays, n)
+                    return HANDOVER, used, bad
         if h > 0.0:
             t_new[0], t_new[1] = t[0], t[1]
             advance_clock(t_new, h)
