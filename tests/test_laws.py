@@ -447,7 +447,7 @@ def one_error_line(res):
     (f'[model]\nlaw = "{CL}"\nb = 30.0\n', f"model.b does not belong to model.law = '{CL}' (its keys: alpha, sigma)"),
     (f'[model]\nlaw = "{CL}"\n[sweep]\nb = [20.0, 30.0]\n', f"sweep.b does not belong to model.law = '{CL}'"),
     ("[model]\nalpha = 2.0\n", "model.alpha does not belong to model.law = 'aging' (its keys: a, b, c)"),
-    ('[model]\nlaw = "coulomb"\n', "model.law must be one of aging, carlson-langer, got 'coulomb'"),
+    ('[model]\nlaw = "coulomb"\n', "model.law must be one of aging, carlson-langer, slip, got 'coulomb'"),
     # a law that cannot creep asked to creep
     (f'[model]\nlaw = "{CL}"\n[integrator]\ncreep_tol = 1e-5\n',
      f"integrator.creep_tol = 1e-05: model.law = '{CL}' has no creep phase"),

@@ -20,9 +20,9 @@ import numba as nb
 import numpy as np
 
 from .creep import (ENDED, HANDOVER, after_event, continue_creep, join, loaded_past_threshold, off_schedule,
-                    possible, report, stable)
+                    alone_creeps, possible, report)
 from .event import begin_event, begin_handover, continue_event
-from .laws import creep_weakening, loader_moves, onset_delay, rest_state, threshold
+from .laws import loader_moves, onset_delay, rest_state, threshold
 from .schedule import advance_clock, build_schedule, finite_state, materialize, tree_min
 from .undo import log_block
 from .workspace import (BETWEEN, CS_ENDED, CS_NCREEP, D_DURATION, D_ENDING, D_KIND, D_SLIP, EV_CLOCK_HI,
@@ -110,7 +110,7 @@ def simulate(arrays, clock, p, n_events, budget, out_t, out_epicenter, out_diag)
             onset[1] = since[epicenter, 1]
             advance_clock(onset, delay)
             # a block stiffer than its law's weakening creeps instead of rupturing
-            creeps_here = (creep_on and stable(n, p.l2, creep_weakening(p.law), epicenter, epicenter)
+            creeps_here = (creep_on and alone_creeps(arrays, n, p, epicenter)
                            and loaded_past_threshold(p, n, rest_state(p.law, W[epicenter, P], delay)))
             if not creeps_here:
                 # from here on the event changes the between-events state: keep what it was

@@ -36,7 +36,7 @@ from .geometry import left, right
 from .laws import creep_state, creep_weakening, creeps, friction, friction_slopes, onset_delay, rest_state, state_rate, threshold
 from .schedule import advance_clock, elapsed, materialize, onset_key, tree_min, tree_set
 from .workspace import (CR_DIAG, CR_DPSI, CR_DU, CR_EP, CR_H, CR_HB, CR_LEFT, CR_PSI, CR_RES, CR_SERIAL, CR_UPPER, CR_V,
-                        CR_VN, CS_DIRTY, CS_ENDED, CS_FRESH, CS_H, CS_NCREEP, CS_SERIAL, CS_T_HI, CS_T_LO, E_ACTIVE, E_BLOCK_STEPS,
+                        CR_VN, CR_W, CS_DIRTY, CS_ENDED, CS_FRESH, CS_H, CS_NCREEP, CS_SERIAL, CS_T_HI, CS_T_LO, E_ACTIVE, E_BLOCK_STEPS,
                         E_END_HI, E_END_LO, E_EPICENTER, E_FIRST, E_LAST, E_NBLOCKS, E_RUNNING, E_RUPTURED,
                         E_SERIAL, E_SLIP, E_START_HI, E_START_LO, E_STATE, E_STOPPED, E_VMAX, F0, P,
                         D_BLOCK_STEPS, D_DURATION, D_ENDING, D_FIRST, D_KIND, D_LAST, D_NSLIP, D_SLIP, D_VMAX,
@@ -63,12 +63,19 @@ def stiffness(i, n, l2):
 def possible(p, n):
     """Some block of this chain can creep under these parameters: its law creeps, and the stiffest
     single block (interior 1 + 2 l^2, at a free end 1 + l^2, alone 1) is stiffer than the law's
-    weakening. Otherwise no cluster ever creeps (a cluster is never stiffer than its stiffest block
-    alone), and the kernels run exactly as without a creep phase."""
+    weakening as it starts from rest (v = 0; the aging law's does not depend on the state, the slip
+    law's is -inf). Otherwise no cluster ever creeps (a cluster is never stiffer than its stiffest
+    block alone), and the kernels run exactly as without a creep phase."""
     if not creeps(p.law):
         return False
     k_max = stiffness(min(1, n - 1), n, p.l2)
-    return creep_weakening(p.law) < k_max
+    return creep_weakening(p.law, 0.0, 0.0) < k_max
+
+
+@nb.njit(cache=True)
+def alone_creeps(arrays, n, p, j):
+    """Block j, starting from rest with its state, may creep alone: stiffer than its weakening."""
+    return stiffness(j, n, p.l2) > creep_weakening(p.law, 0.0, arrays.W[j, P])
 
 
 @nb.njit(cache=True)
@@ -99,12 +106,12 @@ def run_of(C, n, j):
 
 
 @nb.njit(cache=True)
-def stable(n, l2, weakening, lo, hi):
-    """The cluster lo..hi may creep: K_C - weakening I is positive definite (every pivot of its
-    tridiagonal LDL^T factorisation positive)."""
+def stable(C, n, l2, lo, hi):
+    """The cluster lo..hi may creep: K_C - diag(C[lo..hi, CR_W]), its stiffness less each block's
+    weakening, is positive definite (every pivot of its tridiagonal LDL^T factorisation positive)."""
     pivot = 1.0
     for i in range(lo, hi + 1):
-        d = stiffness(i, n, l2) - weakening
+        d = stiffness(i, n, l2) - C[i, CR_W]
         if i > lo:
             d -= l2 * l2 / pivot
         if not d > 0.0:
@@ -114,12 +121,13 @@ def stable(n, l2, weakening, lo, hi):
 
 
 @nb.njit(cache=True)
-def fastest_creep(C, n, l2, weakening, nu, lo, hi):
-    """C[lo..hi, CR_RES] = (K_C - weakening I)^-1 nu 1 for the stable cluster lo..hi: the fastest creep
-    it can sustain (its creep velocities solve M v = nu - b exp(-psi) <= nu componentwise, and M^-1
-    has positive entries). Thomas' algorithm, the pivots in CR_DIAG."""
+def fastest_creep(C, n, l2, nu, lo, hi):
+    """C[lo..hi, CR_RES] = (K_C - diag(max(CR_W, 0)))^-1 nu 1 for the stable cluster lo..hi: a bound of
+    the fastest creep it can sustain (docs/numerics.md: the creep velocities solve M v = nu - s with
+    M's diagonal no smaller and s >= 0, and such an M^-1 has positive entries). Thomas' algorithm,
+    the pivots in CR_DIAG."""
     for i in range(lo, hi + 1):
-        d = stiffness(i, n, l2) - weakening
+        d = stiffness(i, n, l2) - max(C[i, CR_W], 0.0)
         r = nu
         if i > lo:
             m = -l2 / C[i - 1, CR_DIAG]
@@ -267,16 +275,41 @@ def _step_sizes(C, since, lst, m, t, h):
 def _newton(arrays, n, p):
     """One backward-Euler step of every creeping block to its CR_H: the velocities CR_VN that put
     every creeping block's force at the step's end on its friction, with psi from its own state
-    equation (creep_state). Tridiagonal Newton from CR_V. Returns False if it does not converge or
-    a pivot is not negative (the step's system is no longer that of a creeping cluster)."""
-    C, W = arrays.creep, arrays.W
+    equation (creep_state). Tridiagonal Newton from CR_V, and if that fails from rest: a law whose
+    friction first rises and then falls with v (the slip law) has a second, fast root, and the
+    creep's is the one next to rest, which Newton reaches from v = 0 (its residual is convex in v
+    there). Returns -1, or if neither converges with every pivot negative (the step's system is no
+    longer that of a creeping cluster) the block where the iteration from rest failed: the first
+    whose pivot is not negative (where the cluster became too soft), else the last that had not
+    converged."""
+    C = arrays.creep
     lst = arrays.crept
     m_c = creeping_list(arrays, n)
-    l2 = p.l2
     for k in range(m_c):
         i = lst[k]
         C[i, CR_VN] = C[i, CR_V]
-    for _ in range(_NEWTON):
+    if _newton_from(arrays, n, p, m_c) < 0:
+        return -1
+    for k in range(m_c):
+        C[lst[k], CR_VN] = 0.0
+    return _newton_from(arrays, n, p, m_c)
+
+
+@nb.njit(cache=True)
+def _newton_from(arrays, n, p, m_c):
+    """_newton's iteration from CR_VN: -1 if it converged, else the block where it failed."""
+    C, W = arrays.creep, arrays.W
+    lst = arrays.crept
+    l2 = p.l2
+    # the rounding of the cluster's forces (~1e-14 of the largest) reaches every block through the
+    # springs: the scale of the convergence test
+    scale = 1.0
+    for k in range(m_c):
+        scale = max(scale, abs(W[lst[k], F0]))
+    for it in range(_NEWTON):
+        # near the fold of a cluster about to become too soft Newton converges only linearly: the
+        # last iterations accept an update below 1e-9 of v
+        rel = 1e-12 if it < _NEWTON - 5 else 1e-9
         for k in range(m_c):
             i = lst[k]
             h = C[i, CR_H]
@@ -285,7 +318,7 @@ def _newton(arrays, n, p):
             C[i, CR_PSI] = psi
             C[i, CR_DPSI] = dpsi
             C[i, CR_DU] = h * v
-        done = True
+        worst = -1
         for k in range(m_c):
             i = lst[k]
             h = C[i, CR_H]
@@ -302,7 +335,7 @@ def _newton(arrays, n, p):
                 d -= m * l2 * h                                   # J[i-1, i] = l2 h_i
                 r -= m * C[i - 1, CR_RES]
             if not d < 0.0:
-                return False
+                return i
             C[i, CR_DIAG] = d
             C[i, CR_RES] = r
         for k in range(m_c - 1, -1, -1):
@@ -314,17 +347,17 @@ def _newton(arrays, n, p):
             C[i, CR_UPPER] = delta          # the step of block i, read by block i - 1
             v = C[i, CR_VN] + delta
             C[i, CR_VN] = v
-            # converged: the update is below 1e-12 of v, or below what the rounding of the force
-            # (~1e-14 of its size) moves v by
-            if not (abs(delta) <= 1e-12 * abs(v) + 1e-14 * (abs(W[i, F0]) + 1.0) / abs(C[i, CR_DIAG])):
-                done = False
-        if done:
+            # converged: the update is below 1e-12 of v, or below what the rounding of the forces
+            # moves v by
+            if not (abs(delta) <= rel * abs(v) + 1e-14 * scale / abs(C[i, CR_DIAG])):
+                worst = i
+        if worst < 0:
             for k in range(m_c):
                 i = lst[k]
                 C[i, CR_PSI], C[i, CR_DPSI] = creep_state(p.law, W[i, P], C[i, CR_VN], C[i, CR_H])
                 C[i, CR_DU] = C[i, CR_H] * C[i, CR_VN]
-            return True
-    return False
+            return -1
+    return worst
 
 
 @nb.njit(cache=True)
@@ -358,6 +391,19 @@ def _locate(W, C, since, n, p, j, t, h):
 
 
 @nb.njit(cache=True)
+def _overrun(arrays, n, p, t, h):
+    """A block that stopped creeping in this step (CR_LEFT) is past its threshold again by the step's
+    end: the step is too long for the active set that stopped it (its onset is looked for only from the
+    next step, so this step must not carry it past its threshold)."""
+    C = arrays.creep
+    for j in range(n):
+        if C[j, CR_LEFT] != 0.0 and not creeping(C, j):
+            if _excess(arrays.W, C, arrays.since, n, p, j, t, h, 1.0) > 0.0:
+                return True
+    return False
+
+
+@nb.njit(cache=True)
 def _rate(law, v, psi):
     """The state's rate (a call of its own: numba's inliner mislabels two in one loop)."""
     return state_rate(law, v, psi)
@@ -367,9 +413,8 @@ def _rate(law, v, psi):
 def _error(arrays, n, p):
     """The step's error norm: half the change over the step of the state's rate and of the
     velocity (backward Euler's local error), in psi, relative to integrator.creep_tol; the slip's
-    error counts as the force it makes (K_ii du) over the law's weakening."""
+    error counts as the force it makes (K_ii du) over the friction's slope in psi."""
     C, W = arrays.creep, arrays.W
-    w = creep_weakening(p.law)
     err = 0.0
     lst = arrays.crept
     for k in range(creeping_list(arrays, n)):
@@ -377,6 +422,7 @@ def _error(arrays, n, p):
         g_end = _rate(p.law, C[i, CR_VN], C[i, CR_PSI])
         g_start = _rate(p.law, C[i, CR_V], W[i, P])
         dv = C[i, CR_VN] - C[i, CR_V]
+        w = friction_slopes(p.law, C[i, CR_VN], C[i, CR_PSI])[1]
         e = 0.5 * C[i, CR_H] * (abs(g_end - g_start) + stiffness(i, n, p.l2) * abs(dv) / w) / p.creep_tol
         err = max(err, e)
     return err
@@ -427,7 +473,7 @@ def _commit(arrays, n, p, t_new):
 def _solve(arrays, n, p, t, h):
     """The creep step from time t (two floats) by h: Newton, and every block whose velocity comes out
     negative stops at t (it is at rest instead: an active-set pass), until none does. Returns
-    (converged, work in block-steps, blocks stopped)."""
+    (converged, work in block-steps, blocks stopped, the block where Newton failed or -1)."""
     C, cs = arrays.creep, arrays.cstate
     work = 0
     stopped = 0
@@ -435,8 +481,9 @@ def _solve(arrays, n, p, t, h):
         m = creeping_list(arrays, n)
         _step_sizes(C, arrays.since, arrays.crept, m, t, h)
         work += m
-        if not _newton(arrays, n, p):
-            return False, work, stopped
+        bad = _newton(arrays, n, p)
+        if bad >= 0:
+            return False, work, stopped, bad
         backward = False
         for k in range(m):
             i = arrays.crept[k]     # (leave changes the set, not this list, until it is made again)
@@ -447,7 +494,7 @@ def _solve(arrays, n, p, t, h):
                 backward = True
         if not backward:
             break
-    return True, work, stopped
+    return True, work, stopped, -1
 
 
 @nb.njit(cache=True)
@@ -486,7 +533,6 @@ def continue_creep(arrays, clock, n, p, budget):
     creep's time; PAUSED when the budget (block-steps, as events count them) ran out before a step.
     `clock` follows the creep's time."""
     C, cs, W, since, tree = arrays.creep, arrays.cstate, arrays.W, arrays.since, arrays.tree
-    w = creep_weakening(p.law)
     inertial = 2.0 * math.pi / math.sqrt(stiffness(min(1, n - 1), n, p.l2))
     t = np.empty(2)
     t_new = np.empty(2)
@@ -515,10 +561,10 @@ def continue_creep(arrays, clock, n, p, budget):
             # step of inertia's time scale, so that the error estimate starts from the creep's own
             # velocities and not from the jump of a block's velocity to them
             cs[CS_FRESH] = 0.0
-            solved, work, stopped = _solve(arrays, n, p, t, inertial)
+            solved, work, stopped, bad = _solve(arrays, n, p, t, inertial)
             used += work
             if not solved:
-                return HANDOVER, used, _fastest(arrays, n)
+                return HANDOVER, used, bad
             for k in range(creeping_list(arrays, n)):
                 i = arrays.crept[k]
                 C[i, CR_V] = C[i, CR_VN]
@@ -529,17 +575,26 @@ def continue_creep(arrays, clock, n, p, budget):
         h = min(cs[CS_H], t_far)
         err = 0.0
         while True:
-            solved, work, gone = _solve(arrays, n, p, t, h)
+            solved, work, gone, bad = _solve(arrays, n, p, t, h)
             used += work
             stopped += gone
-            if h <= inertial or (solved and cs[CS_NCREEP] == 0.0):
+            if solved and cs[CS_NCREEP] == 0.0:
                 break
             err = _error(arrays, n, p) if solved else np.inf
-            if err <= 1.0:
+            if h <= inertial:
                 break
+            if err <= 1.0:
+                if stopped == 0 or not _overrun(arrays, n, p, t, h):
+                    break
+                h = max(0.5 * h, inertial)
+                continue
             # never below inertia's time scale, which the quasi-static equations do not resolve
             h = max(h * max(_SHRINK, 0.9 / math.sqrt(err)), h * 0.25, inertial)
         if not solved:
+            # no creep: the cluster became too soft where Newton failed
+            return HANDOVER, used, bad
+        if err > 1.0:
+            # creep whose error wants steps shorter than inertia's time scale: an event
             return HANDOVER, used, _fastest(arrays, n)
         # creep that accelerates on inertia's time scale is no longer quasi-static: an event
         who = _accelerating(arrays, n, h, inertial)
@@ -578,10 +633,10 @@ def continue_creep(arrays, clock, n, p, budget):
                 h = 0.0
             else:
                 h *= x_cut
-                solved, work, _ = _solve(arrays, n, p, t, h)
+                solved, work, _, bad = _solve(arrays, n, p, t, h)
                 used += work
                 if not solved:
-                    return HANDOVER, used, _fastest(arrays, n)
+                    return HANDOVER, used, bad
         if h > 0.0:
             t_new[0], t_new[1] = t[0], t[1]
             advance_clock(t_new, h)
@@ -593,22 +648,28 @@ def continue_creep(arrays, clock, n, p, budget):
         # -- a resting neighbour starts: it creeps with its cluster, or the cluster ruptures
         t[0], t[1] = cs[CS_T_HI], cs[CS_T_LO]
         lo, hi = run_of(C, n, who)
-        if not stable(n, p.l2, w, lo, hi):
+        for i in range(lo, hi + 1):
+            C[i, CR_W] = creep_weakening(p.law, C[i, CR_V] if creeping(C, i) else 0.0, W[i, P])
+        if not stable(C, n, p.l2, lo, hi):
             return HANDOVER, used, who
         join(arrays, n, p, who, 0.0, t)
 
 
 @nb.njit(cache=True)
-def slow_enough(arrays, n, p, na):
+def slow_enough(arrays, n, p, na, vmax):
     """Every sliding block of the event in progress (act[:na]) could creep instead: each run of
-    sliding blocks is a stable cluster, and each block moves forward no faster than the fastest
-    creep its cluster can sustain ((K_C - b I)^-1 nu, fastest_creep). The event then hands its
-    blocks back to creep; the kinetic energy it drops is at most that of those creep velocities."""
+    sliding blocks is a stable cluster at its blocks' weakening there, and each block moves forward
+    no faster than the fastest creep its cluster can sustain (fastest_creep, at the weakening from
+    rest: a law whose weakening grows with v creeps slower than it), while the event, its
+    largest velocity so far `vmax`, has been faster than that somewhere (an event that a cluster too
+    soft to creep handed over must first leave the creep's range: handed back before, it would find
+    no creep again). The event then hands its blocks back to creep; the kinetic energy it drops is
+    at most that of those creep velocities."""
     W, act, flag, C = arrays.W, arrays.act, arrays.flag, arrays.creep
-    w = creep_weakening(p.law)
     for k in range(na):
-        if not W[act[k], V] > 0.0:
+        if not W[act[k], V] >= 0.0:
             return False
+    fastest = 0.0
     for k in range(na):
         lo = act[k]
         if lo > 0 and flag[lo - 1] == SLIDING:
@@ -616,13 +677,18 @@ def slow_enough(arrays, n, p, na):
         hi = lo
         while hi < n - 1 and flag[hi + 1] == SLIDING:
             hi += 1
-        if not stable(n, p.l2, w, lo, hi):
+        for i in range(lo, hi + 1):
+            C[i, CR_W] = creep_weakening(p.law, W[i, V], W[i, P])
+        if not stable(C, n, p.l2, lo, hi):
             return False
-        fastest_creep(C, n, p.l2, w, p.nu, lo, hi)
+        for i in range(lo, hi + 1):
+            C[i, CR_W] = creep_weakening(p.law, 0.0, W[i, P])
+        fastest_creep(C, n, p.l2, p.nu, lo, hi)
         for i in range(lo, hi + 1):
             if W[i, V] > C[i, CR_RES]:
                 return False
-    return True
+            fastest = max(fastest, C[i, CR_RES])
+    return vmax > fastest
 
 
 @nb.njit(cache=True)

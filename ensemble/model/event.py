@@ -161,12 +161,15 @@ def begin_event(arrays, t0, n, epicenter, v_start, p):
 @nb.njit(cache=True)
 def begin_handover(arrays, t0, n, epicenter, p):
     """Start an event where creep hands over to inertia (creep.continue_creep): `epicenter` starts
-    from rest at time t0, and every block creeping in its run slides from its creep velocity (as
+    at time t0 from its creep velocity (from rest if it was joining), and every block creeping in its run slides from its creep velocity (as
     begin_event otherwise; the creep arrays keep them until the event's end, creep.after_event)."""
     W, event, C = arrays.W, arrays.event, arrays.creep
     na, nt, yrest = _start(arrays, 0, 0, t0, p, epicenter, 0.0, 0.0)
     lo, hi = run_of(C, n, epicenter)
     vmax = 0.0
+    if C[epicenter, CR_V] > 0.0:
+        W[epicenter, V] = C[epicenter, CR_V]
+        vmax = W[epicenter, V]
     for i in range(lo, hi + 1):
         if i != epicenter and C[i, CR_V] > 0.0:
             na, nt, yrest = _start(arrays, na, nt, t0, p, i, 0.0, yrest)
@@ -334,7 +337,7 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
                     na, nt, yrest = _start(arrays, na, nt, t0, p, j, tau, yrest)
         # -- the hand-back: sliding blocks slow enough to creep stop here and creep from here on
         # (creep.slow_enough, creep.after_event)
-        if creep_on and na > 0 and slow_enough(arrays, n, p, na):
+        if creep_on and na > 0 and slow_enough(arrays, n, p, na, vmax):
             for k in range(na):
                 i = act[k]
                 arrays.creep[i, CR_HB] = 1.0

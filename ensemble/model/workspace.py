@@ -148,7 +148,8 @@ CR_DIAG = 9     # Thomas' pivot
 CR_UPPER = 10   # Newton's update of the block (read by its left neighbour in the back sweep)
 CR_HB = 11      # 1: the event that just ended handed the block back to creep
 CR_LEFT = 12    # 1: the block stopped creeping in the step being taken
-NCREEP = 13
+CR_W = 13       # the block's weakening per unit slip (Law.creep_weakening) where a cluster's stability is checked
+NCREEP = 14
 # The episode table `episodes`: one row (slot) per episode running or ended and not yet reported
 E_STATE = 0     # 0 free, E_RUNNING, E_STOPPED (its blocks stopped), E_RUPTURED (an event took them)
 E_START_HI, E_START_LO = 1, 2      # two-float time at which it began

@@ -69,8 +69,10 @@ class Law:
                           # None: not of this form, and a law with a state then refuses that method
     # Quasi-static creep (model/creep.py, docs/numerics.md "Quasi-static creep"); a law without
     # `creep_state` never creeps (a block that reaches its threshold always starts an event)
-    creep_weakening: object = None  # (law) -> w: a cluster of blocks may creep while K_C - w I is
-                          # positive definite (K_C its stiffness matrix); the aging law: b
+    creep_weakening: object = None  # (law, v, psi) -> w = -d friction / d slip of a block creeping at v
+                          # with state psi, -(d friction / d psi) (d psi' / d v); a cluster may creep
+                          # while K_C - diag(w) is positive definite (K_C its stiffness matrix); the
+                          # aging law: b at every state
     creep_state: object = None  # (law, psi0, v, h) -> (psi, d psi / d v): the state after a backward
                           # Euler step of size h at velocity v from psi0
     friction_slopes: object = None  # (law, v, psi) -> (d friction / d v, d friction / d psi)
@@ -144,8 +146,8 @@ def creeps(law):
     """The law has a quasi-static creep phase (a compile-time constant)."""
 
 
-def creep_weakening(law):
-    """w: a cluster may creep while its stiffness matrix minus w I is positive definite."""
+def creep_weakening(law, v, psi):
+    """w at (v, psi): a cluster may creep while its stiffness matrix minus diag(w) is positive definite."""
 
 
 def creep_state(law, psi0, v, h):
@@ -229,33 +231,31 @@ def _creeps(law):
     return lambda law: value
 
 
-def _optional(stub, field, arity):
+def _optional(stub, field, arity, pair):
     """Compile calls of `stub` to the law's optional function `field`; a law without it never
-    reaches the call (creeps(law) is False), which compiles to NaNs."""
+    reaches the call (creeps(law) is False), which compiles to a NaN (a pair of NaNs if `pair`)."""
     def choose(law):
         return getattr(_BY_PARAMS[law.instance_class], field)
 
-    if arity == 1:
-        @overload(stub, inline="always")
-        def _one(law):
-            fn = choose(law)
-            return (lambda law: math.nan) if fn is None else (lambda law: fn(law))
-    elif arity == 2:
+    if arity == 2:
         @overload(stub, inline="always")
         def _two(law, x, y):
             fn = choose(law)
-            return (lambda law, x, y: (math.nan, math.nan)) if fn is None else (lambda law, x, y: fn(law, x, y))
+            if fn is not None:
+                return lambda law, x, y: fn(law, x, y)
+            return (lambda law, x, y: (math.nan, math.nan)) if pair else (lambda law, x, y: math.nan)
     else:
         @overload(stub, inline="always")
         def _three(law, x, y, z):
             fn = choose(law)
-            return ((lambda law, x, y, z: (math.nan, math.nan)) if fn is None
-                    else (lambda law, x, y, z: fn(law, x, y, z)))
+            if fn is not None:
+                return lambda law, x, y, z: fn(law, x, y, z)
+            return (lambda law, x, y, z: (math.nan, math.nan)) if pair else (lambda law, x, y, z: math.nan)
 
 
-_optional(creep_weakening, "creep_weakening", 1)
-_optional(friction_slopes, "friction_slopes", 2)
-_optional(creep_state, "creep_state", 3)
+_optional(creep_weakening, "creep_weakening", 2, pair=False)
+_optional(friction_slopes, "friction_slopes", 2, pair=True)
+_optional(creep_state, "creep_state", 3, pair=True)
 
 for _stub in (friction, threshold, state_rate, rest_state, onset_delay, implicit_state, stiff_limit,
               rk4_unstable):

@@ -60,8 +60,9 @@ def linear_state(law, v):
 
 
 @nb.njit(cache=True, inline="always")
-def creep_weakening(law):
-    """A cluster creeps while K_C - b I is positive definite (docs/numerics.md)."""
+def creep_weakening(law, v, psi):
+    """-b d(psi')/dv = b at every state: a cluster creeps while K_C - b I is positive definite
+    (docs/numerics.md)."""
     return law.b
 
 
