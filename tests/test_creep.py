@@ -8,8 +8,8 @@ from ensemble.config import Model, Integrator
 from ensemble.integrators import kernel_params
 from ensemble.model import creep
 from ensemble.model.chain import simulate
-from ensemble.model.workspace import (CR_V, D_ENDING, D_KIND, D_NSLIP, D_SLIP, F0, KIND_CREEP, KIND_EVENT, NDIAG,
-                                      OK, P, UNLIMITED, Workspace)
+from ensemble.model.workspace import (CR_V, D_DURATION, D_ENDING, D_KIND, D_NSLIP, D_SLIP, F0, KIND_CREEP, KIND_EVENT,
+                                      NDIAG, OK, P, UNLIMITED, Workspace)
 
 from .creep_reference import inertial, on_the_manifold, stiffness
 
@@ -199,6 +199,21 @@ def test_a_cluster_too_soft_to_creep_hands_over_to_an_event():
     assert d[0, D_KIND] == KIND_EVENT and e[0] == 2 and d[0, D_NSLIP] >= 2
     assert d[1, D_KIND] == KIND_CREEP and e[1] == 1 and d[1, D_ENDING] == 2 and d[1, D_NSLIP] == 1
     assert t[1] == 0.0 < t[0], "the episode began at the start, the event later"
+
+
+def test_an_episode_taken_over_ends_at_the_onset_of_the_event_that_took_it():
+    """An episode that an inertial event took (ending 2) ends at the event's onset (creep.after_event), where
+    the event's row begins: its start plus its duration is the onset of the last event row before it (its
+    row follows the event's) to round-off of the time (t ~ 1e12 here, whose spacing is 1.2e-4), not the
+    event's end (the events here last 12 to 33; measured: at most one spacing away)."""
+    t, _, d = rows(60, 15.0, 150)
+    taken = np.flatnonzero((d[:, D_KIND] == KIND_CREEP) & (d[:, D_ENDING] == 2))
+    events = np.flatnonzero(d[:, D_KIND] == KIND_EVENT)
+    assert len(taken) > 20 and events[0] < taken[0]
+    took = events[np.searchsorted(events, taken) - 1]
+    end = t[taken] + d[taken, D_DURATION]
+    late = np.abs(end - t[took]) / np.spacing(t[took])
+    assert np.all(late <= 2), f"ends up to {late.max():.3g} spacings of t away from the onset"
 
 
 def test_above_the_block_stiffness_nothing_creeps():

@@ -135,12 +135,14 @@ def simulate(arrays, clock, p, n_events, budget, out_t, out_epicenter, out_diag)
         if status == PAUSED:
             return PAUSED, k
         t_onset = clock[0] + clock[1]
+        if creep_on:
+            onset[0], onset[1] = clock[0], clock[1]     # where the event took any creeping blocks
         if loader_moves(p.law):     # else the event took no loading time (laws/__init__.py)
             advance_clock(clock, diag[D_DURATION])
         if status != OK:
             return status, k
         if creep_on:
-            after_event(arrays, n, p, clock)
+            after_event(arrays, n, p, onset, clock)
         if diag[D_SLIP] == 0.0:
             continue    # nothing moved (an onset within round-off of the threshold): no event
         out_t[k] = t_onset

@@ -692,18 +692,24 @@ def slow_enough(arrays, n, p, na, vmax):
 
 
 @nb.njit(cache=True)
-def after_event(arrays, n, p, clock):
-    """The event that just ended (its touched blocks, event.py) meets the creep: creeping blocks it
-    took leave their episodes (RUPTURED), blocks it handed back (CR_HB) start to creep with their
-    velocity, the creep goes on from the event's end, and the blocks around it are rescheduled."""
+def after_event(arrays, n, p, onset, clock):
+    """The event that just ended (its touched blocks, event.py), from `onset` to `clock` (two-float
+    times), meets the creep: creeping blocks it took leave their episodes (RUPTURED) at its onset,
+    blocks it handed back (CR_HB) start to creep with their velocity, the creep goes on from the
+    event's end, and the blocks around it are rescheduled.
+
+    The event took its blocks at its onset, not when each started to slide in it: from the onset on
+    the event integrates them (a block at rest in its equations, its state healing from the onset,
+    until its force reaches the threshold), and creep, which waits while an event runs, moves them
+    no more; a hand-over slides the cluster's blocks from the onset anyway. So an episode taken over
+    ends where the event's row begins, and the two rows do not overlap in time."""
     C, cs, touched = arrays.creep, arrays.cstate, arrays.touched
     nt = int(arrays.event[EV_NT])
     t = np.empty(2)
     for k in range(nt):
         i = touched[k]
         if creeping(C, i):
-            t[0], t[1] = arrays.since[i, 0], arrays.since[i, 1]
-            leave(arrays, n, p, i, t, E_RUPTURED)
+            leave(arrays, n, p, i, onset, E_RUPTURED)
     for k in range(nt):
         i = touched[k]
         if C[i, CR_HB] != 0.0:
