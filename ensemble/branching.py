@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .catalog import FAILED, OPEN, Checkpoint
+from .model.workspace import CR_EP, CR_KEEP
 from .tasks import Task, branch_rng, perturb, point_tasks, spinups
 
 
@@ -38,9 +39,23 @@ def spins_needed(cfg, tasks, stored=None, rerun=None):
     return needed
 
 
+def creeping(spun):
+    """Which blocks of a spun-up state (Checkpoint) creep: its creep state's episode column CR_EP."""
+    n = len(spun.force)
+    if spun.creep is None:
+        return np.zeros(n, dtype=bool)
+    return spun.creep[:n * CR_KEEP].reshape(n, CR_KEEP)[:, CR_EP] > 0
+
+
 def branch_start(cfg, task, spun):
     """The state a branched task starts from: its point's spun-up state (Checkpoint, its creep state
-    included) with the task's own perturbation, no events done."""
-    force = perturb(spun.force, cfg.run.perturbation, branch_rng(cfg, task))
+    included) with the task's own perturbation, no events done.
+
+    Only blocks at rest are lowered: a creeping block's force is its friction (force balance, the
+    creep phase's invariant), and lowered it would creep on out of balance; the perturbation of
+    the others decorrelates the seeds all the same. Every block still draws its number, so the
+    stream does not depend on which blocks creep."""
+    lowered = perturb(spun.force, cfg.run.perturbation, branch_rng(cfg, task))
+    force = np.where(creeping(spun), spun.force, lowered)
     return Checkpoint(force, spun.psi.copy(), spun.since.copy(), spun.clock.copy(), 0,
                       None if spun.creep is None else spun.creep.copy())

@@ -199,3 +199,30 @@ def test_branch_keys_are_validated_by_name():
     cfg = loads("[model]\nN = 400\n[sweep]\nN = [200, 300]\n[run]\nbranch = true\ntransient = 100\n")
     assert cfg.run.decorrelation == cfg.run.discarded == DECORRELATION_PER_BLOCK * 300   # the longest chain
     assert loads("[run]\ntransient = 100\n").run.discarded == 100
+
+
+def test_a_branch_lowers_the_blocks_at_rest_and_keeps_the_creeping_ones_in_balance(tmp_path):
+    """Below the block stiffness a spun-up state holds creeping blocks, whose force is their
+    friction (the creep phase's force balance): the perturbation lowers only the blocks at rest,
+    each by its own draw in [0, perturbation), and the branches run."""
+    from ensemble.branching import branch_start, creeping
+    from ensemble.config import load
+    from ensemble.tasks import task_list
+    perturbation = 1e-3
+    # (rows end with every block at rest as a rule; at N = 200, b = 15 the 11th ends with one creeping)
+    cfg_path = write_config(tmp_path / "creep.toml", model={"N": 200, "b": 15.0},
+                            run={"seeds": 2, "events": 30, "transient": 11, "branch": True,
+                                 "decorrelation": 10, "perturbation": perturbation})
+    res = run_cli("run", cfg_path, "-o", tmp_path / "creep.h5")
+    assert res.returncode == 0, res.stderr
+    cfg = load(cfg_path)
+    with catalog.Reader(tmp_path / "creep.h5") as cat:
+        layout = cat.layout
+        spun = layout.read_state(layout.n_tasks, layout.head(layout.n_tasks))
+    moving = creeping(spun)
+    assert 0 < moving.sum() < len(moving), "the spin-up ends with some blocks creeping and some at rest"
+    for task in task_list(cfg):
+        start = branch_start(cfg, task, spun)
+        np.testing.assert_array_equal(start.force[moving], spun.force[moving])
+        lowered = spun.force[~moving] - start.force[~moving]
+        assert np.all((lowered > 0) & (lowered < perturbation))
