@@ -255,8 +255,8 @@ def compare(paths, opt):
 
 def _cell(est, lo, hi):
     def g(x):
-        return "inf" if x == math.inf else f"{x:.3g}"
-    return f"{g(est)} [{g(lo)}, {g(hi)}]" if np.isfinite(lo) else g(est)
+        return "inf" if x == math.inf else "n/a" if math.isnan(x) else f"{x:.3g}"
+    return f"{g(est)} [{g(lo)}, {g(hi)}]" if np.isfinite(est) and np.isfinite(lo) else g(est)
 
 
 def table(points, opt, command):
@@ -275,6 +275,9 @@ def table(points, opt, command):
         for j in (6, 7):
             cells.append(_cell(x[j], lo[j], hi[j]))
         lines.append("| " + " | ".join(cells) + " |")
+    if any(not np.all(np.isfinite(p["numbers"][[2, 3, 4, 6, 7]])) for p in points):
+        lines += ["", f"inf: no event between n = 2 and the peak at n >= {opt.n_large}; n/a: tau and KS need events "
+                      f"of two sizes or more below n = {opt.n_large}, CV and sharpness two recurrences or more."]
     return "\n".join(lines) + "\n"
 
 

@@ -210,3 +210,18 @@ def test_reduce_takes_the_scales_of_the_catalogs_law(two_laws, tmp_path):
     assert res.returncode == 0, res.stderr
     with h5py.File(tmp_path / "both.h5") as h5:
         assert h5.attrs["mu_c"] == 1.0 and len(h5["bins/mu"]) == 101
+
+
+def test_the_table_says_in_words_what_a_law_without_small_events_lacks():
+    """Ruina's slip law at N = 800 makes only system-size events: no dip below them, no small events
+    to fit tau to. The table prints inf and n/a with a note saying why, never nan."""
+    from types import SimpleNamespace
+    nan, inf = math.nan, math.inf
+    x = np.array([18, 1.0, inf, nan, nan, 10, 0.39, 6.0])
+    lo = np.array([18, 1.0, inf, nan, nan, 10, 0.2, 4.6])
+    hi = np.array([18, 1.0, inf, nan, nan, 10, 0.5, 13.0])
+    opt = SimpleNamespace(n_large=50, level=0.95, bootstrap=1000)
+    text = cmp.table([{"label": "slip", "numbers": x, "numbers_lo": lo, "numbers_hi": hi}], opt, "cmd")
+    row = text.splitlines()[5]
+    assert row.split(" | ")[3:6] == ["inf", "n/a", "n/a"] and "0.39 [0.2, 0.5]" in row
+    assert "nan" not in text and "n/a: tau and KS need events" in text
