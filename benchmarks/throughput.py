@@ -2,7 +2,7 @@
 
     python benchmarks/throughput.py [--N 800] [--b 20] [--dt 1e-3] [--method rk4|ark3|ark4|ark5|exp4]
                                     [--rtol 1e-5] [--transient 1000] [--events 2000]
-                                    [--law carlson-langer --alpha 2 --sigma 0.01]
+                                    [--law carlson-langer --alpha 2 --sigma 0.01 | --law slip --a 0] [--per-row]
 
 Runs the transient (not timed, includes compilation), then times `events`
 recorded events and prints events/s, cost per block-step, the magnitude range
@@ -38,16 +38,30 @@ def main():
     p.add_argument("--transient", type=int, default=1000)
     p.add_argument("--events", type=int, default=2000)
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--per-row", action="store_true",
+                   help="time each row alone (one kernel call per row, ~1e-5 s more each) and print the time "
+                        "per creep episode and per inertial event: a creep row is charged the work until it is "
+                        "reported, an event row the work from its onset")
     args = p.parse_args()
-    keys = dict(a=args.a, b=args.b) if args.law == "aging" else dict(alpha=args.alpha, sigma=args.sigma)
+    keys = dict(alpha=args.alpha, sigma=args.sigma) if args.law == "carlson-langer" else dict(a=args.a, b=args.b)
     cfg = Config(model=Model(N=args.N, nu=args.nu, law=args.law, **keys),
                  run=Run(events=args.events, transient=args.transient, seed=args.seed),
                  integrator=Integrator(method=args.method, dt=args.dt, rtol=args.rtol))
     traj = Trajectory(cfg, task_list(cfg)[0])
     traj.advance(args.transient)
-    start = time.perf_counter()
-    _, _, diag = traj.advance(args.events)
-    elapsed = time.perf_counter() - start
+    if args.per_row:
+        rows, seconds = [], np.empty(args.events)
+        start = time.perf_counter()
+        for k in range(args.events):
+            t0 = time.perf_counter()
+            rows.append(traj.advance(1)[2])
+            seconds[k] = time.perf_counter() - t0
+        elapsed = time.perf_counter() - start
+        diag = np.concatenate(rows)
+    else:
+        start = time.perf_counter()
+        _, _, diag = traj.advance(args.events)
+        elapsed = time.perf_counter() - start
     block_steps = diag[:, D_BLOCK_STEPS].sum()      # (creep steps count their creeping blocks alike)
     creep = diag[diag[:, D_KIND] == KIND_CREEP]
     diag = diag[diag[:, D_KIND] == KIND_EVENT]      # the event statistics below: inertial events alone
@@ -62,6 +76,12 @@ def main():
               f"({len(creep) / elapsed:.1f}/s; median slip {np.median(creep[:, D_SLIP]):.3g}, median duration "
               f"{np.median(creep[:, D_DURATION]):.3g}, {creep[:, D_BLOCK_STEPS].mean():.0f} block-steps each); "
               f"aseismic slip fraction {creep[:, D_SLIP].sum() / (creep[:, D_SLIP].sum() + diag[:, D_SLIP].sum()):.2e}")
+    if args.per_row:
+        kind = np.concatenate(rows)[:, D_KIND]
+        for name, which in (("inertial event", KIND_EVENT), ("creep episode", KIND_CREEP)):
+            if np.any(kind == which):
+                print(f"  per {name}: {seconds[kind == which].mean() * 1e3:.3g} ms (median "
+                      f"{np.median(seconds[kind == which]) * 1e3:.3g} ms), {seconds[kind == which].sum():.1f} s in all")
     print(f"  {diag[:, D_STEPS].mean():.0f} steps and {diag[:, D_BLOCK_STEPS].mean():.0f} block-steps per event, "
           f"{elapsed / block_steps * 1e9:.0f} ns per block-step")
     print(f"  mu in [{mu.min():.2f}, {mu.max():.2f}], fraction mu >= 4: {np.mean(mu >= 4):.3f}, "
