@@ -48,8 +48,8 @@ def elastic_energy(force, l):
 
 
 def balance(start, end, t, diag, nu, l):
-    """The energy balance (Balance) from `start` to `end`, each (force, time, in flight): the forces of
-    every block at that time (Workspace.state) and Workspace.episodes_in_flight() then; over the rows
+    """The energy balance (Balance) from `start` to `end`, two moments between events, each (force, time,
+    in flight): the forces of every block then (Workspace.state) and Workspace.episodes_in_flight(); over the rows
     (onset times t, diagnostics diag) the kernels returned in between. An episode in flight counts with
     what it had done by `end`, less what it had done by `start` (its row, if any, carries both)."""
     (force0, t0, open0), (force1, t1, open1) = start, end
