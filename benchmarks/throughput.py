@@ -7,13 +7,16 @@
 Runs the transient (not timed, includes compilation), then times `events`
 recorded events and prints events/s, cost per block-step, the magnitude range
 and the largest relative energy residual. Below the block stiffness the rows are inertial events and
-creep episodes: it prints the rate of each, and the event statistics of the inertial events alone.
+creep episodes: it prints the rate of each, the event statistics of the inertial events alone, and the
+energy balance of the timed stretch of the run, events and creep together (ensemble/energy.py: a creep
+episode has no residual of its own).
 """
 import argparse
 import time
 
 import numpy as np
 
+from ensemble import energy
 from ensemble.config import Config, Integrator, Model, Run
 from ensemble.events import relative_energy_residual
 from ensemble.model.workspace import (D_BLOCK_STEPS, D_DURATION, D_ENERGY_SCALE, D_KIND, D_NSLIP, D_RESIDUAL, D_SLIP,
@@ -49,19 +52,23 @@ def main():
                  integrator=Integrator(method=args.method, dt=args.dt, rtol=args.rtol))
     traj = Trajectory(cfg, task_list(cfg)[0])
     traj.advance(args.transient)
+    before = (traj.state()[0], traj.clock.sum(), traj.ws.episodes_in_flight())
     if args.per_row:
         rows, seconds = [], np.empty(args.events)
         start = time.perf_counter()
         for k in range(args.events):
             t0 = time.perf_counter()
-            rows.append(traj.advance(1)[2])
+            rows.append(traj.advance(1))
             seconds[k] = time.perf_counter() - t0
         elapsed = time.perf_counter() - start
-        diag = np.concatenate(rows)
+        t, _, diag = (np.concatenate(column) for column in zip(*rows))
     else:
         start = time.perf_counter()
-        _, _, diag = traj.advance(args.events)
+        t, _, diag = traj.advance(args.events)
         elapsed = time.perf_counter() - start
+    balance = energy.balance(before, (traj.state()[0], traj.clock.sum(), traj.ws.episodes_in_flight()), t, diag,
+                             args.nu, cfg.model.l)
+    kind = diag[:, D_KIND]
     block_steps = diag[:, D_BLOCK_STEPS].sum()      # (creep steps count their creeping blocks alike)
     creep = diag[diag[:, D_KIND] == KIND_CREEP]
     diag = diag[diag[:, D_KIND] == KIND_EVENT]      # the event statistics below: inertial events alone
@@ -76,8 +83,10 @@ def main():
               f"({len(creep) / elapsed:.1f}/s; median slip {np.median(creep[:, D_SLIP]):.3g}, median duration "
               f"{np.median(creep[:, D_DURATION]):.3g}, {creep[:, D_BLOCK_STEPS].mean():.0f} block-steps each); "
               f"aseismic slip fraction {creep[:, D_SLIP].sum() / (creep[:, D_SLIP].sum() + diag[:, D_SLIP].sum()):.2e}")
+        print(f"  energy balance of the run, events and creep: residual {abs(balance.residual / balance.load_work):.1e} "
+              f"of the driver's work (friction work of the creep episodes {balance.creep_work:.3g}, of the events "
+              f"{balance.friction_work - balance.creep_work:.3g}, c-free frame)")
     if args.per_row:
-        kind = np.concatenate(rows)[:, D_KIND]
         for name, which in (("inertial event", KIND_EVENT), ("creep episode", KIND_CREEP)):
             if np.any(kind == which):
                 print(f"  per {name}: {seconds[kind == which].mean() * 1e3:.3g} ms (median "
@@ -86,7 +95,7 @@ def main():
           f"{elapsed / block_steps * 1e9:.0f} ns per block-step")
     print(f"  mu in [{mu.min():.2f}, {mu.max():.2f}], fraction mu >= 4: {np.mean(mu >= 4):.3f}, "
           f"fraction of events slipping >= 50 blocks: {np.mean(diag[:, D_NSLIP] >= 50):.3f}, "
-          f"max relative energy residual {residual.max():.1e}")
+          f"max relative energy residual{' of an inertial event' if len(creep) else ''} {residual.max():.1e}")
 
 
 if __name__ == "__main__":

@@ -51,20 +51,25 @@ from .config import LAW_KEYS, ConfigError, loads
 from .model import laws
 from .tasks import spinups as spinup_points, task_list
 from .integrity import EventCrc, commit_crc, crc, event_problems
-from .model.workspace import KIND_CREEP, KIND_EVENT, Workspace
+from .model.workspace import KIND_CREEP, KIND_EVENT, NEPISODE, Workspace
 from .tables import FAILED, FINISHED, OPEN, STATUS_NAMES
 
-FORMAT = "bk-catalog-5"
-# older formats this version reads (not resumes), and what they lack: bk-catalog-4 has no /events/kind and
-# /events/ending (every row an inertial event; the reader supplies kind 0, ending 0) and no creep state in its
-# checkpoints; bk-catalog-3 lacks also tables_crc and /tasks/record_crc (its tables are checked against its
-# config only). Only FORMAT is written and resumed.
+FORMAT = "bk-catalog-6"
+# older formats this version reads (not resumes), and what they lack: bk-catalog-5 keeps a creep state of
+# another layout in its checkpoints (its episode table without the episodes' energy, EPISODE_COLUMNS);
+# bk-catalog-4 has no /events/kind and /events/ending (every row an inertial event; the reader supplies kind 0,
+# ending 0) and no creep state in its checkpoints; bk-catalog-3 lacks also tables_crc and /tasks/record_crc (its
+# tables are checked against its config only). Only FORMAT is written and resumed.
 OLDER = {
+    "bk-catalog-5": "written before creep episodes kept their energy (another creep state in its checkpoints)",
     "bk-catalog-4": "written before the creep phase (no /events/kind, no creep state in its checkpoints)",
     "bk-catalog-3": "written before its tables were checksummed",
 }
 READABLE = {*OLDER, FORMAT}
-CHECKSUMMED = {"bk-catalog-4", FORMAT}      # formats with tables_crc and /tasks/record_crc
+CHECKSUMMED = {"bk-catalog-4", "bk-catalog-5", FORMAT}      # formats with tables_crc and /tasks/record_crc
+WITH_CREEP = {"bk-catalog-5", FORMAT}       # formats with /events/kind, /events/ending and /checkpoint/creep
+# columns of the episode table in a checkpoint's creep state (Workspace.creep_state), by format
+EPISODE_COLUMNS = {"bk-catalog-5": 14, FORMAT: NEPISODE}
 
 # /events/kind: what a row is, KIND_EVENT (0) or KIND_CREEP (1) (ensemble/model/workspace.py, imported above)
 # /events/ending: 0 an inertial event; a creep episode 1 whose blocks all stopped, 2 taken over by an event
@@ -148,7 +153,8 @@ DATASETS = {
     "checkpoint/state": ("mixed", "(sum over tasks, then spin-ups, of 2 (4 N + 2 + creep * C(N)),)",
                          "per task two slots of [force (N, model force), psi = ln theta (N), since (2N, model "
                          "time), clock (2, model time), then where /checkpoint/creep is 1 the creep phase's "
-                         "state (C(N) = Workspace.creep_size(N) values, Workspace.creep_state)]: block i's force "
+                         "state (C(N) = Workspace.creep_size(N) values, Workspace.creep_state; in bk-catalog-5 "
+                         "14 columns per episode, not 16)]: block i's force "
                          "and psi hold at the two-float time (since[2i], since[2i+1]); clock = (hi, lo) now"),
     "checkpoint/creep": ("bool", "(tasks + spin-ups,)", "1: the record's chain can creep (model/creep.py "
                                                          "possible) and its slots hold its creep state; absent in "
@@ -233,9 +239,10 @@ def carries_creep(model):
     return bool(possible(kernel_params(model, Integrator()), model.N))
 
 
-def _state_size(n, creep=False):
-    """Floats of one checkpoint slot of an n-block record (creep: with its creep state)."""
-    return 4 * n + 2 + (Workspace.creep_size(n) if creep else 0)
+def _state_size(n, creep=False, episode_columns=NEPISODE):
+    """Floats of one checkpoint slot of an n-block record (creep: with its creep state, of an episode table
+    of `episode_columns`, EPISODE_COLUMNS)."""
+    return 4 * n + 2 + (Workspace.creep_size(n, episode_columns) if creep else 0)
 
 
 def _text(value):
@@ -298,7 +305,7 @@ class _Layout:
         self.barrier = barrier
         self.format = h5.attrs.get("format")
         # the event columns this catalog stores (those of its format), in the order of its events CRC
-        self.event_fields = tuple(EVENT_FIELDS) if self.format == FORMAT else OLDER_EVENT_FIELDS
+        self.event_fields = tuple(EVENT_FIELDS) if self.format in WITH_CREEP else OLDER_EVENT_FIELDS
         try:
             self.events = {name: h5["events"][name] for name in self.event_fields}
             self.tasks = {name: h5["tasks"][name] for name in h5["tasks"]}
@@ -312,7 +319,7 @@ class _Layout:
             self.spinup_events = int(h5.attrs.get("spinup", 0))
             self.spinup = {name: ds[...] for name, ds in h5["spinup"].items()} if "spinup" in h5 else {}
             # which records keep a creep state in their slots (none before bk-catalog-5)
-            self.creep = (h5["checkpoint"]["creep"][...].astype(np.int64) if self.format == FORMAT else None)
+            self.creep = (h5["checkpoint"]["creep"][...].astype(np.int64) if self.format in WITH_CREEP else None)
         except (KeyError, OSError, ValueError) as err:
             raise CatalogError(f"{self.path}: damaged catalog ({err})") from None
         n_tasks = len(self.n_blocks)
@@ -320,8 +327,9 @@ class _Layout:
         n_records = len(self.record_blocks)
         if self.creep is None:
             self.creep = np.zeros(n_records, dtype=np.int64)
-        self.slot_sizes = np.array([_state_size(int(n), c == 1) for n, c in zip(self.record_blocks, self.creep)],
-                                   dtype=np.int64)
+        columns = EPISODE_COLUMNS.get(self.format, NEPISODE)
+        self.slot_sizes = np.array([_state_size(int(n), c == 1, columns)
+                                    for n, c in zip(self.record_blocks, self.creep)], dtype=np.int64)
         sizes = 2 * self.slot_sizes
         if (self.commit.shape != (n_records, 2, NCOMMIT) or len(self.offset) != n_records
                 or self.creep.shape != (n_records,) or np.any((self.creep != 0) & (self.creep != 1))

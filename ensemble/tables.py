@@ -5,7 +5,7 @@ protects the rest, so that no damaged table can make a reader or a resume silent
 
 - **Fixed at creation**: every /tasks column but a task's record and the events_written mirror (the
   parameter tables point, seed_index, N, l, nu, law, the law keys, branch_of), /spinup/*,
-  /checkpoint/offset, /checkpoint/creep (bk-catalog-5: which records keep a creep state) and the root
+  /checkpoint/offset, /checkpoint/creep (bk-catalog-5 on: which records keep a creep state) and the root
   attributes (the stored config among them). One CRC of all of them is stored as the root attribute
   `tables_crc` at creation and verified on every open; the parameter tables are also recomputed from
   the stored config, where this version can read it, and compared (`config_problems`), so a config and

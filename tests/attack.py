@@ -24,13 +24,16 @@ import h5py  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ensemble import catalog, lock  # noqa: E402
+from ensemble.model.workspace import Workspace  # noqa: E402
 from tests.processes import child_env, run_bounded, wait_for  # noqa: E402
 
 DEADLINE = 120        # seconds for any command: what they take is a few (a hang fails the attack)
 QUICK = 30            # ... for a run that must end at once (a full disk, a failed collective step)
 COMPILE = 600         # ... for a run of an older commit, which compiles its own kernels first
-# the last commit that writes bk-catalog-4 (before the creep phase): its catalogs are real older catalogs
+# the last commits that write bk-catalog-4 (before the creep phase) and bk-catalog-5 (before creep episodes kept
+# their energy, a creep state of another layout): their catalogs are real older catalogs
 FORMAT_4_COMMIT = "2383acc5f5f0bb6d46cf41bdfe915c3f0db86193"
+FORMAT_5_COMMIT = "d10345f72faa30b4b82c7f6fd3a7d08bf8ec7b33"
 MPIEXEC = shutil.which("mpiexec")
 CONFIG = """[model]
 N = 60
@@ -42,6 +45,20 @@ transient = 10
 [integrator]
 method = "rk4"
 dt = 1e-3
+[output]
+batch = 20
+flush_seconds = 1000.0
+"""
+# a point whose chain creeps (b below the block stiffness 19: creep states in its checkpoint slots) and one
+# whose chain cannot
+CREEP_CONFIG = """[model]
+N = 40
+[sweep]
+b = [15.0, 25.0]
+[run]
+seeds = 2
+events = 60
+transient = 10
 [output]
 batch = 20
 flush_seconds = 1000.0
@@ -105,23 +122,30 @@ class Workshop:
         res = _python("ensemble", "run", self.cfg, "-o", self.crashed, setup="inject.crash_at_write(60)")
         assert res.returncode == 99, res.stderr
 
-    def older(self):
-        """The finished catalog of this config written by FORMAT_4_COMMIT (bk-catalog-4): its tree taken from
-        git, run with its own numba cache; made once. Its final path."""
-        out = self.root / "format4.h5"
+    def older(self, version=4):
+        """The finished catalog of bk-catalog-`version` written by the last commit of that format (4: of this
+        config, FORMAT_4_COMMIT; 5: of CREEP_CONFIG, FORMAT_5_COMMIT): its tree taken from git, run with its
+        own numba cache; made once. Its final path."""
+        out = self.root / f"format{version}.h5"
         if out.exists():
             return out
-        tree = self.root / "format4-tree"
+        commit, cfg = {4: (FORMAT_4_COMMIT, self.cfg), 5: (FORMAT_5_COMMIT, self.creep_config())}[version]
+        tree = self.root / f"format{version}-tree"
         tree.mkdir()
-        archive = subprocess.run(f"git -C '{ROOT}' archive {FORMAT_4_COMMIT} | tar -x -C '{tree}'", shell=True,
+        archive = subprocess.run(f"git -C '{ROOT}' archive {commit} | tar -x -C '{tree}'", shell=True,
                                  capture_output=True, text=True)
-        assert archive.returncode == 0, (f"the commit {FORMAT_4_COMMIT} (the last to write bk-catalog-4) is not in "
+        assert archive.returncode == 0, (f"the commit {commit} (the last to write bk-catalog-{version}) is not in "
                                          f"the repository (a shallow clone?): {archive.stderr}")
-        env = child_env(PYTHONPATH=str(tree), NUMBA_CACHE_DIR=str(self.root / "format4-cache"))
-        res = run_bounded([sys.executable, "-m", "ensemble", "run", str(self.cfg), "-o", str(out)], COMPILE,
+        env = child_env(PYTHONPATH=str(tree), NUMBA_CACHE_DIR=str(self.root / f"format{version}-cache"))
+        res = run_bounded([sys.executable, "-m", "ensemble", "run", str(cfg), "-o", str(out)], COMPILE,
                           cwd=tree, env=env)
         assert res.returncode == 0, res.stdout + res.stderr
         return out
+
+    def creep_config(self):
+        path = self.root / "creep.toml"
+        path.write_text(CREEP_CONFIG)
+        return path
 
     def copy(self, which, name):
         """A copy of the finished ('full') or interrupted ('crashed': its .partial) catalog; its final path."""
@@ -311,6 +335,33 @@ def an_older_format(w):
     one_line(_python("ensemble", "resume", three), (1,), "bk-catalog-3")
 
 
+def format_5_with_creep(w):
+    """A bk-catalog-5 catalog, written by the last commit of that format with creep states in its checkpoint
+    slots (their episode table of 14 columns, not 16), reads: its events are those of this version's run of the
+    config (the creep's slips are unchanged, only its energy is kept now) and its states unpack with their
+    own layout; a run of it is not continued (its checkpoints could not be restored): one line naming it."""
+    old = w.older(5)
+    events, tasks, attrs = catalog.read(old)
+    assert attrs["format"] == "bk-catalog-5"
+    assert np.count_nonzero(events["kind"] == 1) > 20
+    now = w.root / "format5-now.h5"
+    res = _python("ensemble", "run", w.creep_config(), "-o", now)
+    assert res.returncode == 0, res.stderr
+    events_now, _, _ = catalog.read(now)
+    for column in catalog.EVENT_FIELDS:
+        np.testing.assert_array_equal(events[column], events_now[column], err_msg=column)
+    with catalog.Reader(old) as cat:
+        creeps = cat.layout.creep
+        assert creeps.any() and not creeps.all()
+        for k in range(len(tasks["point"])):
+            state = cat.layout.read_state(k, cat.layout.head(k))
+            assert (state.creep is None if not creeps[k]
+                    else len(state.creep) == Workspace.creep_size(int(tasks["N"][k]), 14))
+    part = w.root / "format5-resume.h5"
+    shutil.copy(old, catalog.partial_path(part))
+    one_line(_python("ensemble", "resume", part), (1,), "bk-catalog-5")
+
+
 def flipped_creep_layout(w):
     """/checkpoint/creep (which records keep a creep state) is fixed at creation: a flipped byte is refused."""
     bad = w.copy("full", "flip-creep.h5")
@@ -422,6 +473,7 @@ ATTACKS = {
     "changed stored config, partial": changed_config("crashed"),
     "status of an unknown status code": status_of_an_unknown_code,
     "an older catalog format reads, and is not continued": an_older_format,
+    "a bk-catalog-5 catalog with creep states reads, and is not continued": format_5_with_creep,
     "flip /checkpoint/creep": flipped_creep_layout,
     "resume of a finished catalog with --set": resume_of_a_finished_catalog_with_set,
     "empty config and /dev/null": empty_config,

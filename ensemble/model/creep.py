@@ -37,10 +37,11 @@ from .laws import creep_state, creep_weakening, creeps, friction, friction_slope
 from .schedule import advance_clock, elapsed, materialize, onset_key, tree_min, tree_set
 from .workspace import (CR_DIAG, CR_DPSI, CR_DU, CR_EP, CR_H, CR_HB, CR_LEFT, CR_PSI, CR_RES, CR_SERIAL, CR_UPPER, CR_V,
                         CR_VN, CR_W, CS_DIRTY, CS_ENDED, CS_FRESH, CS_H, CS_NCREEP, CS_SERIAL, CS_T_HI, CS_T_LO, E_ACTIVE, E_BLOCK_STEPS,
-                        E_END_HI, E_END_LO, E_EPICENTER, E_FIRST, E_LAST, E_NBLOCKS, E_RUNNING, E_RUPTURED,
-                        E_SERIAL, E_SLIP, E_START_HI, E_START_LO, E_STATE, E_STOPPED, E_VMAX, F0, P,
-                        D_BLOCK_STEPS, D_DURATION, D_ENDING, D_FIRST, D_KIND, D_LAST, D_NSLIP, D_SLIP, D_VMAX,
-                        EV_NT, KIND_CREEP, PAUSED, SLIDING, V)
+                        E_END_HI, E_END_LO, E_EPICENTER, E_FIRST, E_LAST, E_LOAD_WORK, E_NBLOCKS, E_RUNNING,
+                        E_RUPTURED, E_SERIAL, E_SLIP, E_START_HI, E_START_LO, E_STATE, E_STOPPED, E_VMAX, E_WORK,
+                        F0, P, D_BLOCK_STEPS, D_DURATION, D_ELASTIC, D_ENDING, D_ENERGY_SCALE, D_FIRST, D_KIND,
+                        D_LAST, D_LOAD_WORK, D_NSLIP, D_RESIDUAL, D_SLIP, D_VMAX, D_WORK, EV_NT, KIND_CREEP,
+                        PAUSED, SLIDING, V)
 
 # what continue_creep returns besides PAUSED
 REACHED = 10      # creep is integrated up to the onset of the schedule's next block (or nothing creeps)
@@ -431,7 +432,11 @@ def _error(arrays, n, p):
 @nb.njit(cache=True)
 def _commit(arrays, n, p, t_new):
     """The step's end becomes the state: creeping blocks' force, psi, velocity and time; their resting
-    neighbours brought to t_new with the creeping blocks' slip in their force; episode statistics."""
+    neighbours brought to t_new with the creeping blocks' slip in their force; episode statistics and
+    energy. A block's slip is linear in time over its own step (since[i] to t_new), so is its force, and
+    the friction work is the trapezoid of the force at the step's two ends: exactly the loader's work
+    less the elastic change along that path (docs/numerics.md, "Energy of creep"); the loader's work
+    counts from the episode's start, the slip at the step's middle (workspace.E_LOAD_WORK)."""
     C, E, W, since = arrays.creep, arrays.episodes, arrays.W, arrays.since
     lst = arrays.crept
     m = creeping_list(arrays, n)
@@ -452,6 +457,7 @@ def _commit(arrays, n, p, t_new):
                         W[j, F0] += l2 * C[q, CR_DU]
     for k in range(m):
         i = lst[k]
+        force = W[i, F0]        # at the step's start
         W[i, F0] = C[i, CR_RES]
         W[i, P] = C[i, CR_PSI]
         since[i, 0] = t_new[0]
@@ -460,6 +466,9 @@ def _commit(arrays, n, p, t_new):
         C[i, CR_V] = v
         slot = int(C[i, CR_EP]) - 1
         du = C[i, CR_DU]
+        E[slot, E_WORK] += 0.5 * (force + C[i, CR_RES]) * du
+        E[slot, E_LOAD_WORK] += p.nu * du * ((t_new[0] - E[slot, E_START_HI]) + (t_new[1] - E[slot, E_START_LO])
+                                             - 0.5 * C[i, CR_H])
         E[slot, E_BLOCK_STEPS] += 1.0
         if du > 0.0:
             E[slot, E_SLIP] += du
@@ -746,6 +755,10 @@ def report(arrays, n, out_t, out_epicenter, out_diag, k):
             out_diag[k, D_NSLIP] = E[slot, E_NBLOCKS]
             out_diag[k, D_VMAX] = E[slot, E_VMAX]
             out_diag[k, D_BLOCK_STEPS] = E[slot, E_BLOCK_STEPS]
+            out_diag[k, D_WORK] = E[slot, E_WORK]
+            out_diag[k, D_LOAD_WORK] = E[slot, E_LOAD_WORK]
+            # not an episode's own: the balance closes over a run (workspace.py)
+            out_diag[k, D_ELASTIC] = out_diag[k, D_RESIDUAL] = out_diag[k, D_ENERGY_SCALE] = np.nan
             out_diag[k, D_KIND] = KIND_CREEP
             out_diag[k, D_ENDING] = 1.0 if state == E_STOPPED else 2.0
             return 1

@@ -31,6 +31,12 @@ energy change from the slip with the driver held where it was at the onset, and
 D_LOAD_WORK = nu tau sum(y) - nu int_0^tau sum(y) dt = nu int_0^tau t sum(v) dt the work of the
 driver's advance since the onset on the sliding blocks; the rest of the two energy changes
 (the driver alone pulling every block) cancels. residual = D_ELASTIC + D_WORK - D_LOAD_WORK.
+
+A creep episode's row (kind 1) carries D_WORK, its blocks' friction work, and D_LOAD_WORK, the driver's
+work on their slips since the episode's start, both accumulated step by step (E_WORK, E_LOAD_WORK,
+creep._commit). Its elastic change is not its own (events and other episodes change its blocks' forces
+while it runs), so D_ELASTIC, D_RESIDUAL and D_ENERGY_SCALE are NaN there: the balance closes over a
+stretch of the run instead (ensemble/energy.py).
 """
 from collections import namedtuple
 
@@ -162,7 +168,9 @@ E_ACTIVE = 9                       # blocks creeping in it now
 E_SERIAL = 10                      # its serial number (creep.join counts a block once per episode)
 E_END_HI, E_END_LO = 11, 12        # two-float time at which it ended
 E_BLOCK_STEPS = 13                 # creep steps of its blocks
-NEPISODE = 14
+E_WORK = 14        # friction work of its blocks' steps, c-free frame (creep._commit: trapezoidal in each step)
+E_LOAD_WORK = 15   # the driver's work on its blocks' slips since its start: nu sum(du (t_mid - start)) (D_LOAD_WORK)
+NEPISODE = 16
 E_RUNNING, E_STOPPED, E_RUPTURED = 1.0, 2.0, 3.0
 # The creep phase's own scalars `cstate`
 CS_NCREEP = 0   # blocks creeping
@@ -284,15 +292,23 @@ class Workspace:
         self.cstate[CS_DIRTY] = 1.0
 
     @staticmethod
-    def creep_size(n):
-        """Length of `creep_state` for n blocks."""
-        return n * CR_KEEP + 2 * n * NEPISODE + NCSTATE
+    def creep_size(n, episode_columns=NEPISODE):
+        """Length of `creep_state` for n blocks (of an episode table of `episode_columns`: an older
+        catalog's checkpoints kept fewer, catalog.py)."""
+        return n * CR_KEEP + 2 * n * episode_columns + NCSTATE
 
     def creep_state(self):
         """The creep phase's state as one flat array (a copy), for a checkpoint: with the
         between-events state it continues the run exactly (`load`). An event in progress leaves it
         unchanged until the event's end (creep.after_event)."""
         return np.concatenate([self.creep[:, :CR_KEEP].ravel(), self.episodes.ravel(), self.cstate])
+
+    def episodes_in_flight(self):
+        """(start time, slip, friction work, loader's work) of each creep episode begun and not yet
+        reported (running, or ended and waiting for its row): what it has done so far (energy.py)."""
+        E = self.episodes[self.episodes[:, E_STATE] != 0.0]
+        return (E[:, E_START_HI] + E[:, E_START_LO], E[:, E_SLIP].copy(), E[:, E_WORK].copy(),
+                E[:, E_LOAD_WORK].copy())
 
     @property
     def paused(self):
