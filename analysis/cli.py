@@ -186,14 +186,15 @@ def _scales(args, inputs):
     if not missing:
         return {name: getattr(args, name) for name in SCALE_OPTIONS}
     from ensemble.model import laws
-    names = sorted({law.decode() if isinstance(law, bytes) else str(law) for law in inputs.tasks["law"]})
-    if len(names) > 1:
+    names = sorted({merge.law_name(law) for law in inputs.tasks["law"]})
+    for name in names:
+        if name not in laws.LAWS:
+            raise ValueError(f"friction law {name!r} is unknown to this version: give "
+                             + ", ".join("--" + key.replace("_", "-") for key in missing))
+    if len({laws.get(name).scales for name in names}) > 1:
         raise ValueError(f"the catalogs hold points of several friction laws ({', '.join(names)}), whose "
                          "magnitudes lie on different scales: give " + ", ".join(
                              "--" + name.replace("_", "-") for name in missing))
-    if names[0] not in laws.LAWS:
-        raise ValueError(f"friction law {names[0]!r} is unknown to this version: give "
-                         + ", ".join("--" + name.replace("_", "-") for name in missing))
     law = laws.get(names[0]).scales
     return {name: getattr(args, name) if getattr(args, name) is not None else getattr(law, name)
             for name in SCALE_OPTIONS}
@@ -268,7 +269,8 @@ def _reduce_on(comm, args):
     for i, p in enumerate(points):
         why = unreliable(p["units"], p["method"])
         if why:
-            print(f"warning: point {i} ({', '.join(f'{k} = {v:g}' for k, v in p['params'].items())}): {why}",
+            print(f"warning: point {i} ({p['params']['law']}: "
+                  f"{', '.join(f'{k} = {v:g}' for k, v in p['params'].items() if k != 'law' and v == v)}): {why}",
                   file=sys.stderr)
     methods = sorted({p["method"] for p in points})
     print(f"wrote {out}: {len(points)} parameter points, {len(per_task)} tasks"

@@ -62,7 +62,8 @@ class Options:
 def power_law_tau(counts, n_min, n_max):
     """Maximum-likelihood exponent of P(n) ~ n^-tau on the integers n_min <= n < n_max, from the
     counts per n (counts[n]); the root of mean(ln n) under the law = the sample's (bisection:
-    the model mean falls monotonically with tau). NaN without two distinct values."""
+    the model mean falls monotonically with tau). NaN without two distinct values, and where the root
+    lies at an end of TAU_RANGE (no maximum inside it: sizes flat or rising over n_min..n_max)."""
     n = np.arange(n_min, n_max, dtype=float)
     c = np.asarray(counts[n_min:n_max], dtype=float)
     if c.sum() <= 0 or np.count_nonzero(c) < 2:
@@ -76,7 +77,8 @@ def power_law_tau(counts, n_min, n_max):
             lo = tau
         else:
             hi = tau
-    return 0.5 * (lo + hi)
+    tau = 0.5 * (lo + hi)
+    return tau if TAU_RANGE[0] + 1e-9 < tau < TAU_RANGE[1] - 1e-9 else math.nan
 
 
 def power_law_ks(counts, n_min, tau):
@@ -216,7 +218,7 @@ def compare_point(paths, tasks, params, rows, opt):
 
 
 def label(law, params):
-    keys = [k for k in PARAMS[3:] if params[k] == params[k]]
+    keys = [k for k in PARAMS[3:] if params[k] == params[k]]   # (the law's keys: others are NaN)
     return f"{law}: " + ", ".join(f"{k} = {params[k]:g}" for k in keys)
 
 
@@ -240,8 +242,7 @@ def compare(paths, opt):
         _check_memory(opt, len(rows), int(params["N"]))
     out = []
     for params, rows in inputs.points:
-        law = inputs.tasks["law"][rows[0]]
-        law = law.decode() if isinstance(law, bytes) else str(law)
+        law = params["law"]
         n_blocks = int(params["N"])
         if opt.n_large > n_blocks:
             raise ValueError(f"--n-large {opt.n_large} exceeds the chain of {n_blocks} blocks")
@@ -276,8 +277,9 @@ def table(points, opt, command):
             cells.append(_cell(x[j], lo[j], hi[j]))
         lines.append("| " + " | ".join(cells) + " |")
     if any(not np.all(np.isfinite(p["numbers"][[2, 3, 4, 6, 7]])) for p in points):
-        lines += ["", f"inf: no event between n = 2 and the peak at n >= {opt.n_large}; n/a: tau and KS need events "
-                      f"of two sizes or more below n = {opt.n_large}, CV and sharpness two recurrences or more."]
+        lines += ["", f"inf: R(log10 n) is empty in a bin between n = 2 and its peak at n >= {opt.n_large}; n/a: no "
+                      f"power law fits the sizes below n = {opt.n_large} (fewer than two, or not falling), or fewer "
+                      "than two recurrences."]
     return "\n".join(lines) + "\n"
 
 

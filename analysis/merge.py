@@ -41,7 +41,8 @@ class Inputs:
       catalog_point           the task's point in its catalog
       point                   the task's point in the summary (index into `points`)
       seed_entropy, spawn_key its stream (filled in for tasks that have not finished)
-    points: [(parameters {name: value}, [rows of `tasks` in stream order])], first appearance order
+    points: [(parameters {name: value, "law": its law}, [rows of `tasks` in stream order])], first
+                            appearance order
     partial: "" for finished runs, else the one-line statement of what is missing
     """
     paths: list
@@ -120,14 +121,16 @@ def _concatenate(tables):
 
 
 def _points(paths, tasks):
-    """Pool the rows of `tasks` by exact parameters; set tasks["point"]; refuse repeated streams."""
+    """Pool the rows of `tasks` by friction law and exact parameters; set tasks["point"]; refuse repeated
+    streams. Two laws may share keys (aging and slip: a, b, c), so the law is part of a point."""
     where = {}
     for g in range(len(tasks["point"])):
         # by bit pattern: keys of another law are NaN, which equals nothing, itself included
-        bits = tuple(np.float64(tasks[name][g]).view(np.uint64).item() for name in PARAMS)
-        where.setdefault(bits, (tuple(tasks[name][g].item() for name in PARAMS), []))[1].append(g)
+        law = law_name(tasks["law"][g])
+        bits = (law, *(np.float64(tasks[name][g]).view(np.uint64).item() for name in PARAMS))
+        where.setdefault(bits, (tuple(tasks[name][g].item() for name in PARAMS), law, []))[2].append(g)
     points = []
-    for i, (key, rows) in enumerate(where.values()):
+    for i, (key, law, rows) in enumerate(where.values()):
         rows.sort(key=lambda g: (int(tasks["seed_entropy"][g]), int(tasks["spawn_key"][g])))
         for a, b in zip(rows, rows[1:]):
             stream = (int(tasks["seed_entropy"][a]), int(tasks["spawn_key"][a]))
@@ -139,8 +142,13 @@ def _points(paths, tasks):
                     f"spawn_key {stream[1]}, " + ", ".join(f"{n} = {v:g}" for n, v in zip(PARAMS, key) if v == v)
                     + "): give each trajectory once")
         tasks["point"][rows] = i
-        points.append((dict(zip(PARAMS, key)), rows))
+        points.append(({**dict(zip(PARAMS, key)), "law": law}, rows))
     return points
+
+
+def law_name(law):
+    """A task's friction law as text (the catalogs store it as bytes)."""
+    return law.decode() if isinstance(law, bytes) else str(law)
 
 
 def _partial_statement(paths, tables, per_tasks, unfinished):

@@ -78,11 +78,14 @@ def legend_labels(summaries, names=None):
         for i in range(len(s["points/N"])):
             owner.append(j)
             # None for a key of another friction law (NaN in the summary, which equals nothing)
-            rows.append(tuple(None if v != v else v for v in (s[f"points/{k}"][i].item() for k in PARAMS)))
+            rows.append(tuple(None if v != v else v for v in (s[f"points/{k}"][i].item() for k in PARAMS))
+                        + (str(summary_file.point_laws(s)[i]),))
     keys = [k for n, k in enumerate(PARAMS) if len({r[n] for r in rows}) > 1] or ["b"]
+    laws = len({r[-1] for r in rows}) > 1      # points of several laws: "slip: b = 20"
     for exact in (False, True):
-        labels = [", ".join(f"{k} = {repr(r[PARAMS.index(k)]) if exact else format(r[PARAMS.index(k)], 'g')}"
-                            for k in keys if r[PARAMS.index(k)] is not None) for r in rows]
+        labels = [(f"{r[-1]}: " if laws else "")
+                  + ", ".join(f"{k} = {repr(r[PARAMS.index(k)]) if exact else format(r[PARAMS.index(k)], 'g')}"
+                              for k in keys if r[PARAMS.index(k)] is not None) for r in rows]
         if all(labels[a] != labels[b] or rows[a] == rows[b]
                for a in range(len(rows)) for b in range(a)):
             break

@@ -26,9 +26,12 @@ def varying(s):
 
 
 def point_label(s, i, keys=None):
+    """"b = 20", or "slip: b = 20" where the summary's points are of more than one law."""
     keys = keys or varying(s)
-    return ", ".join(f"{k} = {s[f'points/{k}'][i]:g}" for k in keys
+    text = ", ".join(f"{k} = {s[f'points/{k}'][i]:g}" for k in keys
                      if not np.isnan(s[f'points/{k}'][i]))     # NaN: a key of another law
+    laws = summary.point_laws(s)
+    return f"{laws[i]}: {text}" if len(set(laws)) > 1 else text
 
 
 def unreliable(s, i):

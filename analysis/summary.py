@@ -16,6 +16,7 @@
     /per_task/creep                             (tasks, stretches, 4) counts and sums of the slow side
     /points/{N, l, nu, <law keys>}              parameters of each point (first appearance order;
                                                 the keys of every friction law, NaN if not its law's)
+    /points/law                                 its friction law (two laws may share keys: aging, slip)
     /points/method, /points/units               resampling used ("seeds" or "blocks") and unit count
     /points/{mu, tnu, tnu_interior}_density     (points, bins): estimate; *_lo, *_hi: interval
     /points/{creep_mu, creep_duration}_density  the same for the creep episodes (format 3)
@@ -135,6 +136,7 @@ DATASETS = {
                        "(analysis/stats.py) per task and stretch"),
     **{f"points/{name}": (unit, _POINTS, f"{meaning}, of the point's tasks")
        for name, (unit, _, meaning) in ((n, catalog.DATASETS[f"tasks/{n}"]) for n in PARAMS)},
+    "points/law": ("text", _POINTS, "friction law of the point's tasks (a point is a law and its parameters)"),
     "points/method": ("text", _POINTS, "resampling units of the intervals: 'seeds' (the point's tasks, "
                                        f"when it has at least {MIN_UNITS}) or 'blocks' (the stretches of all its tasks)"),
     "points/units": ("count", _POINTS, "resampling units of the point"),
@@ -201,6 +203,7 @@ def write(path, inputs, per_task, points, opt, force=False):
             h5[f"per_task/{name}"] = np.stack([getattr(per_task[k], name) for k in order])
         for name in PARAMS:
             h5[f"points/{name}"] = np.array([p["params"][name] for p in points])
+        h5["points/law"] = np.array([p["params"]["law"] for p in points], dtype="S")
         h5["points/method"] = np.array([p["method"] for p in points], dtype="S")
         h5["points/units"] = np.array([p["units"] for p in points])
         start = 0
@@ -237,7 +240,20 @@ def read(path):
         out["points/method"] = np.array([m.decode() for m in out["points/method"]])
     for name in PARAMS:   # a summary from before the friction-law registry: aging points, no other keys
         out.setdefault(f"points/{name}", np.full(len(out["points/N"]), np.nan))
+    if "points/law" in out:
+        out["points/law"] = np.array([law.decode() for law in out["points/law"]])
+    out["points/law"] = point_laws(out)
     return out
+
+
+def point_laws(s):
+    """(points,) the friction law of each point of summary `s` (read). A summary from before the law
+    was part of a point holds none: Carlson-Langer where alpha is set, else the aging law (the slip
+    law, which shares the aging law's keys, came with the law in the point)."""
+    if "points/law" in s:
+        return np.asarray(s["points/law"])
+    alpha = s.get("points/alpha", np.full(len(s["points/N"]), np.nan))
+    return np.where(np.isnan(alpha), "aging", "carlson-langer")
 
 
 def has_creep(s):

@@ -289,6 +289,14 @@ MUTATIONS = (
              "    try:\n        import pandas\n    except ImportError:", "    import pandas\n    if False:",
              ("tests/test_export.py::test_without_pandas_a_dataframe_is_a_clear_error",),
              "frame=True without pandas fails with a bare import error"),
+    Mutation("points-pool-two-laws", "analysis/merge.py",
+             "        bits = (law, *(np.float64", "        bits = (\"\", *(np.float64",
+             ("tests/test_compare.py::test_two_laws_with_the_same_keys_are_two_points",),
+             "a slip-law run and an aging run of equal a, b, c pool into one point"),
+    Mutation("branch-lowers-creeping-blocks", "ensemble/branching.py",
+             "    force = np.where(creeping(spun), spun.force, lowered)", "    force = lowered",
+             ("tests/test_branch.py::test_a_branch_lowers_the_blocks_at_rest_and_keeps_the_creeping_ones_in_balance",),
+             "a branch starts creeping blocks out of force balance"),
 )
 
 

@@ -427,16 +427,17 @@ def expected_tasks(catalogs):
     table = {name: np.concatenate(parts) for name, parts in table.items()}
     keys, values = [], []
     for g in range(len(table["point"])):
-        key = tuple(bits(table[name][g]) for name in PARAMS)     # NaN == NaN by bits
+        law = table["law"][g].decode() if isinstance(table["law"][g], bytes) else str(table["law"][g])
+        key = (law, *(bits(table[name][g]) for name in PARAMS))     # NaN == NaN by bits; laws may share keys
         if key not in keys:
             keys.append(key)
-            values.append(tuple(table[name][g].item() for name in PARAMS))
+            values.append((law, *(table[name][g].item() for name in PARAMS)))
         table["point"][g] = keys.index(key)
     points = []
-    for i, key in enumerate(values):
+    for i, (law, *key) in enumerate(values):
         rows = [g for g in range(len(table["point"])) if table["point"][g] == i]
         rows.sort(key=lambda g: (table["seed_entropy"][g], table["spawn_key"][g]))
-        points.append((dict(zip(PARAMS, key)), rows))
+        points.append(({**dict(zip(PARAMS, key)), "law": law}, rows))
     return table, points
 
 
@@ -480,6 +481,7 @@ def expected_summary(catalogs, opt):
         results.append(r)
     for name in PARAMS:
         exp[f"points/{name}"] = np.array([r["params"][name] for r in results])
+    exp["points/law"] = np.array([r["params"]["law"] for r in results])
     exp["points/method"] = np.array([r["method"] for r in results])
     exp["points/units"] = np.array([r["units"] for r in results])
     for name in CURVES:
@@ -530,6 +532,7 @@ def check_summary(s, expected, opt):
     numbers = {f"points/numbers/{n}" for n in NUMBERS + CREEP_NUMBERS}
     curves = {f"points/{c}_{x}" for c in CURVES for x in ("density", "lo", "hi")}
     known = ({"bins/mu", "bins/tnu", "bins/creep_mu", "bins/creep_duration", "points/method", "points/units",
+              "points/law",
               "points/peaks", "attrs"}
              | {f"per_task/{k}" for k in ("mu", "tnu", "tnu_interior", "numbers",
                                           "creep_mu", "creep_duration", "creep")}
@@ -562,6 +565,7 @@ def check_summary(s, expected, opt):
                 "points/units", *(f"points/{p}" for p in PARAMS)):
         np.testing.assert_array_equal(s[key], expected[key], err_msg=key)
     assert [m.decode() for m in s["points/method"]] == list(expected["points/method"])
+    assert [law.decode() for law in s["points/law"]] == list(expected["points/law"])
     got, want = s["per_task/numbers"], expected["per_task/numbers"]
     counts = [PER_TASK_COLUMNS.index(c) for c in ("n_events", "n_large", "n_rec", "n_rec_int", "n_gr")]
     np.testing.assert_array_equal(got[..., counts], want[..., counts], err_msg="per_task/numbers counts")

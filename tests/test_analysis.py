@@ -302,10 +302,14 @@ def test_legend_labels_name_what_differs_between_the_plotted_points():
     # nothing differs: b names the points; six digits that cannot tell two points apart: all digits
     assert legend_labels([fake_summary(b=[20.0])]) == (["b"], ["b = 20"])
     assert legend_labels([fake_summary(b=[20.0000001, 20.0000002])])[1] == ["b = 20.0000001", "b = 20.0000002"]
-    # two friction laws: each point is named by its own law's keys (the other law's are NaN)
+    # two friction laws: each point is named by its law and its own law's keys (the other law's are NaN)
     cl = fake_summary(a=[np.nan], b=[np.nan], c=[np.nan], alpha=[2.0], sigma=[0.01])
     assert legend_labels([fake_summary(b=[20.0]), cl]) == (
-        ["a", "b", "c", "alpha", "sigma"], ["a = 0, b = 20, c = 1000", "alpha = 2, sigma = 0.01"])
+        ["a", "b", "c", "alpha", "sigma"], ["aging: a = 0, b = 20, c = 1000", "carlson-langer: alpha = 2, sigma = 0.01"])
+    # two laws with the same keys (aging and slip): only the law tells the points apart
+    slip = fake_summary(b=[20.0])
+    slip["points/law"] = np.array(["slip"])
+    assert legend_labels([fake_summary(b=[20.0]), slip])[1] == ["aging: b = 20", "slip: b = 20"]
 
 
 def test_plot_overlays_several_summaries(merged):
