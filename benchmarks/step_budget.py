@@ -28,6 +28,7 @@ from ensemble.config import Model
 from ensemble.events import check, run_event
 from ensemble.integrators import kernel_params
 from ensemble.model.methods import take_step
+from ensemble.model.steppers import FIRST_NEW
 from ensemble.model.workspace import F0, NCOLS, P, P0, V, V0, Y, Y0, YS
 
 from .common import parse_setting, single_event_parser, write_outputs
@@ -43,7 +44,7 @@ SLIDING = 4     # blocks sliding in the step-alone timing
 def _repeat_step(W, act, na, h, p, reps):
     total = 0.0
     for _ in range(reps):
-        total += take_step(W, act, na, W.shape[0], 0.0, h, p, 0.0)[2]
+        total += take_step(W, act, na, W.shape[0], 0.0, h, p, 0.0, FIRST_NEW, (0.0, 0.0))[2]
     return total
 
 

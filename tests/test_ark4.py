@@ -9,6 +9,7 @@ from ensemble.config import Integrator, Model
 from ensemble.events import check, run_event
 from ensemble.integrators import kernel_params
 from ensemble.model.methods import take_step
+from ensemble.model.steppers import FIRST_NEW
 from ensemble.model.tableaux import ARK324, ARK436, ARK548
 from ensemble.model.workspace import (NTRACE, P, P0, T_BLOCK, T_ERROR, T_H, T_OWN, T_PART, T_SLIDING, T_TAU, V,
                                       V0, Y, Y0, YS, Workspace)
@@ -172,8 +173,9 @@ def test_kernel_arrays_are_the_tableau():
 
 @nb.njit
 def step(W, act, na, n, tau, h, p, yrest):
-    """One step of the method p.method (the kernels' call, methods.take_step)."""
-    return take_step(W, act, na, n, tau, h, p, yrest)
+    """One step of the method p.method (the kernels' call, methods.take_step, every stage evaluated):
+    (friction work, slip integral, error norm)."""
+    return take_step(W, act, na, n, tau, h, p, yrest, FIRST_NEW, (0.0, 0.0))[:3]
 
 
 @pytest.mark.parametrize("method", ["ark3", "ark4", "ark5"])

@@ -41,6 +41,7 @@ from .geometry import left, right
 from .laws import loader_moves, onset_delay, rest_state, rk4_unstable, stiff_limit
 from .methods import adaptive, take_step
 from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
+from .steppers import FIRST_KEPT, FIRST_LAST, FIRST_NEW
 from .transitions import (NO_CUT, ONSET_LOADING, ONSET_NEIGHBOUR, STICK, above_threshold, event_nu, force_now,
                           loading_cut, locate, pressed, rest_psi, velocity_slopes)
 from .undo import clear_log, log_block
@@ -231,6 +232,10 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
     psi_limit = stiff_limit(p.law, v_limit)
     creep_on = possible(p, n)
     used = 0
+    # the last step's end state is this step's start, unchanged (steppers.FIRST_LAST): not after a
+    # block started or stopped or the step was cut, and not at a call's first step (exact either way)
+    unchanged = False
+    at_last = (0.0, 0.0)
     while na > 0:
         if used >= budget:
             _keep(event, na, nt, yrest, t_far, far, tau, work, slip_time, steps, block_steps, rejected,
@@ -247,8 +252,11 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
             W[i, P0] = W[i, P]
         h = h_next
         tries = 0
+        first = FIRST_LAST if unchanged else FIRST_NEW
+        at_first = at_last
         while True:
-            dwork, dslip, err = take_step(W, act, na, n, tau, h, p, yrest)
+            dwork, dslip, err, at_first, at_last = take_step(W, act, na, n, tau, h, p, yrest, first, at_first)
+            first = FIRST_KEPT
             tries += 1
             if traced < trace.shape[0]:
                 record(trace, traced, p, W, act, na, tau, h, err)
@@ -287,7 +295,7 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
         if kind != NO_CUT and x_cut < 1.0:
             h = x_cut * h
             cuts += 1
-            dwork, dslip, _ = take_step(W, act, na, n, tau, h, p, yrest)
+            dwork, dslip, _, at_first, at_last = take_step(W, act, na, n, tau, h, p, yrest, FIRST_KEPT, at_first)
             used += na
         tau += h
         steps += 1
@@ -345,7 +353,8 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
                 nstuck, yrest = _stop(W, flag, stuck, nstuck, i, tau, yrest)
             na = 0
         # -- rescheduling, once the set of watched blocks has changed
-        if kind != NO_CUT or nstuck > 0 or na != m:
+        unchanged = kind == NO_CUT and nstuck == 0 and na == m
+        if not unchanged:
             t_far, far = _reschedule(W, flag, stuck, since, tree, nstuck, n, t0, tau, p)
     if profile.shape[0] == n:
         profile[:] = 0.0

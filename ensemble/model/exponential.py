@@ -24,8 +24,8 @@ import numba as nb
 import numpy as np
 
 from .laws import has_state, linear_state
-from .steppers import _error_norms, stage_columns
-from .workspace import (ARK_A, ARK_G, ARK_V, K1V, P, P0, PS, V, V0, VS, X_EH, X_P1, X_P1H, X_P2, X_P2H, X_P3,
+from .steppers import FIRST_KEPT, FIRST_LAST, FIRST_NEW, _error_norms, stage_rates
+from .workspace import (ARK_A, ARK_G, ARK_V, K1V, KV, KY, P, P0, PS, V, V0, VS, X_EH, X_P1, X_P1H, X_P2, X_P2H, X_P3,
                         X_RATE0, X_THETA, X_THETA0, Y, Y0, YS)
 
 
@@ -72,27 +72,32 @@ def phis(x, em1):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def exp_step(W, act, na, n, tau, h, p, yrest):
+def exp_step(W, act, na, n, tau, h, p, yrest, first, at_first):
     """One exp4 step of the active blocks from (Y0, V0, P0) by h (steppers.py's contract).
 
     Stage s: slip and velocity from the classical rows; theta from Krogstad's rows in the stage
     remainders g (ARK_G), psi = ln theta. Stage 5 is the new state. Returns (friction work, time
-    integral of the total slip, error norm); the error of psi is that of theta relative to theta.
-    On return ARK_G + 3 and + 4 hold the remainders scaled so that steppers.block_error, with the
-    weights (0, 0, 0, 1/6, -1/6), gives the psi error of the step.
+    integral of the total slip, error norm, at_first, at_last: methods.take_step); the error of psi
+    is that of theta relative to theta. On return ARK_G + 3 and + 4 hold the remainders scaled so
+    that steppers.block_error, with the weights (0, 0, 0, 1/6, -1/6), gives the psi error of the
+    step.
+
+    Stage 5's rates are the next step's first stage's (first = FIRST_LAST: copied from its columns,
+    the same numbers), and a retry keeps the first stage it had (FIRST_KEPT: its rates, theta0,
+    r(v0) and g0 do not depend on h).
     """
     state = has_state(p.law)
     if state:
         for k in range(na):
             i = act[k]
-            theta0 = math.exp(W[i, P0])
-            r0 = _linear_state(p.law, W[i, V0])[1]
+            if first != FIRST_KEPT:
+                W[i, X_THETA0] = math.exp(W[i, P0])
+                W[i, X_RATE0] = _linear_state(p.law, W[i, V0])[1]
+            r0 = W[i, X_RATE0]
             x = -0.5 * h * r0
             em1h = math.expm1(x)
             p1h, p2h, _ = phis(x, em1h)
             p1, p2, p3 = phis(2.0 * x, em1h * (2.0 + em1h))
-            W[i, X_THETA0] = theta0
-            W[i, X_RATE0] = r0
             W[i, X_EH] = 1.0 + em1h
             W[i, X_P1H] = p1h
             W[i, X_P2H] = p2h
@@ -101,28 +106,48 @@ def exp_step(W, act, na, n, tau, h, p, yrest):
             W[i, X_P3] = p3
     pw = 0.0
     ys = 0.0
+    at_last = at_first
     for s in range(5):
-        for k in range(na):
-            i = act[k]
-            y = W[i, Y0]
-            v = W[i, V0]
-            for j in range(s):
-                y += h * _A[s][j] * W[i, ARK_V + j]
-                v += h * _A[s][j] * W[i, ARK_A + j]
-            W[i, YS] = y
-            W[i, VS] = v
-            if state:
-                if s == 0:
-                    theta = W[i, X_THETA0]
-                    W[i, PS] = W[i, P0]
-                else:
-                    theta = _stage_theta(W, i, s, h)
-                    W[i, PS] = math.log(theta)
-                W[i, X_THETA] = theta
-                # the stage's remainder: a function of its v and theta alone, not of its rates
-                sr = linear_state(p.law, v)
-                W[i, ARK_G + s] = sr[0] - (sr[1] - W[i, X_RATE0]) * theta
-        pw, ys = stage_columns(W, act, na, n, tau + _C[s] * h, p, yrest, s, _B[s], False, False, pw, ys)
+        if s > 0 or first != FIRST_KEPT:
+            for k in range(na):
+                i = act[k]
+                y = W[i, Y0]
+                v = W[i, V0]
+                for j in range(s):
+                    y += h * _A[s][j] * W[i, ARK_V + j]
+                    v += h * _A[s][j] * W[i, ARK_A + j]
+                W[i, YS] = y
+                W[i, VS] = v
+                if state:
+                    if s == 0:
+                        theta = W[i, X_THETA0]
+                        W[i, PS] = W[i, P0]
+                    else:
+                        theta = _stage_theta(W, i, s, h)
+                        W[i, PS] = math.log(theta)
+                    W[i, X_THETA] = theta
+                    # the stage's remainder: a function of its v and theta alone, not of its rates
+                    sr = linear_state(p.law, v)
+                    W[i, ARK_G + s] = sr[0] - (sr[1] - W[i, X_RATE0]) * theta
+        if s > 0 or first == FIRST_NEW:
+            at_stage = stage_rates(W, act, na, n, tau + _C[s] * h, p, yrest, False)
+            for k in range(na):
+                i = act[k]
+                W[i, ARK_V + s] = W[i, KY]
+                W[i, ARK_A + s] = W[i, KV]
+        else:
+            if first == FIRST_LAST:
+                for k in range(na):
+                    i = act[k]
+                    W[i, ARK_V] = W[i, ARK_V + 4]
+                    W[i, ARK_A] = W[i, ARK_A + 4]
+            at_stage = at_first
+        # (as steppers.stage_columns sums them)
+        pw = pw + _B[s] * at_stage[0]
+        ys = ys + _B[s] * at_stage[1]
+        if s == 0:
+            at_first = at_stage
+        at_last = at_stage
     err = 0.0
     for k in range(na):
         i = act[k]
@@ -145,7 +170,7 @@ def exp_step(W, act, na, n, tau, h, p, yrest):
         # (max would drop a NaN): a stage's theta <= 0 (far too long a step in a fast change of v)
         # or a blow-up is an infinite error, and the step is retried shorter
         err = max(err, e1, e2, e3) if math.isfinite(e) else math.inf
-    return pw * h, ys * h, err
+    return pw * h, ys * h, err, at_first, at_last
 
 
 @nb.njit(cache=True)

@@ -107,9 +107,19 @@ def _method_of(params_type):
 def _ark_stepper(pair):
     c, ae, ai, bw, bd, gamma = pair.kernel_arrays()
 
-    def step(W, act, na, n, tau, h, p, yrest):
-        return ark_step(W, act, na, n, tau, h, p, yrest, c, ae, ai, bw, bd, gamma)
+    def step(W, act, na, n, tau, h, p, yrest, first, at_first):
+        work, slip_time, err = ark_step(W, act, na, n, tau, h, p, yrest, c, ae, ai, bw, bd, gamma)
+        return work, slip_time, err, _NO_SUMS, _NO_SUMS
     return nb.njit(error_model="numpy")(step)
+
+
+_NO_SUMS = (0.0, 0.0)   # a stepper that evaluates every stage passes on no sums (take_step)
+
+
+@nb.njit(error_model="numpy")
+def _rk4_stepper(W, act, na, n, tau, h, p, yrest, first, at_first):
+    work, slip_time, err = rk4_step(W, act, na, n, tau, h, p, yrest)
+    return work, slip_time, err, _NO_SUMS, _NO_SUMS
 
 
 # the stepper of each kind of tableau, and its error weights (b - bhat) for steppers.block_error
@@ -124,16 +134,18 @@ def _stepper(method):
     """The numba function that takes one step of `method` (compiled once a process; not inlined:
     one copy however often the kernel steps, with steppers.py's error model)."""
     if not method.adaptive:
-        return rk4_step
+        return _rk4_stepper
     return _STEPPERS[type(method.tableau)][0](method.tableau)
 
 
 # The kernels' calls; each stub is replaced by numba with the method's own code.
 
-def take_step(W, act, na, n, tau, h, p, yrest):
+def take_step(W, act, na, n, tau, h, p, yrest, first, at_first):
     """One step of the method p.method of the active blocks from (Y0, V0, P0) by h (steppers.py);
-    returns (friction work, time integral of the total slip, error norm relative to the
-    tolerances, 0 for RK4)."""
+    `first` (steppers.FIRST_*) says where its first stage is, at_first = (friction power, total
+    slip) there when it is not FIRST_NEW. Returns (friction work, time integral of the total slip,
+    error norm relative to the tolerances, 0 for RK4; at_first, at_last): the power and slip sums
+    at the step's first and last evaluation, which a method that reuses neither leaves (0, 0)."""
 
 
 def error_weights(method):
@@ -145,9 +157,10 @@ def adaptive(method):
 
 
 @overload(take_step, inline="always")
-def _take_step(W, act, na, n, tau, h, p, yrest):
+def _take_step(W, act, na, n, tau, h, p, yrest, first, at_first):
     step = _stepper(_method_of(p))
-    return lambda W, act, na, n, tau, h, p, yrest: step(W, act, na, n, tau, h, p, yrest)
+    return lambda W, act, na, n, tau, h, p, yrest, first, at_first: step(W, act, na, n, tau, h, p, yrest,
+                                                                         first, at_first)
 
 
 @overload(error_weights, inline="always")

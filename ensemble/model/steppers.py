@@ -6,6 +6,12 @@ leaves the derivative at the step start in K1V (for the Hermite interpolant), an
 returns (friction work, time integral of the total slip, error estimate relative
 to the tolerances; 0 for fixed steps).
 
+The event loop calls them through methods.take_step, which also says where the step's first stage
+is (`first`, one of FIRST_* below) and returns the sums of the friction power and of the total slip
+at the step's first and last evaluation: a stepper whose last evaluation is at the new state
+(exponential.exp_step) reuses it as the next step's first (FSAL), and a retry from the same start
+reuses its first stage. The steppers here evaluate every stage (methods.py adapts their calls).
+
 - rk4_step: classical RK4, the paper's method; stable only while h / theta < 2.785.
 - ark_step: a step of an additive (IMEX) Runge-Kutta pair of tableaux.py, such as ARK3(2)4L[2]SA,
   ARK4(3)6L[2]SA and ARK5(4)8L[2]SA of Kennedy & Carpenter (2003): explicit for slip and velocity,
@@ -20,6 +26,14 @@ from .geometry import left, right, spring_force
 from .laws import friction, has_state, implicit_state, loader_moves, state_rate
 from .workspace import (ARK_A, ARK_G, ARK_V, F0, K1V, KP, KV, KY, P, P0, PS, SP, SV, SY, V, V0,
                         VS, Y, Y0, YS)
+
+# where the first stage of a step is (methods.take_step's argument `first`); each reuse is exact, so
+# a stepper may always evaluate instead
+FIRST_NEW = 0     # evaluate it
+FIRST_LAST = 1    # the previous step's last evaluation, at the state it accepted, unchanged since
+                  # (no block started or stopped, no cut): this step's start
+FIRST_KEPT = 2    # the previous call's first stage: a retry (rejected, or cut at a transition) from
+                  # the same start
 
 
 @nb.njit(cache=True, error_model="numpy")
