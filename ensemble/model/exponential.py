@@ -11,8 +11,10 @@ Acta Numerica 19, 209, 2010, sec. 2.3), whose coefficients are the functions phi
 At z = 0 they are classical RK4's, which is what slip and velocity (linear part 0) see. A fifth
 evaluation at the new state gives an embedded solution of order 3 (bhat = (1/6, 1/3, 1/3, 0, 1/6)
 at z = 0; in the state b4(z) moves from stage 4 to stage 5), so the step is controlled like the ARK
-methods'. Every stage is explicit: one log per block (psi = ln theta for the friction), one
-expm1 per block and step. Derivation and order conditions: docs/state_integrator.md.
+methods'. The fifth evaluation is also the next step's first when no block started or stopped
+(FSAL: 4 right-hand sides per step, exactly the numbers a fresh evaluation gives). Every stage is
+explicit: one log per block (psi = ln theta for the friction), one expm1 per block and step.
+Derivation and order conditions: docs/state_integrator.md.
 
 A law without a state takes the classical part alone (adaptive RK4 with the embedded pair); a law
 with a state not of this form is refused (methods.Method.refusal).
@@ -71,7 +73,14 @@ def phis(x, em1):
     return p1, p2, p3
 
 
-@nb.njit(cache=True, error_model="numpy")
+# fastmath on this function's own arithmetic (and what is inlined into it; stage_rates and the laws keep
+# theirs): contract (fused multiply-adds in the phi series and the stage sums), arcp (reciprocals for four
+# divisions), afn, nsz; never nnan or ninf: a NaN or inf error norm must reject the step (below). Changes
+# exp4's last bits; measured in docs/benchmarks.md (exp4).
+_FASTMATH = {"contract", "afn", "arcp", "nsz"}
+
+
+@nb.njit(cache=True, error_model="numpy", fastmath=_FASTMATH)
 def exp_step(W, act, na, n, tau, h, p, yrest, first, at_first):
     """One exp4 step of the active blocks from (Y0, V0, P0) by h (steppers.py's contract).
 
