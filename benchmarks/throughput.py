@@ -5,7 +5,7 @@
                                     [--law carlson-langer --alpha 2 --sigma 0.01 | --law slip --a 0] [--per-row]
 
 Runs the transient (not timed, includes compilation), then times `events`
-recorded events and prints events/s, cost per block-step, the magnitude range
+recorded events and prints events/s (wall clock, and per second of the process's cpu time), cost per block-step, the magnitude range
 and the largest relative energy residual. Below the block stiffness the rows are inertial events and
 creep episodes: it prints the rate of each, the event statistics of the inertial events alone, and the
 energy balance of the timed stretch of the run, events and creep together (ensemble/energy.py: a creep
@@ -53,19 +53,17 @@ def main():
     traj = Trajectory(cfg, task_list(cfg)[0])
     traj.advance(args.transient)
     before = (traj.state()[0], traj.clock.sum(), traj.ws.episodes_in_flight())
+    start, cpu = time.perf_counter(), time.process_time()
     if args.per_row:
         rows, seconds = [], np.empty(args.events)
-        start = time.perf_counter()
         for k in range(args.events):
             t0 = time.perf_counter()
             rows.append(traj.advance(1))
             seconds[k] = time.perf_counter() - t0
-        elapsed = time.perf_counter() - start
         t, _, diag = (np.concatenate(column) for column in zip(*rows))
     else:
-        start = time.perf_counter()
         t, _, diag = traj.advance(args.events)
-        elapsed = time.perf_counter() - start
+    elapsed, cpu = time.perf_counter() - start, time.process_time() - cpu
     balance = energy.balance(before, (traj.state()[0], traj.clock.sum(), traj.ws.episodes_in_flight()), t, diag,
                              args.nu, cfg.model.l)
     kind = diag[:, D_KIND]
@@ -77,7 +75,8 @@ def main():
     how = f"dt={args.dt}" if args.method == "rk4" else f"rtol={args.rtol:g}"
     point = " ".join(f"{k}={v:g}" for k, v in keys.items())
     print(f"N={args.N} {args.law} {point} {args.method} {how}: {args.events / elapsed:.1f} events/s "
-          f"({args.events} events in {elapsed:.1f} s after {args.transient} transient)")
+          f"({args.events} events in {elapsed:.1f} s after {args.transient} transient; "
+          f"{args.events / max(cpu, 1e-9):.1f} events per cpu-second)")
     if len(creep):
         print(f"  rows: {len(diag)} inertial events ({len(diag) / elapsed:.1f}/s) and {len(creep)} creep episodes "
               f"({len(creep) / elapsed:.1f}/s; median slip {np.median(creep[:, D_SLIP]):.3g}, median duration "

@@ -4,7 +4,7 @@ import json
 import numpy as np
 import pytest
 
-from benchmarks import cost_scaling, hard_cases, statistics, step_budget, step_trace, work_precision
+from benchmarks import cost_scaling, hard_cases, paired, statistics, step_budget, step_trace, work_precision
 from benchmarks.baselines import BASELINES
 from benchmarks.common import cost_at_error, ks_distance, parse_setting, wasserstein1
 from ensemble.config import Model
@@ -250,6 +250,19 @@ def test_step_trace_tiny(tmp_path):
     assert single and all(r["multirate_bound"] == pytest.approx(1.0) for r in single)
     with pytest.raises(SystemExit, match="rk4:dt=1e-3 has no error control"):
         step_trace.main(["--runs", "rk4:dt=1e-3", "--out", str(tmp_path)])
+
+
+def test_paired_tiny(tmp_path):
+    data = paired.main(["--N", "40", "--rounds", "2", "--transient", "20", "--events", "60", "--cpu", "-1",
+                        "--runs", "rk4:dt=1e-3", "ark4:rtol=1e-4", "--out", str(tmp_path)])
+    assert data["baseline"] == "rk4:dt=1e-3"
+    rk4, ark4 = data["settings"]["rk4:dt=1e-3"], data["settings"]["ark4:rtol=1e-4"]
+    assert rk4["ratios"] == [1.0, 1.0]
+    assert all(r > 0 for r in rk4["rates"] + ark4["rates"])
+    assert ark4["ratios"] == [x / y for x, y in zip(ark4["rates"], rk4["rates"])]
+    assert (tmp_path / "paired_N40_b20.txt").read_text().count("\n") >= 3
+    with pytest.raises(SystemExit, match="atol"):
+        paired.main(["--runs", "ark4:rtol=1e-4,atol=1e-9", "--out", str(tmp_path)])
 
 
 def test_phase_of_a_block():
