@@ -24,7 +24,7 @@ run: setup
 
 test:
 	STACK=$(TEST_STACK) bash scripts/setup.sh
-	ENSEMBLE_TEST_STACK=$(TEST_STACK) $(PY) -m pytest -q -m "not slow"
+	ENSEMBLE_TEST_STACK=$(TEST_STACK) $(PY) -m pytest -q -m "not slow" --durations=30
 
 # a tier of about two minutes that touches every module (the `quick` marker: tests/conftest.py)
 quick: setup
