@@ -19,6 +19,11 @@ def _colors(n):
     return plt.rcParams["axes.prop_cycle"].by_key()["color"] * (n // 10 + 1)
 
 
+def _with_events(p):
+    """A point's legend label with its sample: the events its distributions are made of."""
+    return f"{p['label']} ({int(p['numbers'][0])} events)"
+
+
 def figures(points, opt, out_dir):
     colors = _colors(len(points))
 
@@ -26,7 +31,7 @@ def figures(points, opt, out_dir):
     for p, color in zip(points, colors):
         e = p["size_edges"]
         x = np.sqrt(e[:-1] * (e[1:] - 1.0))          # geometric middle of the integers of the bin
-        _band(ax, x, p["size_density"], p["size_lo"], p["size_hi"], p["label"], color, log=True, style=".-")
+        _band(ax, x, p["size_density"], p["size_lo"], p["size_hi"], _with_events(p), color, log=True, style=".-")
         tau = p["numbers"][3]
         if np.isfinite(tau):
             n = np.arange(opt.n_min, opt.n_large, dtype=float)
@@ -43,7 +48,7 @@ def figures(points, opt, out_dir):
 
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
     for p, color in zip(points, colors):
-        _band(ax, centers(MU_EDGES), p["mu_density"], p["mu_lo"], p["mu_hi"], p["label"], color, log=True)
+        _band(ax, centers(MU_EDGES), p["mu_density"], p["mu_lo"], p["mu_hi"], _with_events(p), color, log=True)
     lowest = min(p["mu_density"][p["mu_density"] > 0].min() for p in points)
     ax.set_ylim(bottom=lowest / 3)      # a lower bound of 0 would stretch the axis to 1e-300
     ax.set(yscale="log", xlabel="mu = log10(total slip) (each law's own scale)", ylabel="R(mu)",
@@ -60,7 +65,7 @@ def figures(points, opt, out_dir):
         if len(T) >= 2:
             h, _ = np.histogram(T / np.median(T), TNU_BINS)
             ax.plot(x, h / len(T) / np.diff(TNU_BINS), color=color, lw=1.4,
-                    label=f"{p['label']} (CV {p['numbers'][6]:.2f})")
+                    label=f"{p['label']} ({len(T)} recurrences, CV {p['numbers'][6]:.2f})")
     ax.plot(x, np.log(2.0) * 2.0 ** -x, "k:", lw=1, label="Poisson (exponential)")
     ax.set(xlabel=f"T / median(T), large events (n >= {opt.n_large}) within {opt.window} blocks",
            ylabel="density", title="local recurrence time")
