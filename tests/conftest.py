@@ -89,6 +89,7 @@ NOT_QUICK = {   # test files with no test in the quick tier, and why
     "test_hard_cases.py": "hard cases at their own sizes (N = 6400, t = 1e15): tens of seconds each",
     "test_kernel_identity.py": "compiles the kernels of a reference commit first (about 15 s, more under load)",
     "test_third_law.py": "compiles a copy of the package with a third law (about a minute)",
+    "test_summary_identity.py": "makes and reduces a catalog of 2400 rows (about 20 s)",
 }
 
 
