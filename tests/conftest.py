@@ -35,6 +35,7 @@ os.environ["PATH"] = os.path.dirname(sys.executable) + os.pathsep + os.environ.g
 # file is here or in NOT_QUICK, with the reason.
 QUICK = {
     "test_creep.py": ["test_a_cluster_too_soft_to_creep_hands_over_to_an_event", "test_above_the_block_stiffness_nothing_creeps"],
+    "test_summary_identity.py": ["test_a_reduction_gives_the_committed_summary"],
     "test_slip_law.py": ["test_two_blocks_at_the_paper_rate_alternate_without_small_events"],
     "test_creep_reference.py": ["test_quasi_static_creep_is_stable_exactly_while_its_matrix_is_positive_definite"],
     "test_attacks.py": ["test_a_flipped_parameter_table_and_record_are_refused"],
@@ -89,7 +90,6 @@ NOT_QUICK = {   # test files with no test in the quick tier, and why
     "test_hard_cases.py": "hard cases at their own sizes (N = 6400, t = 1e15): tens of seconds each",
     "test_kernel_identity.py": "compiles the kernels of a reference commit first (about 15 s, more under load)",
     "test_third_law.py": "compiles a copy of the package with a third law (about a minute)",
-    "test_summary_identity.py": "makes and reduces a catalog of 2400 rows (about 20 s)",
 }
 
 
