@@ -4,7 +4,7 @@ collective steps failing on one rank, and inputs nobody meant. Each attack says 
     python tests/attack.py              # every attack; a table of held / FAILED / skipped; exit 1 if any failed
     python tests/attack.py flip mpi     # those whose name contains one of the words
 
-tests/test_attacks.py runs each attack as a test (the suite and CI); .ci/run also runs this script for
+tests/test_attacks.py runs each attack as a test (the suite, and so CI); run this script for
 the table. The tmpfs attacks need root (mount); elsewhere they are skipped, saying so. Every command
 runs under a deadline (tests/processes.py): a hang is a failure, not a stuck suite.
 """
