@@ -24,10 +24,15 @@ def _with_events(p):
     return f"{p['label']} ({int(p['numbers'][0])} events)"
 
 
+def _legend(ax):
+    """The legend right of the axes, on no curve (six laws' points with their samples are long labels)."""
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+
+
 def figures(points, opt, out_dir):
     colors = _colors(len(points))
 
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    fig, ax = plt.subplots(figsize=(9.6, 4.4))
     for p, color in zip(points, colors):
         e = p["size_edges"]
         x = np.sqrt(e[:-1] * (e[1:] - 1.0))          # geometric middle of the integers of the bin
@@ -41,24 +46,24 @@ def figures(points, opt, out_dir):
     ax.set_ylim(bottom=min(p["size_density"][p["size_density"] > 0].min() for p in points) / 3)
     ax.set(xscale="log", yscale="log", xlabel="blocks slipped in an event, n", ylabel="R(log10 n)",
            title=f"rupture length (dotted: power law fitted below n = {opt.n_large})")
-    ax.legend(fontsize=8)
+    _legend(ax)
     fig.tight_layout()
     fig.savefig(os.path.join(out_dir, "size.png"), dpi=120)
     plt.close(fig)
 
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    fig, ax = plt.subplots(figsize=(9.6, 4.4))
     for p, color in zip(points, colors):
         _band(ax, centers(MU_EDGES), p["mu_density"], p["mu_lo"], p["mu_hi"], _with_events(p), color, log=True)
     lowest = min(p["mu_density"][p["mu_density"] > 0].min() for p in points)
     ax.set_ylim(bottom=lowest / 3)      # a lower bound of 0 would stretch the axis to 1e-300
     ax.set(yscale="log", xlabel="mu = log10(total slip) (each law's own scale)", ylabel="R(mu)",
            title="magnitude distribution")
-    ax.legend(fontsize=8)
+    _legend(ax)
     fig.tight_layout()
     fig.savefig(os.path.join(out_dir, "magnitude.png"), dpi=120)
     plt.close(fig)
 
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    fig, ax = plt.subplots(figsize=(9.6, 4.4))
     x = centers(TNU_BINS)
     for p, color in zip(points, colors):
         T = p["T"]
@@ -69,7 +74,7 @@ def figures(points, opt, out_dir):
     ax.plot(x, np.log(2.0) * 2.0 ** -x, "k:", lw=1, label="Poisson (exponential)")
     ax.set(xlabel=f"T / median(T), large events (n >= {opt.n_large}) within {opt.window} blocks",
            ylabel="density", title="local recurrence time")
-    ax.legend(fontsize=8)
+    _legend(ax)
     fig.tight_layout()
     fig.savefig(os.path.join(out_dir, "recurrence.png"), dpi=120)
     plt.close(fig)
