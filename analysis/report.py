@@ -2,8 +2,7 @@
 import numpy as np
 
 from . import reduce, summary
-from .reduce import CREEP_NUMBERS, NUMBERS, PARAMS
-from .stats import N_EVENTS
+from .reduce import CREEP_NUMBERS, LAYOUT, NUMBERS, PARAMS
 
 LABELS = {
     "n_events": "events", "n_large": "large", "fraction_large": "frac(mu>=mu_c)",
@@ -58,7 +57,7 @@ def count_text(n):
 
 def events_per_task(s):
     """Events each task of the summary contributed (reduced, not discarded), (tasks,)."""
-    return s["per_task/numbers"][:, :, N_EVENTS].sum(axis=1).astype(np.int64)
+    return s["per_task/numbers"][:, :, LAYOUT.column("numbers", "n_events")].sum(axis=1).astype(np.int64)
 
 
 def events_per_point(s):
