@@ -94,6 +94,7 @@ def reduce_task(chunks, written, nu, n_blocks_chain, opt, rows=None, layout=LAYO
     recurrences = any("recurrences" in s.needs for s in layout.statistics)
     scanner = RecurrenceScanner(n_blocks_chain, opt.mu_c, opt.window) if written and recurrences else None
     lo = row = 0
+    t_before = np.nan
     for part in chunks:
         inertial = part["kind"] == catalog.KIND_EVENT
         creep = part["kind"] == catalog.KIND_CREEP
@@ -108,9 +109,11 @@ def reduce_task(chunks, written, nu, n_blocks_chain, opt, rows=None, layout=LAYO
                 src, T, interior = scanner.feed(ev["t"], ev["epicenter"], ev["mu"], ev["boundary"])
                 rec = ((src * k) // written, T * nu, interior)
             lo = hi
-        seen = Rows(part, inertial, ev, block, creep, creep_block, rec, nu, opt)
+        seen = Rows(part, inertial, ev, block, creep, creep_block, rec, t_before, nu, opt)
         for statistic in layout.statistics:
             statistic.feed(out, seen)
+        if ev is not None:
+            t_before = ev["t"][-1]
     return out
 
 

@@ -162,7 +162,8 @@ class Rows:
     part: the chunk's columns (every kind); inertial: bool mask of its inertial events; ev: the inertial
     events' columns; block: the stretch of each inertial event; creep: mask of its creep episodes and
     creep_block their stretches; recurrences: (stretch of the starting event, T nu, interior) of the
-    recurrences closed in this chunk, or None when no statistic asks for them; nu, opt.
+    recurrences closed in this chunk, or None when no statistic asks for them; t_before: the time of the
+    task's last inertial event before this chunk (NaN before its first); nu, opt.
     """
     part: dict
     inertial: np.ndarray
@@ -171,5 +172,6 @@ class Rows:
     creep: np.ndarray
     creep_block: Optional[np.ndarray]
     recurrences: Optional[tuple]
+    t_before: float
     nu: float
     opt: object
