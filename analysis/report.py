@@ -11,6 +11,7 @@ LABELS = {
     "ks_gr": "KS to GR",
     "n_creep": "creep episodes", "creep_share": "creep share (rows)", "taken_over_share": "taken over",
     "aseismic_fraction": "aseismic fraction",
+    **{n.name: n.label for n in LAYOUT.numbers if n.label},   # the statistics' own labels
 }
 
 
@@ -107,7 +108,7 @@ def table(s):
         if unreliable(s, i):
             lines.append(f"    WARNING: {unreliable(s, i)}")
         for name in NUMBERS:
-            if name not in CREEP_NUMBERS:
+            if name not in CREEP_NUMBERS and f"points/numbers/{name}" in s:   # (older summaries lack newer ones)
                 est, lo, hi = s[f"points/numbers/{name}"][i]
                 lines.append(f"    {LABELS[name]:>18s}  {_fmt(est, lo, hi)}")
         peaks = [row for row in s["points/peaks"][i] if np.isfinite(row[0])]

@@ -58,10 +58,12 @@ from ensemble import catalog, checks, filekind
 from . import reduce
 from .reduce import MIN_UNITS, NUMBERS, PARAMS
 
-FORMAT = filekind.SUMMARY_FORMAT_PREFIX + "3"   # 3: the creep episodes (bins, per-task counts and sums,
-# densities, CREEP_NUMBERS). 2: GR b and its standard error, 9 per-task sums, peaks by prominence; several
-# catalogs (catalogs, configs, partial, /tasks/catalog, catalog_task, catalog_point)
-READS = (FORMAT, filekind.SUMMARY_FORMAT_PREFIX + "2")   # format 2: without the creep datasets
+FORMAT = filekind.SUMMARY_FORMAT_PREFIX + "4"   # 4: the intervals statistic (/per_task/intervals, cv_tnu,
+# mean_gap, cv_gap). 3: the creep episodes (bins, per-task counts and sums, densities, CREEP_NUMBERS). 2: GR b
+# and its standard error, 9 per-task sums, peaks by prominence; several catalogs (catalogs, configs, partial,
+# /tasks/catalog, catalog_task, catalog_point)
+# formats 3 and 2 still read, without the datasets that came after them (a number a summary lacks is not shown)
+READS = (FORMAT, filekind.SUMMARY_FORMAT_PREFIX + "3", filekind.SUMMARY_FORMAT_PREFIX + "2")
 
 # Every dataset, one line each: (unit, shape, meaning), units as in ensemble/catalog.py's DATASETS
 # (T nu, the plate's displacement during a recurrence time, is a model length).

@@ -43,6 +43,7 @@ class Number:
     name: str
     unit: str
     meaning: str
+    label: str = ""      # a few characters for `analysis report` (default: the name)
 
 
 @dataclass(frozen=True)

@@ -44,8 +44,9 @@ STATISTIC = Statistic(
     tables=(Table("intervals", "sum or count", "sums of the recurrence times' squares and of the whole chain's "
                                                "inter-event times", columns=("sum_tnu2", "n_gaps", "sum_gap", "sum_gap2")),),
     numbers=(Number("cv_tnu", "1", "coefficient of variation of the local recurrence times T nu "
-                                   "(< 1 quasi-periodic, 1 Poisson, > 1 clustered)"),
+                                   "(< 1 quasi-periodic, 1 Poisson, > 1 clustered)", "CV of T*nu"),
              Number("mean_gap", "model length", "mean inter-event time of the whole chain, times nu "
-                                                "(onset to the next inertial event's onset)"),
-             Number("cv_gap", "1", "coefficient of variation of the whole chain's inter-event times")),
+                                                "(onset to the next inertial event's onset)", "mean gap*nu"),
+             Number("cv_gap", "1", "coefficient of variation of the whole chain's inter-event times",
+                    "CV of gaps")),
     feed=feed, estimate=estimate)
