@@ -28,7 +28,7 @@ from .processes import ROOT, child_env, run_bounded
 
 CONFIG = ROOT / "tests" / "data" / "summary_reference.toml"
 REFERENCE = ROOT / "tests" / "data" / "summary_reference.h5.gz"
-CATALOG = ROOT / "tests" / "data" / "summary_reference_catalog.h5.gz"   # of the machine, not the physics
+CATALOG = ROOT / "tests" / "data" / "summary_reference_catalog.h5.gz"
 OPTIONS = ("format", "partial", "mu_c", "window", "b_cut", "bootstrap", "level", "blocks", "seed")
 
 
