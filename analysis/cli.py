@@ -29,8 +29,7 @@ from ensemble import checks, filekind
 from ensemble.catalog import CatalogError
 
 from . import merge, summary
-from .reduce import CREEP_DURATION_BINS, CREEP_MU_BINS, NUMBERS, Options, parse_bins
-from .stats import N_CREEP_STATS, N_STATS
+from .reduce import CREEP_DURATION_BINS, CREEP_MU_BINS, LAYOUT, NUMBERS, Options, bin_edges, parse_bins
 
 # errors that reduce's rank 0 finds before the work starts and every rank then raises alike
 # (ensemble.abort.on_root), with their exit codes; any other error on any rank aborts them all
@@ -215,7 +214,8 @@ def _memory(opt, n_tasks):
     resample's curves and T nu counts."""
     n_mu, n_tnu = len(opt.mu_edges) - 1, len(opt.tnu_edges) - 1
     n_creep = len(opt.creep_mu_edges) + len(opt.creep_duration_edges) - 2
-    per_task = opt.blocks * (n_mu + 2 * n_tnu + n_creep + N_STATS + N_CREEP_STATS)
+    edges = bin_edges(opt)
+    per_task = opt.blocks * sum(LAYOUT.width(name, edges) for name in LAYOUT.tables)
     resamples = opt.bootstrap * (n_mu + 3 * n_tnu + n_creep + len(NUMBERS) + n_tasks * opt.blocks)
     checks.memory(f"--blocks {opt.blocks}, --bootstrap {opt.bootstrap} and {n_mu} + 2 x {n_tnu} + {n_creep} bins "
                   f"over {n_tasks} tasks", 8 * (2 * n_tasks * per_task + resamples))

@@ -164,7 +164,7 @@ def _partial_statement(paths, tables, per_tasks, unfinished):
 
 
 def reduce_share(inputs, rows, opt):
-    """TaskHistograms of the given rows of inputs.tasks (one rank's share), keyed by row."""
+    """The tables (reduce.reduce_task) of the given rows of inputs.tasks (one rank's share), keyed by row."""
     out = {}
     for c, path in enumerate(inputs.paths):
         mine = [g for g in rows if inputs.tasks["catalog"][g] == c]

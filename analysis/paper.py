@@ -27,7 +27,7 @@ import numpy as np
 from ensemble.config import TRANSIENT_PER_BLOCK
 
 from . import stats, summary
-from .reduce import PARAMS
+from .reduce import LAYOUT, PARAMS
 from .report import LABELS, count_text, events_per_point, level_text, partial_text, point_label, size_text
 
 PAPER_EVENTS = 200_000      # events the paper recorded per point (one trajectory, N = 800) ...
@@ -93,7 +93,7 @@ def shape_statistics(s, i, level=None):
     edges = s["bins/mu"]
     c = stats.centers(edges)
     tasks = np.flatnonzero(s["tasks/point"] == i)
-    counts, events = s["per_task/mu"][tasks], s["per_task/numbers"][tasks][:, :, stats.N_EVENTS]
+    counts, events = s["per_task/mu"][tasks], s["per_task/numbers"][tasks][:, :, LAYOUT.column("numbers", "n_events")]
     if s["points/method"][i] == "seeds":     # the summary's own units: seeds, else every stretch
         counts, events = counts.sum(axis=1, keepdims=True), events.sum(axis=1, keepdims=True)
     rows = np.concatenate([counts.reshape(-1, len(c)), events.reshape(-1, 1)], axis=1)

@@ -23,6 +23,7 @@ from ensemble.config import LAW_KEYS
 
 from . import stats
 from .recurrence import RecurrenceScanner
+from .statistics import Layout, Rows
 
 # the parameters that tell points apart: the chain's, and every friction law's keys (NaN where a
 # key is not of the task's law, so tasks of two laws never pool)
@@ -51,15 +52,15 @@ class Options:
     creep_duration_edges: np.ndarray = field(default_factory=lambda: parse_bins(CREEP_DURATION_BINS))
 
 
-# the densities of a point, in the order of its curves (analysis/summary.py CURVES), with their bins
-CURVES = {"mu": "mu", "tnu": "tnu", "tnu_interior": "tnu", "creep_mu": "creep_mu",
-          "creep_duration": "creep_duration"}
+# every statistic of analysis/statistics/, laid out: its tables, numbers and curves in the registry's order
+LAYOUT = Layout()
+# the densities of a point, in the order of its curves (name -> the bins of its table)
+CURVES = {c.name: LAYOUT.tables[c.table].bins for c in LAYOUT.curves}
 
 
 def bin_edges(opt):
-    """{bins name: edges} of the options (the summary's /bins/<name>)."""
-    return {"mu": opt.mu_edges, "tnu": opt.tnu_edges, "creep_mu": opt.creep_mu_edges,
-            "creep_duration": opt.creep_duration_edges}
+    """{bins name: edges} of the options (the summary's /bins/<name>): option <name>_edges."""
+    return {name: getattr(opt, f"{name}_edges") for name in LAYOUT.bins}
 
 
 MAX_BINS = 10 ** 6   # bins of a histogram: beyond a million, (tasks, stretches, bins) counts outgrow memory
@@ -82,90 +83,48 @@ def parse_bins(text, name="bins"):
     return edges
 
 
-@dataclass
-class TaskHistograms:
-    """Additive statistics of one task, per stretch (leading axis)."""
-    mu: np.ndarray            # (blocks, n_mu) counts of mu
-    tnu: np.ndarray           # (blocks, n_tnu) counts of T * nu, all large events
-    tnu_interior: np.ndarray  # (blocks, n_tnu) counts of T * nu, interior starting events
-    numbers: np.ndarray       # (blocks, stats.N_STATS) counts and sums
-    creep_mu: np.ndarray      # (blocks, n_creep_mu) counts of the creep episodes' mu
-    creep_duration: np.ndarray  # (blocks, n_creep_duration) counts of their log10(duration nu)
-    creep: np.ndarray         # (blocks, stats.N_CREEP_STATS) counts and sums of the slow side
-    rows: int = 0             # the task's committed rows read, of every kind (analysis/cli.py checks them)
-
-
-def _bin_add(hist, block, values, edges):
-    idx = np.searchsorted(edges, values, side="right") - 1
-    ok = (idx >= 0) & (idx < len(edges) - 1)
-    np.add.at(hist, (block[ok], idx[ok]), 1)
-
-
-def reduce_task(chunks, written, nu, n_blocks_chain, opt, rows=None):
+def reduce_task(chunks, written, nu, n_blocks_chain, opt, rows=None, layout=LAYOUT):
     """Stream one task's rows (chunks of dicts of columns, `written` inertial events and `rows`
-    rows of every kind in all) into TaskHistograms. The chunks are consumed to their end (the
-    catalog checks a task's checksum there)."""
+    rows of every kind in all) into its tables (statistics.Tables: {table: (stretches, width)}; the
+    attribute `rows` the rows read). Every statistic is fed each chunk once. The chunks are consumed to
+    their end (the catalog checks a task's checksum there)."""
     k = opt.blocks
-    out = TaskHistograms(np.zeros((k, len(opt.mu_edges) - 1), np.int64),
-                         np.zeros((k, len(opt.tnu_edges) - 1), np.int64),
-                         np.zeros((k, len(opt.tnu_edges) - 1), np.int64),
-                         np.zeros((k, stats.N_STATS)),
-                         np.zeros((k, len(opt.creep_mu_edges) - 1), np.int64),
-                         np.zeros((k, len(opt.creep_duration_edges) - 1), np.int64),
-                         np.zeros((k, stats.N_CREEP_STATS)))
-    scanner = RecurrenceScanner(n_blocks_chain, opt.mu_c, opt.window) if written else None
+    out = layout.empty(k, bin_edges(opt))
+    out.rows = 0
+    recurrences = any("recurrences" in s.needs for s in layout.statistics)
+    scanner = RecurrenceScanner(n_blocks_chain, opt.mu_c, opt.window) if written and recurrences else None
     lo = row = 0
+    t_before = np.nan
     for part in chunks:
         inertial = part["kind"] == catalog.KIND_EVENT
-        _creep_add(out, part, inertial, lo, row, written, rows, nu, opt)
+        creep = part["kind"] == catalog.KIND_CREEP
+        creep_block = _creep_stretches(inertial, creep, lo, row, written, rows, k) if creep.any() else None
         row += len(inertial)
-        if not inertial.any():
-            continue
-        ev = part if inertial.all() else {name: column[inertial] for name, column in part.items()}
-        hi = lo + len(ev["t"])
-        t, mu, epicenter, boundary = ev["t"], ev["mu"], ev["epicenter"], ev["boundary"]
-        block = (np.arange(lo, hi) * k) // written
-        _bin_add(out.mu, block, mu, opt.mu_edges)
-        np.add.at(out.numbers[:, stats.N_EVENTS], block, 1)
-        np.add.at(out.numbers[:, stats.N_LARGE], block, mu >= opt.mu_c)
-        np.add.at(out.creep[:, stats.SUM_SLIP_EVENTS], block, ev["slip"])
-        gr = mu >= opt.b_cut
-        np.add.at(out.numbers[:, stats.N_GR], block[gr], 1)
-        np.add.at(out.numbers[:, stats.SUM_MU_GR], block[gr], mu[gr])
-        np.add.at(out.numbers[:, stats.SUM_MU2_GR], block[gr], mu[gr] ** 2)
-        src, T, interior = scanner.feed(t, epicenter, mu, boundary)
-        rblock = (src * k) // written
-        tnu = T * nu
-        _bin_add(out.tnu, rblock, tnu, opt.tnu_edges)
-        _bin_add(out.tnu_interior, rblock[interior], tnu[interior], opt.tnu_edges)
-        np.add.at(out.numbers[:, stats.N_REC], rblock, 1)
-        np.add.at(out.numbers[:, stats.SUM_TNU], rblock, tnu)
-        np.add.at(out.numbers[:, stats.N_REC_INT], rblock[interior], 1)
-        np.add.at(out.numbers[:, stats.SUM_TNU_INT], rblock[interior], tnu[interior])
-        lo = hi
+        ev = block = rec = None
+        if inertial.any():
+            ev = part if inertial.all() else {name: column[inertial] for name, column in part.items()}
+            hi = lo + len(ev["t"])
+            block = (np.arange(lo, hi) * k) // written
+            if scanner is not None:
+                src, T, interior = scanner.feed(ev["t"], ev["epicenter"], ev["mu"], ev["boundary"])
+                rec = ((src * k) // written, T * nu, interior)
+            lo = hi
+        seen = Rows(part, inertial, ev, block, creep, creep_block, rec, t_before, nu, opt)
+        for statistic in layout.statistics:
+            statistic.feed(out, seen)
+        if ev is not None:
+            t_before = ev["t"][-1]
     return out
 
 
-def _creep_add(out, part, inertial, before, row, written, rows, nu, opt):
-    """Add a chunk's creep episodes (its rows of kind KIND_CREEP) to `out`; `before` inertial
-    events and `row` rows of the task precede the chunk. A creep row's stretch is that of the
-    inertial events before it (the last one after the last event); without events, by its row."""
-    creep = part["kind"] == catalog.KIND_CREEP
-    if not creep.any():
-        return
-    k = opt.blocks
+def _creep_stretches(inertial, creep, before, row, written, rows, k):
+    """The stretches of a chunk's creep episodes; `before` inertial events and `row` rows of the task
+    precede the chunk. A creep row's stretch is that of the inertial events before it (the last one
+    after the last event); without events, by its row."""
     if written:
         events_before = before + np.cumsum(inertial) - inertial
-        block = np.minimum((events_before[creep] * k) // written, k - 1)
-    else:
-        block = ((row + np.flatnonzero(creep)) * k) // max(rows or 0, row + len(creep))
-    with np.errstate(divide="ignore"):      # a duration of 0 is out of every bin (still counted)
-        log_duration = np.log10(part["duration"][creep] * nu)
-    _bin_add(out.creep_mu, block, part["mu"][creep], opt.creep_mu_edges)
-    _bin_add(out.creep_duration, block, log_duration, opt.creep_duration_edges)
-    np.add.at(out.creep[:, stats.N_CREEP], block, 1)
-    np.add.at(out.creep[:, stats.N_CREEP_TAKEN_OVER], block, part["ending"][creep] == catalog.ENDING_TAKEN_OVER)
-    np.add.at(out.creep[:, stats.SUM_SLIP_CREEP], block, part["slip"][creep])
+        return np.minimum((events_before[creep] * k) // written, k - 1)
+    return ((row + np.flatnonzero(creep)) * k) // max(rows or 0, row + len(creep))
 
 
 def reduce_tasks(path, task_indices, opt):
@@ -186,10 +145,7 @@ def reduce_tasks(path, task_indices, opt):
 
 # -- per point ------------------------------------------------------------------------------
 
-NUMBERS = ("n_events", "n_large", "fraction_large", "n_recurrences", "mean_tnu", "mode_tnu",
-           "mean_tnu_interior", "gr_b", "gr_b_se", "ks_gr",
-           # the slow side (creep episodes, /events/kind 1): NaN where there are none to share
-           "n_creep", "creep_share", "taken_over_share", "aseismic_fraction")
+NUMBERS = tuple(n.name for n in LAYOUT.numbers)
 CREEP_NUMBERS = NUMBERS[NUMBERS.index("n_creep"):]
 # Fewer resampling units than this and the bootstrap intervals are not to be trusted (a
 # percentile interval from a handful of seeds is too narrow and jumps with each one added).
@@ -210,49 +166,37 @@ def _units(per_task, task_ids):
     of all its tasks (task by task, in task order)."""
     stack = [per_task[k] for k in task_ids]
     if len(stack) >= MIN_UNITS:
-        pack = lambda name: np.stack([getattr(h, name).sum(axis=0) for h in stack])  # noqa: E731
+        pack = lambda name: np.stack([h[name].sum(axis=0) for h in stack])  # noqa: E731
         return pack, "seeds"
-    pack = lambda name: np.concatenate([getattr(h, name) for h in stack])  # noqa: E731
+    pack = lambda name: np.concatenate([h[name] for h in stack])  # noqa: E731
     return pack, "blocks"
 
 
-UNIT_ARRAYS = ("mu", "tnu", "tnu_interior", "creep_mu", "creep_duration", "numbers", "creep")
+UNIT_ARRAYS = tuple(LAYOUT.tables)
 
 
-def point_statistics(per_task, task_ids, opt, rng):
-    """Merged densities and summary numbers of one parameter point, with bootstrap intervals."""
+def point_statistics(per_task, task_ids, opt, rng, layout=LAYOUT):
+    """Merged densities and summary numbers of one parameter point, with bootstrap intervals, and each
+    statistic's extras (the recurrence peaks)."""
     pack, method = _units(per_task, task_ids)
-    units = {name: pack(name) for name in UNIT_ARRAYS}
-    # every unit's arrays side by side in one row: one resample draws them all alike
-    ends = np.cumsum([units[name].shape[1] for name in UNIT_ARRAYS])
-    flat = np.concatenate([units[name] for name in UNIT_ARRAYS], axis=1)
+    names = list(layout.tables)
+    units = {name: pack(name) for name in names}
+    # every unit's tables side by side in one row: one resample draws them all alike
+    ends = np.cumsum([units[name].shape[1] for name in names])
+    flat = np.concatenate([units[name] for name in names], axis=1)
     edges = bin_edges(opt)
 
     def split(row):
-        return dict(zip(UNIT_ARRAYS, np.split(row, ends[:-1])))
+        return layout.sum_of(dict(zip(names, np.split(row, ends[:-1]))))
 
     def numbers(row):
         u = split(row)
-        mu, tnu, s, c = u["mu"], u["tnu"], u["numbers"], u["creep"]
-        b = stats.gr_b(s[stats.N_GR], s[stats.SUM_MU_GR], opt.b_cut)
-        b_se = stats.gr_b_standard_error(s[stats.N_GR], s[stats.SUM_MU_GR], s[stats.SUM_MU2_GR], opt.b_cut)
-        mode = stats.centers(opt.tnu_edges)[np.argmax(tnu)] if tnu.sum() > 0 else np.nan
-        with np.errstate(invalid="ignore", divide="ignore"):
-            return np.array([
-                s[stats.N_EVENTS], s[stats.N_LARGE], s[stats.N_LARGE] / s[stats.N_EVENTS],
-                s[stats.N_REC], s[stats.SUM_TNU] / s[stats.N_REC], mode,
-                s[stats.SUM_TNU_INT] / s[stats.N_REC_INT], b, b_se,
-                stats.gr_ks_distance(mu, opt.mu_edges, opt.b_cut, b),
-                c[stats.N_CREEP], c[stats.N_CREEP] / (c[stats.N_CREEP] + s[stats.N_EVENTS]),
-                c[stats.N_CREEP_TAKEN_OVER] / c[stats.N_CREEP],
-                c[stats.SUM_SLIP_CREEP] / (c[stats.SUM_SLIP_CREEP] + c[stats.SUM_SLIP_EVENTS])])
+        return np.array([x for s in layout.statistics if s.numbers for x in s.estimate(u, opt)], dtype=float)
 
     def curves(row):
         u = split(row)
-        totals = {"mu": u["numbers"][stats.N_EVENTS], "tnu": u["numbers"][stats.N_REC],
-                  "tnu_interior": u["numbers"][stats.N_REC_INT], "creep_mu": u["creep"][stats.N_CREEP],
-                  "creep_duration": u["creep"][stats.N_CREEP]}
-        return np.concatenate([stats.density(u[name], edges[bins], totals[name]) for name, bins in CURVES.items()])
+        return np.concatenate([stats.density(u[c.table], edges[layout.tables[c.table].bins], u.column(*c.total))
+                               for c in layout.curves])
 
     total = flat.sum(axis=0)
     samples = stats.bootstrap(flat, lambda row: np.concatenate([curves(row), numbers(row)]),
@@ -262,43 +206,11 @@ def point_statistics(per_task, task_ids, opt, rng):
         lo = hi = np.full_like(est, np.nan)
     else:
         lo, hi = stats.percentile_interval(samples, opt.level)
-    n_curve = len(est) - len(NUMBERS)
-    peaks = _peaks_with_intervals(units["tnu"], opt, rng)
-    return {"curves": (est[:n_curve], lo[:n_curve], hi[:n_curve]),
-            "numbers": np.stack([est[n_curve:], lo[n_curve:], hi[n_curve:]], axis=1),
-            "peaks": peaks, "method": method, "units": len(flat)}
-
-
-def _peaks_with_intervals(tnu_units, opt, rng):
-    """Significant recurrence peaks of the merged histogram (stats.find_peaks), each with the
-    interval of the nearest peak across bootstrap resamples. Rows: (position, lo, hi).
-
-    The noise of each smoothed bin is the standard deviation of its bootstrap resamples over the
-    units, at least the Poisson value (with one unit, or few, the bootstrap understates it).
-    """
-    total = tnu_units.sum(axis=0)
-    noise = stats.poisson_noise(total)
-    resampled = None
-    if len(tnu_units) >= 2 and total.sum() > 0:
-        picks = rng.integers(0, len(tnu_units), size=(opt.bootstrap, len(tnu_units)))
-        resampled = np.array([tnu_units[p].sum(axis=0) for p in picks])
-        spread = np.array([stats.smooth(c) for c in resampled]).std(axis=0, ddof=1)
-        noise = np.maximum(noise, spread)
-    base = stats.find_peaks(total, opt.tnu_edges, noise)
-    if len(base) == 0 or resampled is None:
-        return np.array([[p, np.nan, np.nan] for p in base]).reshape(-1, 3)
-    width = opt.tnu_edges[1] - opt.tnu_edges[0]
-    found = [[] for _ in base]
-    for counts in resampled:
-        peaks = stats.find_peaks(counts, opt.tnu_edges, noise)
-        for i, b in enumerate(base):
-            if len(peaks):
-                near = peaks[np.argmin(np.abs(peaks - b))]
-                if abs(near - b) <= 5 * width:
-                    found[i].append(near)
-    rows = []
-    for b, f in zip(base, found):
-        lo, hi = (np.percentile(f, [50 * (1 - opt.level), 100 - 50 * (1 - opt.level)])
-                  if len(f) else (np.nan, np.nan))
-        rows.append([b, lo, hi])
-    return np.array(rows)
+    n_curve = len(est) - len(layout.numbers)
+    out = {"curves": (est[:n_curve], lo[:n_curve], hi[:n_curve]),
+           "numbers": np.stack([est[n_curve:], lo[n_curve:], hi[n_curve:]], axis=1),
+           "method": method, "units": len(flat)}
+    for statistic in layout.statistics:
+        if statistic.extra is not None:
+            out.update(statistic.extra(units, opt, rng))
+    return out

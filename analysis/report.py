@@ -2,8 +2,7 @@
 import numpy as np
 
 from . import reduce, summary
-from .reduce import CREEP_NUMBERS, NUMBERS, PARAMS
-from .stats import N_EVENTS
+from .reduce import CREEP_NUMBERS, LAYOUT, NUMBERS, PARAMS
 
 LABELS = {
     "n_events": "events", "n_large": "large", "fraction_large": "frac(mu>=mu_c)",
@@ -12,6 +11,7 @@ LABELS = {
     "ks_gr": "KS to GR",
     "n_creep": "creep episodes", "creep_share": "creep share (rows)", "taken_over_share": "taken over",
     "aseismic_fraction": "aseismic fraction",
+    **{n.name: n.label for n in LAYOUT.numbers if n.label},   # the statistics' own labels
 }
 
 
@@ -58,7 +58,7 @@ def count_text(n):
 
 def events_per_task(s):
     """Events each task of the summary contributed (reduced, not discarded), (tasks,)."""
-    return s["per_task/numbers"][:, :, N_EVENTS].sum(axis=1).astype(np.int64)
+    return s["per_task/numbers"][:, :, LAYOUT.column("numbers", "n_events")].sum(axis=1).astype(np.int64)
 
 
 def events_per_point(s):
@@ -108,7 +108,7 @@ def table(s):
         if unreliable(s, i):
             lines.append(f"    WARNING: {unreliable(s, i)}")
         for name in NUMBERS:
-            if name not in CREEP_NUMBERS:
+            if name not in CREEP_NUMBERS and f"points/numbers/{name}" in s:   # (older summaries lack newer ones)
                 est, lo, hi = s[f"points/numbers/{name}"][i]
                 lines.append(f"    {LABELS[name]:>18s}  {_fmt(est, lo, hi)}")
         peaks = [row for row in s["points/peaks"][i] if np.isfinite(row[0])]

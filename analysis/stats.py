@@ -10,14 +10,6 @@ import numpy as np
 
 LOG10_E = math.log10(math.e)
 
-# columns of the per-unit statistics array
-(N_EVENTS, N_LARGE, N_REC, SUM_TNU, N_REC_INT, SUM_TNU_INT, N_GR, SUM_MU_GR, SUM_MU2_GR) = range(9)
-N_STATS = 9
-# columns of the per-unit creep array (/per_task/creep): the creep episodes (/events/kind 1) and the
-# inertial events' slip beside theirs, the slow side of the slip budget
-(N_CREEP, N_CREEP_TAKEN_OVER, SUM_SLIP_CREEP, SUM_SLIP_EVENTS) = range(4)
-N_CREEP_STATS = 4
-
 
 def density(counts, edges, total):
     """Probability density from bin counts; `total` counts the events in and out of range."""

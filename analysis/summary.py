@@ -55,58 +55,46 @@ import numpy as np
 
 from ensemble import catalog, checks, filekind
 
-from . import stats
 from . import reduce
 from .reduce import MIN_UNITS, NUMBERS, PARAMS
 
-FORMAT = filekind.SUMMARY_FORMAT_PREFIX + "3"   # 3: the creep episodes (bins, per-task counts and sums,
-# densities, CREEP_NUMBERS). 2: GR b and its standard error, 9 per-task sums, peaks by prominence; several
-# catalogs (catalogs, configs, partial, /tasks/catalog, catalog_task, catalog_point)
-READS = (FORMAT, filekind.SUMMARY_FORMAT_PREFIX + "2")   # format 2: without the creep datasets
+FORMAT = filekind.SUMMARY_FORMAT_PREFIX + "4"   # 4: the intervals statistic (/per_task/intervals, cv_tnu,
+# mean_gap, cv_gap). 3: the creep episodes (bins, per-task counts and sums, densities, CREEP_NUMBERS). 2: GR b
+# and its standard error, 9 per-task sums, peaks by prominence; several catalogs (catalogs, configs, partial,
+# /tasks/catalog, catalog_task, catalog_point)
+# formats 3 and 2 still read, without the datasets that came after them (a number a summary lacks is not shown)
+READS = (FORMAT, filekind.SUMMARY_FORMAT_PREFIX + "3", filekind.SUMMARY_FORMAT_PREFIX + "2")
 
 # Every dataset, one line each: (unit, shape, meaning), units as in ensemble/catalog.py's DATASETS
 # (T nu, the plate's displacement during a recurrence time, is a model length).
 _POINTS = "(points,)"
 _INTERVAL = "(points, 3): estimate, lo, hi (lo, hi: the bootstrap interval at `level`, NaN with one unit)"
 _CURVE = "(points, {} bins)"   # the curve's variable
-CURVES = {   # name -> (its bins, its variable, whose variable, the density's unit)
-    "mu": ("mu", "mu", "all events", "1/mu"),
-    "tnu": ("tnu", "T nu", "all recurrences", "1/model length"),
-    "tnu_interior": ("tnu", "T nu", "the recurrences starting at an interior event (boundary false)",
-                     "1/model length"),
-    "creep_mu": ("creep_mu", "mu", "the creep episodes (/events/kind 1; mu = log10 of the slip creep released)",
-                 "1/mu"),
-    "creep_duration": ("creep_duration", "log10(duration nu)",
-                       "the creep episodes (duration in units of the loading time 1/nu)", "1/log10 unit"),
+LAYOUT = reduce.LAYOUT   # the statistics (analysis/statistics/): their tables, curves and numbers
+CURVES = {   # name -> (its bins, its variable, whose variable, the density's unit), in the curves' order
+    c.name: (LAYOUT.tables[c.table].bins, c.variable, c.whose, c.unit) for c in LAYOUT.curves}
+NUMBER_MEANINGS = {n.name: (n.unit, n.meaning) for n in LAYOUT.numbers}   # in the order of reduce.NUMBERS
+_BINS = {   # name -> (unit, what its edges bin)
+    "mu": ("log10 model length", "magnitude bins"),
+    "tnu": ("model length", "T nu bins"),
+    "creep_mu": ("log10 model length", "creep episodes' mu bins (reduce --creep-mu-bins)"),
+    "creep_duration": ("log10(duration nu)", "creep episodes' log10(duration nu) bins (reduce --creep-duration-bins)"),
 }
-assert tuple(CURVES) == tuple(reduce.CURVES)   # the order of reduce.point_statistics' curves
-NUMBER_MEANINGS = {   # name -> (unit, meaning), in the order of reduce.NUMBERS
-    "n_events": ("count", "inertial events (/events/kind 0: creep episodes are in none of these numbers)"),
-    "n_large": ("count", "large events (mu >= mu_c)"),
-    "fraction_large": ("1", "fraction of the events with mu >= mu_c"),
-    "n_recurrences": ("count", "recurrences: large events closed by a later one within `window` blocks"),
-    "mean_tnu": ("model length", "mean T nu of all recurrences"),
-    "mode_tnu": ("model length", "centre of the highest T nu bin"),
-    "mean_tnu_interior": ("model length", "mean T nu of the recurrences starting at an interior event"),
-    "gr_b": ("1", "Aki's maximum-likelihood Gutenberg-Richter b (not the model's b) above mu = b_cut"),
-    "gr_b_se": ("1", "Shi & Bolt standard error of gr_b (assumes independent events; trust the interval)"),
-    "ks_gr": ("1", "Kolmogorov-Smirnov distance of the binned mu >= b_cut from the fitted GR law"),
-    "n_creep": ("count", "creep episodes (/events/kind 1, below the block stiffness 1 + 2 l^2)"),
-    "creep_share": ("1", "share of the rows that are creep episodes: n_creep / (n_creep + n_events)"),
-    "taken_over_share": ("1", "share of the creep episodes taken over by an inertial event (/events/ending 2); "
-                              "NaN without creep episodes"),
-    "aseismic_fraction": ("1", "aseismic slip fraction (1 - seismic coupling): the slip of the creep episodes "
-                               "over all slip (creep episodes and inertial events) after the transient"),
-}
+
+
+def _table_entry(name):
+    """DATASETS' line of /per_task/<table>: from the statistics that declare it."""
+    t = LAYOUT.tables[name]
+    if t.bins:
+        return (t.unit, f"(tasks, stretches, {t.bins} bins)", t.meaning)
+    columns = LAYOUT.columns[name]
+    return (t.unit, f"(tasks, stretches, {len(columns)})",
+            f"{', '.join(columns)} (analysis/statistics/) per task and stretch")
+
+
 DATASETS = {
-    "bins/mu": ("log10 model length", "(mu bins + 1,)",
-                "edges of the magnitude bins, half-open [lo, hi), the last one too"),
-    "bins/tnu": ("model length", "(T nu bins + 1,)", "edges of the T nu bins, half-open [lo, hi), the last one too"),
-    "bins/creep_mu": ("log10 model length", "(creep mu bins + 1,)",
-                      "edges of the creep episodes' mu bins (reduce --creep-mu-bins), half-open [lo, hi)"),
-    "bins/creep_duration": ("log10(duration nu)", "(creep duration bins + 1,)",
-                            "edges of the creep episodes' log10(duration nu) bins (reduce --creep-duration-bins), "
-                            "half-open [lo, hi)"),
+    **{f"bins/{name}": (unit, f"({name} bins + 1,)", f"edges of the {what}, half-open [lo, hi), the last one too")
+       for name, (unit, what) in _BINS.items()},
     **{name: entry for name, entry in catalog.DATASETS.items() if name.startswith("tasks/")},
     **{f"tasks/{name}": entry for name, entry in catalog.READER_TASKS.items()},
     # the columns a summary of one or more catalogs (analysis/merge.py) sets or adds
@@ -119,21 +107,7 @@ DATASETS = {
     "tasks/catalog_task": ("index", "(tasks,)", "the task's index in its catalog"),
     "tasks/catalog_point": ("index", "(tasks,)",
                             "the task's parameter point in its catalog (position in the product of its [sweep] lists)"),
-    "per_task/mu": ("count", "(tasks, stretches, mu bins)", "events per magnitude bin, per task and stretch"),
-    "per_task/tnu": ("count", "(tasks, stretches, T nu bins)",
-                     "recurrences per T nu bin, per task and stretch of their starting event"),
-    "per_task/tnu_interior": ("count", "(tasks, stretches, T nu bins)",
-                              "the same for the recurrences starting at an interior event"),
-    "per_task/numbers": ("count or sum", f"(tasks, stretches, {stats.N_STATS})",
-                         "n_events, n_large, n_rec, sum_tnu, n_rec_int, sum_tnu_int, n_gr, sum_mu_gr, "
-                         "sum_mu2_gr (analysis/stats.py) per task and stretch"),
-    "per_task/creep_mu": ("count", "(tasks, stretches, creep mu bins)",
-                          "creep episodes per mu bin, per task and stretch (of the inertial events before them)"),
-    "per_task/creep_duration": ("count", "(tasks, stretches, creep duration bins)",
-                                "creep episodes per log10(duration nu) bin, per task and stretch"),
-    "per_task/creep": ("count or sum", f"(tasks, stretches, {stats.N_CREEP_STATS})",
-                       "n_creep, n_creep_taken_over, sum_slip_creep, sum_slip_events (the inertial events' slip) "
-                       "(analysis/stats.py) per task and stretch"),
+    **{f"per_task/{name}": _table_entry(name) for name in LAYOUT.tables},
     **{f"points/{name}": (unit, _POINTS, f"{meaning}, of the point's tasks")
        for name, (unit, _, meaning) in ((n, catalog.DATASETS[f"tasks/{n}"]) for n in PARAMS)},
     "points/law": ("text", _POINTS, "friction law of the point's tasks (a point is a law and its parameters)"),
@@ -145,8 +119,7 @@ DATASETS = {
        for part, what in (("density", "probability density"), ("lo", "lower interval end of the density"),
                           ("hi", "upper interval end of the density"))},
     **{f"points/numbers/{name}": (unit, _INTERVAL, meaning) for name, (unit, meaning) in NUMBER_MEANINGS.items()},
-    "points/peaks": ("model length", "(points, most peaks, 3): position, lo, hi; NaN rows pad",
-                     "recurrence peaks of the T nu histogram, highest first (analysis/stats.py find_peaks)"),
+    **{f"points/{name}": entry for st in LAYOUT.statistics for name, entry in st.extra_datasets.items()},
 }
 
 
@@ -200,7 +173,7 @@ def write(path, inputs, per_task, points, opt, force=False):
             h5[f"tasks/{name}"] = np.char.encode(values) if values.dtype.kind == "U" else values
         order = sorted(per_task)
         for name in reduce.UNIT_ARRAYS:
-            h5[f"per_task/{name}"] = np.stack([getattr(per_task[k], name) for k in order])
+            h5[f"per_task/{name}"] = np.stack([per_task[k][name] for k in order])
         for name in PARAMS:
             h5[f"points/{name}"] = np.array([p["params"][name] for p in points])
         h5["points/law"] = np.array([p["params"]["law"] for p in points], dtype="S")

@@ -59,7 +59,7 @@ import numpy as np
 
 LOG10_E = math.log10(math.e)
 NUMBERS = ("n_events", "n_large", "fraction_large", "n_recurrences", "mean_tnu", "mode_tnu",
-           "mean_tnu_interior", "gr_b", "gr_b_se", "ks_gr")
+           "mean_tnu_interior", "cv_tnu", "mean_gap", "cv_gap", "gr_b", "gr_b_se", "ks_gr")
 CREEP_NUMBERS = ("n_creep", "creep_share", "taken_over_share", "aseismic_fraction")   # the summary's numbers too
 CURVES = ("mu", "tnu", "tnu_interior", "creep_mu", "creep_duration")
 # the documented defaults of reduce --creep-mu-bins -12:3:75 and --creep-duration-bins -7:3:50
@@ -68,6 +68,7 @@ CREEP_EDGES = {"creep_mu_edges": np.linspace(-12, 3, 76), "creep_duration_edges"
 PER_TASK_COLUMNS = ("n_events", "n_large", "n_rec", "sum_tnu", "n_rec_int", "sum_tnu_int",
                     "n_gr", "sum_mu_gr", "sum_mu2_gr")
 CREEP_COLUMNS = ("n_creep", "n_taken_over", "sum_slip_creep", "sum_slip_events")   # of /per_task/creep
+INTERVAL_COLUMNS = ("sum_tnu2", "n_gaps", "sum_gap", "sum_gap2")   # of /per_task/intervals
 # the chain's parameters and every friction law's keys (NaN where a key is not the task's law's)
 PARAMS = ("N", "l", "nu", "a", "b", "c", "alpha", "sigma")
 MIN_SEEDS = 10
@@ -218,10 +219,19 @@ def quotient(a, b):
     return a / b if b else math.nan
 
 
-def statistics(mu, tnu, interior, event_slip, creep_mu, creep_log_duration, creep_taken, creep_slip, opt):
+def cv(values):
+    """Sample standard deviation (n - 1) over the mean, two-pass; NaN for fewer than two or a mean <= 0."""
+    x = [float(v) for v in values]
+    if len(x) < 2 or sum(x) <= 0:
+        return math.nan
+    mean = sum(x) / len(x)
+    return math.sqrt(sum((v - mean) ** 2 for v in x) / (len(x) - 1)) / mean
+
+
+def statistics(mu, tnu, interior, event_slip, creep_mu, creep_log_duration, creep_taken, creep_slip, gaps, opt):
     """Curves and numbers of pooled raw data: mu (all inertial events), tnu and interior
-    (recurrences), event_slip (the inertial events' slips) and the creep episodes' mu, log10(duration
-    nu), taken over (ending 2) and slip."""
+    (recurrences), event_slip (the inertial events' slips), the creep episodes' mu, log10(duration
+    nu), taken over (ending 2) and slip, and the inter-event times (times nu) of the inertial events."""
     mu = np.asarray(mu, dtype=float)
     tnu = np.asarray(tnu, dtype=float)
     interior = np.asarray(interior, dtype=bool)
@@ -241,6 +251,7 @@ def statistics(mu, tnu, interior, event_slip, creep_mu, creep_log_duration, cree
         "n_recurrences": len(tnu), "mean_tnu": tnu.sum() / len(tnu) if len(tnu) else math.nan,
         "mode_tnu": mode,
         "mean_tnu_interior": tnu[interior].sum() / interior.sum() if interior.any() else math.nan,
+        "cv_tnu": cv(tnu), "mean_gap": quotient(sum(float(g) for g in gaps), len(gaps)), "cv_gap": cv(gaps),
         "gr_b": b, "gr_b_se": gr_b_se(mu, opt["b_cut"]), "ks_gr": ks_distance(mu, me, opt["b_cut"], b),
     }
     m = len(creep_mu)
@@ -291,15 +302,20 @@ class Task:
         self.tnu = np.array([r[1] * nu for r in rec], dtype=float)
         self.interior = np.array([r[2] for r in rec], dtype=bool)
         self.rec_stretch = self.stretch[self.rec_start] if len(rec) else np.zeros(0, dtype=np.int64)
+        # the inter-event times, each in the stretch of the event that closes it
+        t = [float(x) for x in ev["t"]]
+        self.gaps = np.array([(t[i] - t[i - 1]) * nu for i in range(1, n)], dtype=float)
+        self.gap_stretch = self.stretch[1:]
 
     def unit(self, stretch=None):
         """(mu, tnu, interior, event slip, creep mu, creep log10(duration nu), creep taken over,
         creep slip) of the whole task or of one stretch."""
         creep = (self.creep_mu, self.creep_log_duration, self.creep_taken, self.creep_slip)
         if stretch is None:
-            return (self.mu, self.tnu, self.interior, self.event_slip, *creep)
+            return (self.mu, self.tnu, self.interior, self.event_slip, *creep, self.gaps)
         e, r, c = self.stretch == stretch, self.rec_stretch == stretch, self.creep_stretch == stretch
-        return (self.mu[e], self.tnu[r], self.interior[r], self.event_slip[e], *(x[c] for x in creep))
+        return (self.mu[e], self.tnu[r], self.interior[r], self.event_slip[e], *(x[c] for x in creep),
+                self.gaps[self.gap_stretch == stretch])
 
     def per_stretch(self, opt):
         k, me, te = opt["blocks"], opt["mu_edges"], opt["tnu_edges"]
@@ -311,15 +327,17 @@ class Task:
         cm_h = np.zeros((k, len(ce) - 1), dtype=np.int64)
         cd_h = np.zeros((k, len(de) - 1), dtype=np.int64)
         creep = np.zeros((k, len(CREEP_COLUMNS)))
+        intervals = np.zeros((k, len(INTERVAL_COLUMNS)))
         for s in range(k):
-            mu, tnu, interior, event_slip, creep_mu, creep_log_duration, taken, creep_slip = self.unit(s)
+            mu, tnu, interior, event_slip, creep_mu, creep_log_duration, taken, creep_slip, gaps = self.unit(s)
+            intervals[s] = [(tnu ** 2).sum(), len(gaps), gaps.sum(), (gaps ** 2).sum()]
             mu_h[s], t_h[s], ti_h[s] = histogram(mu, me), histogram(tnu, te), histogram(tnu[interior], te)
             cm_h[s], cd_h[s] = histogram(creep_mu, ce), histogram(creep_log_duration, de)
             creep[s] = [len(creep_mu), np.count_nonzero(taken), creep_slip.sum(), event_slip.sum()]
             gr = mu[mu >= opt["b_cut"]]
             numbers[s] = [len(mu), np.count_nonzero(mu >= opt["mu_c"]), len(tnu), tnu.sum(),
                           interior.sum(), tnu[interior].sum(), len(gr), gr.sum(), (gr ** 2).sum()]
-        return mu_h, t_h, ti_h, numbers, cm_h, cd_h, creep
+        return mu_h, t_h, ti_h, numbers, cm_h, cd_h, creep, intervals
 
 
 def _pool(units, pick):
@@ -472,7 +490,8 @@ def expected_summary(catalogs, opt):
            "bins/creep_mu": edges_of(opt, "creep_mu_edges"),
            "bins/creep_duration": edges_of(opt, "creep_duration_edges")}
     stacks = [t.per_stretch(opt) for t in per_task]
-    for j, name in enumerate(("mu", "tnu", "tnu_interior", "numbers", "creep_mu", "creep_duration", "creep")):
+    for j, name in enumerate(("mu", "tnu", "tnu_interior", "numbers", "creep_mu", "creep_duration", "creep",
+                              "intervals")):
         exp[f"per_task/{name}"] = np.stack([s[j] for s in stacks])
     results = []
     for params, rows in points:
@@ -535,7 +554,7 @@ def check_summary(s, expected, opt):
               "points/law",
               "points/peaks", "attrs"}
              | {f"per_task/{k}" for k in ("mu", "tnu", "tnu_interior", "numbers",
-                                          "creep_mu", "creep_duration", "creep")}
+                                          "creep_mu", "creep_duration", "creep", "intervals")}
              | {f"points/{p}" for p in PARAMS} | tasks_keys | numbers | curves)
     # a new output must get its brute-force check here
     assert set(s) == known, f"unchecked {set(s) - known}, missing {known - set(s)}"
@@ -573,6 +592,9 @@ def check_summary(s, expected, opt):
     got, want = s["per_task/creep"], expected["per_task/creep"]
     np.testing.assert_array_equal(got[..., :2], want[..., :2], err_msg="per_task/creep counts")
     np.testing.assert_allclose(got, want, rtol=RTOL, atol=0, err_msg="per_task/creep sums")
+    got, want = s["per_task/intervals"], expected["per_task/intervals"]
+    np.testing.assert_array_equal(got[..., 1], want[..., 1], err_msg="per_task/intervals counts")
+    np.testing.assert_allclose(got, want, rtol=RTOL, atol=0, err_msg="per_task/intervals sums")
     for key in sorted(curves):
         np.testing.assert_allclose(s[key], expected[key], rtol=RTOL, atol=0, err_msg=key)
     for key in sorted(numbers):

@@ -492,7 +492,8 @@ def test_peak_finder_reports_the_true_peaks_and_no_spurious_ones(case):
     would be, through the reduction's own peak step: exactly the true peaks, each within one bin
     and with an interval around it. The threshold (3 noise standard deviations) was chosen on such
     data: at 2 about 2-9% of histograms gained a spurious peak, at 3 and 4 none of 600."""
-    from analysis.reduce import Options, _peaks_with_intervals
+    from analysis.reduce import Options
+    from analysis.statistics.recurrence import peaks
     rng = np.random.default_rng(100 + case)
     edges = np.linspace(0.0, 2000.0, 81)
     shapes = [[], [(600.0, 80.0)], [(400.0, 60.0), (1300.0, 100.0)], "exponential"]
@@ -509,7 +510,7 @@ def test_peak_finder_reports_the_true_peaks_and_no_spurious_ones(case):
             x = rng.gamma(3.0, 250.0, n // 20)    # one broad maximum near 500
         units.append(np.histogram(x, edges)[0])
     opt = Options(np.linspace(0, 7, 71), edges, bootstrap=300)
-    rows = _peaks_with_intervals(np.array(units), opt, rng)
+    rows = peaks({"tnu": np.array(units)}, opt, rng)["peaks"]
     # true positions, and how far a histogram's maximum may stray: 1.5 bins, or 0.3 standard
     # deviations of a broad peak (the gamma's sd is 433; its maximum is found up to ~90 away)
     truth = ([(12.5, 0)] if shape == "exponential" else shape if shape else [(500.0, 433.0)])

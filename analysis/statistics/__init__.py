@@ -1,0 +1,178 @@
+"""Statistics of a catalog as plug-ins: one module per statistic, as the friction laws are one file each.
+
+A statistic (a module of this package that defines STATISTIC) declares
+
+- its tables: additive per-unit arrays, one row per (task, stretch), stored as /per_task/<table>.
+  A table is a histogram over a set of bins (`bins`, the options' `<bins>_edges`) or named columns
+  of counts and sums (`columns`); statistics may share a table of columns, each adding its own
+  columns (the columns are laid out in the order of the statistics, then of their declaration).
+  Additive, so that merging tasks and ranks and resampling units are exact: every estimate is a
+  function of a sum over units.
+- `feed(acc, rows)`: add one chunk of a task's rows to the tables (rows: `Rows`, below).
+- its numbers (name, unit, meaning) and `estimate(u, opt)`: their values from summed tables `u`
+  (u.table(name) the array, u.column(table, column) one column), in the order declared.
+- its curves: densities of a histogram table (`table`), normalised by a count column (`total`), over
+  the table's bins.
+- optionally `extra(units, opt, rng)`: {name: array} per point beyond numbers and curves, computed after
+  the bootstrap of the numbers and curves (the recurrence peaks).
+
+The engine (analysis/reduce.py) streams each task once, hands every statistic the same rows, stacks the
+tables of a point's units, bootstraps them all alike, and the summary stores and describes what the
+statistics declare. Adding a statistic is one module here and its test.
+"""
+import importlib
+import pkgutil
+from dataclasses import dataclass, field
+from typing import Callable, Optional
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Table:
+    """An additive per-unit array: a histogram over `bins`, or the named `columns` (counts and sums)."""
+    name: str
+    unit: str
+    meaning: str
+    bins: str = ""
+    columns: tuple = ()
+
+
+@dataclass(frozen=True)
+class Number:
+    name: str
+    unit: str
+    meaning: str
+    label: str = ""      # a few characters for `analysis report` (default: the name)
+
+
+@dataclass(frozen=True)
+class Curve:
+    """The density of histogram table `table` over its bins, `total` = (table, column) counting the
+    values in and out of range; described as the density of `variable` of `whose` (unit `unit`)."""
+    name: str
+    table: str
+    total: tuple
+    variable: str
+    whose: str
+    unit: str
+
+
+@dataclass(frozen=True)
+class Statistic:
+    name: str
+    order: int                      # place among the statistics (their tables' columns, numbers, curves)
+    needs: tuple = ()               # "recurrences": the engine scans the task's recurrence times for it
+    tables: tuple = ()
+    numbers: tuple = ()
+    curves: tuple = ()
+    feed: Callable = None
+    estimate: Callable = None
+    extra: Optional[Callable] = None
+    extra_datasets: dict = field(default_factory=dict)   # /points/<name>: (unit, shape, meaning) of extra's
+
+
+def _discover():
+    found = []
+    for info in pkgutil.iter_modules(__path__):
+        module = importlib.import_module(f"{__name__}.{info.name}")
+        if hasattr(module, "STATISTIC"):
+            found.append(module.STATISTIC)
+    found.sort(key=lambda s: (s.order, s.name))
+    names = [s.name for s in found]
+    if len(set(names)) != len(names):
+        raise ImportError(f"analysis.statistics: two statistics share a name ({names})")
+    return tuple(found)
+
+
+STATISTICS = _discover()
+
+
+class Layout:
+    """Where every table and column lives: the tables in the statistics' order, columns of shared tables
+    concatenated (first declaration first), and the numbers and curves in order."""
+
+    def __init__(self, statistics=STATISTICS):
+        self.statistics = statistics
+        self.tables = {}           # name -> Table (bins) or merged column table
+        self.columns = {}          # table -> [column names]
+        for s in statistics:
+            for t in s.tables:
+                if t.bins:
+                    if t.name in self.tables:
+                        raise ValueError(f"table {t.name}: declared twice")
+                    self.tables[t.name] = t
+                else:
+                    self.tables.setdefault(t.name, t)
+                    self.columns.setdefault(t.name, [])
+                    clash = set(self.columns[t.name]) & set(t.columns)
+                    if clash:
+                        raise ValueError(f"table {t.name}: columns {sorted(clash)} declared twice")
+                    self.columns[t.name] += list(t.columns)
+        self.numbers = [n for s in statistics for n in s.numbers]
+        self.curves = [c for s in statistics for c in s.curves]
+        self.bins = sorted({t.bins for t in self.tables.values() if t.bins}, key=self._bins_order)
+
+    def _bins_order(self, name):
+        return [t.bins for t in self.tables.values() if t.bins].index(name)
+
+    def width(self, table, edges):
+        """Entries per unit of `table`: its bins, or its columns."""
+        t = self.tables[table]
+        return len(edges[t.bins]) - 1 if t.bins else len(self.columns[table])
+
+    def column(self, table, name):
+        return self.columns[table].index(name)
+
+    def sum_of(self, arrays):
+        """Tables of summed units (1-d arrays) with columns by name."""
+        return Tables(self, arrays)
+
+    def empty(self, blocks, edges):
+        """Zeroed tables of one task: {table: (blocks, width)} (histograms int64, columns float64)."""
+        return Tables(self, {name: np.zeros((blocks, self.width(name, edges)),
+                                            np.int64 if t.bins else np.float64)
+                             for name, t in self.tables.items()})
+
+
+class Tables(dict):
+    """{table: array} of one task (rows: stretches) or of a sum (1-d), with columns by name."""
+
+    def __init__(self, layout, arrays):
+        super().__init__(arrays)
+        self.layout = layout
+
+    def column(self, table, name):
+        return self[table][..., self.layout.column(table, name)]
+
+    def add(self, table, name, block, values):
+        """Add `values` to column `name` of `table` at stretches `block` (unbuffered, repeated indices add)."""
+        np.add.at(self[table][:, self.layout.column(table, name)], block, values)
+
+    def count(self, table, block, values, edges):
+        """Histogram `values` into `table` (bins `edges`) at stretches `block`; out of range: not counted."""
+        idx = np.searchsorted(edges, values, side="right") - 1
+        ok = (idx >= 0) & (idx < len(edges) - 1)
+        np.add.at(self[table], (block[ok], idx[ok]), 1)
+
+
+@dataclass
+class Rows:
+    """One chunk of a task's rows, as every statistic sees it.
+
+    part: the chunk's columns (every kind); inertial: bool mask of its inertial events; ev: the inertial
+    events' columns; block: the stretch of each inertial event; creep: mask of its creep episodes and
+    creep_block their stretches; recurrences: (stretch of the starting event, T nu, interior) of the
+    recurrences closed in this chunk, or None when no statistic asks for them; t_before: the time of the
+    task's last inertial event before this chunk (NaN before its first); nu, opt.
+    """
+    part: dict
+    inertial: np.ndarray
+    ev: Optional[dict]
+    block: Optional[np.ndarray]
+    creep: np.ndarray
+    creep_block: Optional[np.ndarray]
+    recurrences: Optional[tuple]
+    t_before: float
+    nu: float
+    opt: object

@@ -1,0 +1,30 @@
+"""The magnitude distribution R(mu) of the inertial events, and the share of large ones (mu >= mu_c)."""
+import numpy as np
+
+from . import Curve, Number, Statistic, Table
+
+
+def feed(acc, rows):
+    if rows.ev is None:
+        return
+    mu = rows.ev["mu"]
+    acc.count("mu", rows.block, mu, rows.opt.mu_edges)
+    acc.add("numbers", "n_events", rows.block, 1)
+    acc.add("numbers", "n_large", rows.block, mu >= rows.opt.mu_c)
+
+
+def estimate(u, opt):
+    n, large = u.column("numbers", "n_events"), u.column("numbers", "n_large")
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return [n, large, large / n]
+
+
+STATISTIC = Statistic(
+    "magnitude", 10,
+    tables=(Table("mu", "count", "events per magnitude bin, per task and stretch", bins="mu"),
+            Table("numbers", "count or sum", "counts and sums of the inertial events", columns=("n_events", "n_large"))),
+    numbers=(Number("n_events", "count", "inertial events (/events/kind 0: creep episodes are in none of these numbers)"),
+             Number("n_large", "count", "large events (mu >= mu_c)"),
+             Number("fraction_large", "1", "fraction of the events with mu >= mu_c")),
+    curves=(Curve("mu", "mu", ("numbers", "n_events"), "mu", "all events", "1/mu"),),
+    feed=feed, estimate=estimate)

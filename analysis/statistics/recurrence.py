@@ -1,0 +1,81 @@
+"""Local recurrence times T of large events (analysis/recurrence.py scans them): their distribution, of all
+recurrences and of those starting at an interior event, their means and mode, and the significant peaks."""
+import numpy as np
+
+from .. import stats
+from . import Curve, Number, Statistic, Table
+
+
+def feed(acc, rows):
+    if rows.recurrences is None:
+        return
+    block, tnu, interior = rows.recurrences
+    edges = rows.opt.tnu_edges
+    acc.count("tnu", block, tnu, edges)
+    acc.count("tnu_interior", block[interior], tnu[interior], edges)
+    acc.add("numbers", "n_rec", block, 1)
+    acc.add("numbers", "sum_tnu", block, tnu)
+    acc.add("numbers", "n_rec_int", block[interior], 1)
+    acc.add("numbers", "sum_tnu_int", block[interior], tnu[interior])
+
+
+def estimate(u, opt):
+    tnu = u["tnu"]
+    mode = stats.centers(opt.tnu_edges)[np.argmax(tnu)] if tnu.sum() > 0 else np.nan
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return [u.column("numbers", "n_rec"), u.column("numbers", "sum_tnu") / u.column("numbers", "n_rec"), mode,
+                u.column("numbers", "sum_tnu_int") / u.column("numbers", "n_rec_int")]
+
+
+def peaks(units, opt, rng):
+    """Significant recurrence peaks of the merged histogram (stats.find_peaks), each with the
+    interval of the nearest peak across bootstrap resamples. Rows: (position, lo, hi).
+
+    The noise of each smoothed bin is the standard deviation of its bootstrap resamples over the
+    units, at least the Poisson value (with one unit, or few, the bootstrap understates it).
+    """
+    tnu_units = units["tnu"]
+    total = tnu_units.sum(axis=0)
+    noise = stats.poisson_noise(total)
+    resampled = None
+    if len(tnu_units) >= 2 and total.sum() > 0:
+        picks = rng.integers(0, len(tnu_units), size=(opt.bootstrap, len(tnu_units)))
+        resampled = np.array([tnu_units[p].sum(axis=0) for p in picks])
+        spread = np.array([stats.smooth(c) for c in resampled]).std(axis=0, ddof=1)
+        noise = np.maximum(noise, spread)
+    base = stats.find_peaks(total, opt.tnu_edges, noise)
+    if len(base) == 0 or resampled is None:
+        return {"peaks": np.array([[p, np.nan, np.nan] for p in base]).reshape(-1, 3)}
+    width = opt.tnu_edges[1] - opt.tnu_edges[0]
+    found = [[] for _ in base]
+    for counts in resampled:
+        near_peaks = stats.find_peaks(counts, opt.tnu_edges, noise)
+        for i, b in enumerate(base):
+            if len(near_peaks):
+                near = near_peaks[np.argmin(np.abs(near_peaks - b))]
+                if abs(near - b) <= 5 * width:
+                    found[i].append(near)
+    rows = []
+    for b, f in zip(base, found):
+        lo, hi = (np.percentile(f, [50 * (1 - opt.level), 100 - 50 * (1 - opt.level)])
+                  if len(f) else (np.nan, np.nan))
+        rows.append([b, lo, hi])
+    return {"peaks": np.array(rows)}
+
+
+STATISTIC = Statistic(
+    "recurrence", 20, needs=("recurrences",),
+    tables=(Table("tnu", "count", "recurrences per T nu bin, per task and stretch of their starting event", bins="tnu"),
+            Table("tnu_interior", "count", "the same for the recurrences starting at an interior event", bins="tnu"),
+            Table("numbers", "count or sum", "counts and sums of the recurrences",
+                  columns=("n_rec", "sum_tnu", "n_rec_int", "sum_tnu_int"))),
+    numbers=(Number("n_recurrences", "count", "recurrences: large events closed by a later one within `window` blocks"),
+             Number("mean_tnu", "model length", "mean T nu of all recurrences"),
+             Number("mode_tnu", "model length", "centre of the highest T nu bin"),
+             Number("mean_tnu_interior", "model length", "mean T nu of the recurrences starting at an interior event")),
+    curves=(Curve("tnu", "tnu", ("numbers", "n_rec"), "T nu", "all recurrences", "1/model length"),
+            Curve("tnu_interior", "tnu_interior", ("numbers", "n_rec_int"), "T nu",
+                  "the recurrences starting at an interior event (boundary false)", "1/model length")),
+    feed=feed, estimate=estimate, extra=peaks,
+    extra_datasets={"peaks": ("model length", "(points, most peaks, 3): position, lo, hi; NaN rows pad",
+                              "recurrence peaks of the T nu histogram, highest first (analysis/stats.py find_peaks)")})
