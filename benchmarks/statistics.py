@@ -398,6 +398,27 @@ def with_rerun(floor, ref_seeds, rerun_seeds):
     return out
 
 
+def rerun_rows(rows, pools, rerun_seeds):
+    """Every setting against the rerun (the reference's integrator from another root seed, the candidates'):
+    the reference's own distance from it is the size of the sampling noise in one pair of samples."""
+    rerun = pooled(rerun_seeds)
+    if rerun["status"] != "ok":
+        return []
+    large = float(np.mean(rerun["mu"] >= 4))
+    return [{**summarize(r["setting"], pool, rerun), "fraction_large_rerun": large}
+            for r, pool in zip(rows, pools) if pool["status"] == "ok"]
+
+
+def rerun_lines(rows):
+    keys = [f"{n}_{s}" for s in SAMPLES for n in DISTANCES]
+    lines = ["against the rerun (first row: the reference; then each candidate):",
+             f"  {'setting':26s} {'frac>=4':>8s} {'rerun':>7s} " + " ".join(f"{k:>8s}" for k in keys)]
+    for r in rows:
+        lines.append(f"  {r['setting']:26s} {r['fraction_large']:8.4f} {r['fraction_large_rerun']:7.4f} "
+                     + " ".join(f"{r[k]:8.4f}" for k in keys))
+    return lines
+
+
 def within_noise(rows, floor):
     """Labels of the candidates every distance of which is at most the noise floor's max."""
     keys = [f"{n}_{s}" for s in SAMPLES for n in DISTANCES]
@@ -431,12 +452,15 @@ def compare_catalogs(args):
         stem = point_stem(args.name, point, list(ref["points"]))
         inside = within_noise(rows, floor)
         lines = table(rows, floor, title) + catalog_notes(settings + ([rerun] if rerun else []), point)
+        against_rerun = []
         if rerun:
             lines.append(f"noise floor: also the halves of the rerun {rerun['path']} (root seed "
                          f"{rerun['root_seed']}) and its distance from the reference")
+            against_rerun = rerun_rows(rows, pools, rerun["points"][point]["per_seed"])
+            lines += rerun_lines(against_rerun)
         lines.append(f"within the noise (every distance <= the floor's max): {', '.join(inside) or 'none'}")
         data = {"config": vars(args), "point": dict(point), "rows": rows, "noise_floor": floor,
-                "within_noise": inside,
+                "within_noise": inside, "against_rerun": against_rerun,
                 "catalogs": [{"path": s["path"], "label": s["label"], "root_seed": s["root_seed"],
                               "transient": s["transient"], "events_written": s["points"][point]["written"],
                               "events_planned": s["points"][point]["planned"],

@@ -457,5 +457,11 @@ def test_statistics_rerun_widens_the_floor_and_names_the_settings_within_it():
             {"setting": "close", "status": "ok", **{k: 0.5 * wide[k]["max"] for k in keys}},
             {"setting": "one off", "status": "ok", **{k: 0.5 * wide[k]["max"] for k in keys}, "w1_tnu": 1e9}]
     assert statistics.within_noise(rows, wide) == ["close"]
+    # every setting against the rerun: the reference's row is the direct distance, a candidate's its own
+    pools = [statistics.pooled(ref), statistics.pooled(seeds(0.3))]
+    against = statistics.rerun_rows([{"setting": "ref"}, {"setting": "near the rerun"}], pools, rerun)
+    assert [r["setting"] for r in against] == ["ref", "near the rerun"]
+    assert against[0]["ks_mu"] == pytest.approx(direct) and against[1]["ks_mu"] < direct / 3
+    assert against[1]["fraction_large_rerun"] == pytest.approx(np.mean(statistics.pooled(rerun)["mu"] >= 4))
     with pytest.raises(SystemExit):
         statistics.main(["--rerun", "x.h5"])      # a catalog-mode option without --catalogs
