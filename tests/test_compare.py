@@ -234,7 +234,7 @@ def test_two_laws_with_the_same_keys_are_two_points(two_laws, tmp_path):
     import h5py
     d, (_, aging) = two_laws
     slip = write_config(tmp_path / "slip.toml", model={"N": 50, "b": 20.0, "law": "slip"},
-                        run={"events": 300, "transient": 50, "seeds": 2}, integrator={"method": "ark4"})
+                        run={"events": 40, "transient": 10, "seeds": 2}, integrator={"method": "ark4"})
     res = run_cli("run", slip, "-o", tmp_path / "slip.h5")
     assert res.returncode == 0, res.stderr
     kinds = {}

@@ -350,7 +350,7 @@ def test_signal_during_kernel_compilation_is_acknowledged_at_once(small, tmp_pat
 def test_kernel_calls_paused_in_the_middle_of_events_give_the_same_catalog(small, tmp_path):
     """poll_seconds so short that most kernel calls end inside an event (rk4 at a small dt)."""
     d, cfg = small
-    slow = ["--set", "integrator.dt=2e-5", "--set", "run.events=30"]
+    slow = ["--set", "integrator.dt=2e-5", "--set", "run.events=8", "--set", "run.transient=2"]
     ref = tmp_path / "ref.h5"
     assert cli("run", cfg, "-o", ref, *slow, "--set", "run.poll_seconds=100").returncode == 0
     out = tmp_path / "paused.h5"
