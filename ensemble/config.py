@@ -98,7 +98,8 @@ class Run:
 # recurrence times at b = 50 are not (benchmarks/statistics.py --catalogs, docs/benchmarks.md).
 @dataclass(frozen=True)
 class Integrator:
-    method: str = "ark4"           # event integrator (see ensemble.integrators.INTEGRATORS)
+    method: str = "ark4"           # event integrator (ensemble.integrators.INTEGRATORS); a config file without it
+                                   # takes its law's (Law.method: exp4 for the aging law, ark4 for the others)
     dt: float = 1e-3               # time step of "rk4"; first step of the adaptive methods
     rtol: float = 1e-4             # adaptive methods (ark3, ark4, ark5): relative tolerance of the local error per step
     atol: float = 1e-12            # adaptive methods: absolute tolerance (slip, velocity)
@@ -346,6 +347,9 @@ def from_dict(raw, overridden=None):
             raise ConfigError(f"unknown section [{name}] (known: {', '.join(sorted(allowed))})")
     parts = {name: _section(name, raw.get(name, {}), overridden) for name in SECTIONS}
     cfg = Config(sweep=_sweep(raw.get("sweep", {}), overridden), **parts)
+    if "method" not in raw.get("integrator", {}):      # the law's own (the resolved config records it)
+        cfg = dataclasses.replace(cfg, integrator=dataclasses.replace(cfg.integrator,
+                                                                      method=laws.get(cfg.model.law).method))
     for key, _ in cfg.sweep:
         if key in LAW_KEYS and key not in cfg.model.law_keys():
             raise ConfigError(f"sweep.{key} does not belong to model.law = {cfg.model.law!r} "

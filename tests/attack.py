@@ -59,6 +59,8 @@ b = [15.0, 25.0]
 seeds = 2
 events = 60
 transient = 10
+[integrator]
+method = "ark4"   # the default of the format-5 commit, so that its events and this version's are the same
 [output]
 batch = 20
 flush_seconds = 1000.0

@@ -8,7 +8,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from ensemble.config import Integrator, Model
+from ensemble.config import Integrator, Model, loads
 from ensemble.events import advance_to_onset, check, run_event
 from ensemble.model import laws
 from ensemble.model.exponential import phis
@@ -142,3 +142,17 @@ def test_a_law_with_a_state_not_linear_in_theta_is_refused_naming_the_keys():
     assert METHODS["exp4"].refusal(aging) is None
     assert METHODS["exp4"].refusal(laws.get("carlson-langer")) is None
     assert all(METHODS[m].refusal(slip_law) is None for m in ("rk4", "ark3", "ark4", "ark5"))
+
+
+def test_a_config_without_a_method_takes_its_laws():
+    """integrator.method left out: the law's own (Law.method: exp4 for the aging law, whose statistics
+    match the tight reference; ark4 for the slip law, which exp4 refuses, and for Carlson-Langer); the
+    resolved config, which every catalog stores, names it; a method given is kept."""
+    for law, extra, method in (("aging", "", "exp4"), ("slip", "", "ark4"),
+                               ("carlson-langer", "alpha = 2.0\nsigma = 0.01\n", "ark4")):
+        cfg = loads(f'[model]\nlaw = "{law}"\n{extra}')
+        assert cfg.integrator.method == method == laws.get(law).method
+        assert f'method = "{method}"' in cfg.to_toml()
+        assert loads(cfg.to_toml()) == cfg
+    assert loads('[model]\nb = 20.0\n[integrator]\nmethod = "ark4"\n').integrator.method == "ark4"
+    assert loads('[model]\nb = 20.0\n[integrator]\nrtol = 1e-5\n').integrator.method == "exp4"

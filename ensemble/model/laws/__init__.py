@@ -63,6 +63,8 @@ class Law:
     stiff_limit: object   # (law, rate_limit) -> the state bound beyond which RK4 is unstable
     rk4_unstable: object  # (law, v, psi, rate_limit, state_limit) -> RK4's step left its stability region
     scales: Scales        # the reduction's defaults for this law's magnitudes and recurrence times
+    method: str = "ark4"  # integrator.method of a config that does not set it: the fastest method whose
+                          # statistics are those of the tight reference for this law (docs/benchmarks.md)
     linear_state: object = None  # (law, v) -> (s, r): the state's equation is linear in theta = exp(psi),
                           # theta' = s - r theta while sliding, with s and r functions of v alone (the
                           # exponential integrator, model/exponential.py, solves it exactly over a step);
