@@ -129,9 +129,10 @@ def _parser():
     pl.add_argument("summaries", nargs="+", metavar="summary",
                     help="one or more summaries: their points in one figure, labelled by the "
                          "parameters that differ between them")
-    pl.add_argument("--figure", choices=("magnitude", "recurrence", "creep"), required=True,
+    pl.add_argument("--figure", choices=("magnitude", "recurrence", "creep", "seismicity"), required=True,
                     help="creep: the creep episodes' size and duration densities and the aseismic slip "
-                         "fraction (points with creep episodes; an error if none has any)")
+                         "fraction (points with creep episodes; an error if none has any); seismicity: the "
+                         "rate of events around mainshocks by distance and time, one map per point")
     pl.add_argument("-o", "--output", required=True, help="FILE.png or FILE.pdf")
     pl.add_argument("--title", default=None)
     pl.add_argument("--force", action="store_true", help="overwrite an existing figure")
@@ -142,7 +143,7 @@ def _parser():
     pa.add_argument("summaries", nargs="+", metavar="summary",
                     help="each claim reads the summary with the most of the points it needs (the first of equals)")
     from .export import FORMATS
-    ex = sub.add_parser("export", help="catalog (events, tasks) or summary (curves, numbers, peaks) -> "
+    ex = sub.add_parser("export", help="catalog (events, tasks) or summary (curves, numbers, peaks, seismicity) -> "
                                        "tables for other tools (docs/running.md)")
     ex.add_argument("source", help="an event catalog or a reduction summary")
     ex.add_argument("--format", choices=sorted(FORMATS), default="csv", help="file format (default csv)")
