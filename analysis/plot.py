@@ -326,7 +326,7 @@ def seismicity(summaries, fig, labels, names):
                                           ((a["seis_near"], a["seis_ring"]), (-a["seis_long"], 0), ":")):
             ax.plot([d0, d1, d1, d0, d0], [t0, t0, t1, t1, t0], style, color="k", lw=0.9)
         ax.axhline(0.0, color="k", lw=0.5, alpha=0.5)
-        ax.set_title(f"{label}: {count_text(s['points/numbers/n_large'][i][0])} mainshocks "
+        ax.set_title(f"{label}\n{count_text(s['points/numbers/n_large'][i][0])} mainshocks "
                      f"(mu >= {a['mu_c']:g})", fontsize=FONT + 1)
         ax.set_xlabel("distance from the mainshock's epicenter (blocks)")
         ax.set_ylabel(r"time from its onset, $T\nu$")
@@ -404,9 +404,9 @@ def figure(summaries, kind, title=None, names=None):
         _layout(fig, text, 0.45 + 0.2 * math.ceil((n + 1) / 4))   # the figure legend below the panels
     elif kind == "seismicity":
         rows, cols = _grid(n)
-        fig = plt.figure(figsize=(5.2 * cols + 1.2, 4 * rows + 0.6), dpi=DPI)
+        fig = plt.figure(figsize=(5.2 * cols + 1.2, 4.2 * rows + 0.8), dpi=DPI)
         fig.subplots_adjust(left=0.09, right=0.86, bottom=(0.55 + 0.3) / fig.get_figheight(),
-                            top=1 - 0.9 / fig.get_figheight(), hspace=0.45, wspace=0.3)
+                            top=1 - 1.1 / fig.get_figheight(), hspace=0.55, wspace=0.3)
         seismicity(summaries, fig, labels, names)
         fig.suptitle(text, fontsize=FONT + 1, wrap=True)
     else:
