@@ -87,14 +87,19 @@ def coverage(T, start, end, time_edges):
     return np.maximum(np.minimum(b, end) - np.maximum(a, start), 0.0)
 
 
+BATCH = 1024   # mainshocks whose exposures are added at once (their (mainshocks, N) and (mainshocks, cells) arrays)
+
+
 def _expose(acc, carry, take, end, opt):
-    """Add the exposures of the pending mainshocks `take` (a mask, in time order) with the span ending at `end`."""
-    if not take.any():
-        return
-    cov = coverage(carry["pending_T"][take], carry["start"], end, opt.seis_time_edges)
-    space = sites(carry["pending_x"][take], carry["n_blocks"], opt.seis_distance_edges)
-    exposure = (cov[:, :, None] * space[:, None, :]).reshape(len(cov), -1)
-    np.add.at(acc["seis_exposure"], carry["pending_s"][take], exposure)
+    """Add the exposures of the pending mainshocks `take` (a mask, in time order) with the span ending at `end`,
+    one after the other (np.add.at adds in order: the sums are the same whatever the chunks and batches)."""
+    which = np.flatnonzero(take)
+    for a in range(0, len(which), BATCH):
+        pick = which[a:a + BATCH]
+        cov = coverage(carry["pending_T"][pick], carry["start"], end, opt.seis_time_edges)
+        space = sites(carry["pending_x"][pick], carry["n_blocks"], opt.seis_distance_edges)
+        exposure = (cov[:, :, None] * space[:, None, :]).reshape(len(cov), -1)
+        np.add.at(acc["seis_exposure"], carry["pending_s"][pick], exposure)
 
 
 def feed(acc, rows):
