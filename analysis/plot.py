@@ -369,6 +369,9 @@ def title_text(summaries, names, title=None, kind=None):
     (events reduced of expected), whatever the title."""
     levels = " / ".join(dict.fromkeys(level_text(s["attrs"]["level"]) for s in summaries))
     bands = f"bands: {levels} bootstrap over {_values(_units(s) for s in summaries)}"
+    if kind == "seismicity":   # a map has no band: its numbers (analysis report) have the intervals
+        bands = (f"\nmaps without intervals; the numbers' {levels} intervals (analysis report) over "
+                 f"{_values(_units(s) for s in summaries)}")
     if kind == "creep":
         description = f"{_creep_sizes(summaries)}; {bands}"
     else:
