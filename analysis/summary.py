@@ -67,8 +67,8 @@ from .statistics import bin_names
 FORMAT = filekind.SUMMARY_FORMAT_PREFIX + "5"   # 5: the seismicity around large events (/bins/seis_*,
 # /per_task/seis_*, /per_task/seismicity, /points/seismicity_rate, its numbers, the seis_* attributes). 4: the
 # intervals statistic (/per_task/intervals, cv_tnu, mean_gap, cv_gap). 3: the creep episodes (bins, per-task
-# counts and sums, densities, CREEP_NUMBERS). 2: GR b and its standard error, 9 per-task sums, peaks by prominence; several catalogs (catalogs, configs, partial,
-# /tasks/catalog, catalog_task, catalog_point)
+# counts and sums, densities, CREEP_NUMBERS). 2: GR b and its standard error, 9 per-task sums, peaks by
+# prominence; several catalogs (catalogs, configs, partial, /tasks/catalog, catalog_task, catalog_point)
 # formats 4, 3 and 2 still read, without the datasets that came after them (a number a summary lacks is not shown)
 READS = (FORMAT, *(filekind.SUMMARY_FORMAT_PREFIX + n for n in "432"))
 
