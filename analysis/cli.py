@@ -29,7 +29,8 @@ from ensemble import checks, filekind
 from ensemble.catalog import CatalogError
 
 from . import merge, summary
-from .reduce import CREEP_DURATION_BINS, CREEP_MU_BINS, LAYOUT, NUMBERS, Options, bin_edges, parse_bins
+from .reduce import (CREEP_DURATION_BINS, CREEP_MU_BINS, LAYOUT, NUMBERS, SEIS_DISTANCE_BINS, SEIS_LONG, SEIS_NEAR,
+                     SEIS_RING, SEIS_SHORT, SEIS_TIME_BINS, Options, bin_edges, parse_bins)
 
 # errors that reduce's rank 0 finds before the work starts and every rank then raises alike
 # (ensemble.abort.on_root), with their exit codes; any other error on any rank aborts them all
@@ -49,6 +50,12 @@ NUMERIC = {
     "tnu_bins": lambda v: _bins("--tnu-bins", v),
     "creep_mu_bins": lambda v: _bins("--creep-mu-bins", v),
     "creep_duration_bins": lambda v: _bins("--creep-duration-bins", v),
+    "seis_time_bins": lambda v: _bins("--seis-time-bins", v),
+    "seis_distance_bins": lambda v: _bins("--seis-distance-bins", v),
+    "seis_near": lambda v: checks.number("--seis-near", v, 0.0, 1e9),
+    "seis_ring": lambda v: checks.number("--seis-ring", v, 0.0, 1e9),
+    "seis_short": lambda v: checks.number("--seis-short", v, 0.0, 1e300),
+    "seis_long": lambda v: checks.number("--seis-long", v, 0.0, 1e300),
     "window": lambda v: checks.count("--window", v, lo=0, hi=10 ** 9),
     "bootstrap": lambda v: checks.count("--bootstrap", v, lo=1, hi=10 ** 6),
     "level": lambda v: checks.number("--level", v, 0.0, 1.0, exclusive=True),
@@ -93,6 +100,20 @@ def _parser():
     r.add_argument("--creep-duration-bins", default=CREEP_DURATION_BINS,
                    help="bins lo:hi:n of the creep episodes' log10(duration nu), duration in units of the "
                         f"loading time 1/nu (default {CREEP_DURATION_BINS})")
+    r.add_argument("--seis-time-bins", default=SEIS_TIME_BINS,
+                   help="seismicity around mainshocks (mu >= mu_c): bins lo:hi:n of the time T*nu from a mainshock's "
+                        f"onset, negative before it (default {SEIS_TIME_BINS}, for the aging law; a negative lo "
+                        "after '=')")
+    r.add_argument("--seis-distance-bins", default=SEIS_DISTANCE_BINS,
+                   help=f"its bins lo:hi:n of the distance from the epicenter, blocks (default {SEIS_DISTANCE_BINS})")
+    r.add_argument("--seis-near", default=SEIS_NEAR,
+                   help=f"its epicentral neighbourhood: distance < this, blocks (default {SEIS_NEAR:g})")
+    r.add_argument("--seis-ring", default=SEIS_RING,
+                   help=f"its ring: from --seis-near to this, blocks (default {SEIS_RING:g})")
+    r.add_argument("--seis-short", default=SEIS_SHORT,
+                   help=f"its 'just before' and 'just after' the onset, T*nu (default {SEIS_SHORT:g})")
+    r.add_argument("--seis-long", default=SEIS_LONG,
+                   help=f"its 'some time before': from -this to --seis-short, T*nu (default {SEIS_LONG:g})")
     r.add_argument("--mu-c", help="large-event magnitude (default: the law's; aging 4)")
     r.add_argument("--window", default=10, help="epicenter window in blocks (default 10)")
     r.add_argument("--b-cut", help="magnitude cut of the GR b fit (default: the law's; aging 3)")
@@ -108,9 +129,10 @@ def _parser():
     pl.add_argument("summaries", nargs="+", metavar="summary",
                     help="one or more summaries: their points in one figure, labelled by the "
                          "parameters that differ between them")
-    pl.add_argument("--figure", choices=("magnitude", "recurrence", "creep"), required=True,
+    pl.add_argument("--figure", choices=("magnitude", "recurrence", "creep", "seismicity"), required=True,
                     help="creep: the creep episodes' size and duration densities and the aseismic slip "
-                         "fraction (points with creep episodes; an error if none has any)")
+                         "fraction (points with creep episodes; an error if none has any); seismicity: the "
+                         "rate of events around mainshocks by distance and time, one map per point")
     pl.add_argument("-o", "--output", required=True, help="FILE.png or FILE.pdf")
     pl.add_argument("--title", default=None)
     pl.add_argument("--force", action="store_true", help="overwrite an existing figure")
@@ -121,7 +143,7 @@ def _parser():
     pa.add_argument("summaries", nargs="+", metavar="summary",
                     help="each claim reads the summary with the most of the points it needs (the first of equals)")
     from .export import FORMATS
-    ex = sub.add_parser("export", help="catalog (events, tasks) or summary (curves, numbers, peaks) -> "
+    ex = sub.add_parser("export", help="catalog (events, tasks) or summary (curves, numbers, peaks, seismicity) -> "
                                        "tables for other tools (docs/running.md)")
     ex.add_argument("source", help="an event catalog or a reduction summary")
     ex.add_argument("--format", choices=sorted(FORMATS), default="csv", help="file format (default csv)")
@@ -230,7 +252,11 @@ def _prepare(args):
     opt = Options(parse_bins(scale["mu_bins"], "--mu-bins"), parse_bins(scale["tnu_bins"], "--tnu-bins"),
                   scale["mu_c"], args.window, scale["b_cut"], args.bootstrap, args.level, args.blocks, args.seed,
                   creep_mu_edges=parse_bins(args.creep_mu_bins, "--creep-mu-bins"),
-                  creep_duration_edges=parse_bins(args.creep_duration_bins, "--creep-duration-bins"))
+                  creep_duration_edges=parse_bins(args.creep_duration_bins, "--creep-duration-bins"),
+                  seis_time_edges=parse_bins(args.seis_time_bins, "--seis-time-bins"),
+                  seis_distance_edges=parse_bins(args.seis_distance_bins, "--seis-distance-bins"),
+                  seis_near=args.seis_near, seis_ring=args.seis_ring, seis_short=args.seis_short,
+                  seis_long=args.seis_long)
     _memory(opt, len(inputs.tasks["point"]))
     return opt, out, inputs
 

@@ -8,6 +8,7 @@
     cu = export.curves("my.summary.h5")          # one row per point, curve and bin: density, lo, hi
     nb = export.numbers("my.summary.h5")         # one row per point: parameters, every number, lo, hi
     pk = export.peaks("my.summary.h5")           # one row per recurrence peak of a point
+    sm = export.seismicity("my.summary.h5")      # one row per point, time bin and distance bin of its map
     df = export.numbers("my.summary.h5", frame=True)   # a pandas DataFrame (pandas is optional)
     export.columns("my.h5", "events")            # {column: (unit, meaning)}
     export.write("my.h5", "tables/")             # what `python -m analysis export my.h5 -o tables/` does
@@ -57,8 +58,9 @@ TITLES = {   # table -> what its rows are (said in its file's header)
     "curves": "one row per point, curve and bin",
     "numbers": "one row per parameter point",
     "peaks": "one row per recurrence peak of a point",
+    "seismicity": "one row per point, time bin and distance bin of the seismicity around its mainshocks",
 }
-SUMMARY_SETTINGS = ("mu_c", "window", "b_cut", "bootstrap", "level", "blocks", "seed")
+SUMMARY_SETTINGS = ("mu_c", "window", "b_cut", "bootstrap", "level", "blocks", "seed", *summary.SEIS_ATTRS)
 
 
 @dataclass
@@ -241,6 +243,29 @@ def _peaks(s):
     return Table(columns, [_structured(columns, values)])
 
 
+def _seismicity(s):
+    """The maps of the seismicity around large events, long format (no rows for a summary before format 5)."""
+    columns = {
+        "point": ("index", "parameter point (row of numbers.csv)"),
+        "time_lo": ("model length", "lower edge of the time bin: T nu from the mainshock's onset, negative before it"),
+        "time_hi": ("model length", "upper edge of the time bin (bins are half-open)"),
+        "distance_lo": ("blocks", "lower edge of the distance bin: blocks from the mainshock's epicenter"),
+        "distance_hi": ("blocks", "upper edge of the distance bin (bins are half-open)"),
+        "rate": _summary_column("points/seismicity_rate")[:1] + (
+            "events per mainshock per block per unit T nu in the cell (NaN where nothing was exposed); the "
+            "background rate is in numbers.csv",),
+    }
+    values = {name: np.zeros(0) for name in columns}
+    if summary.has_seismicity(s):
+        rate, te, de = s["points/seismicity_rate"], s["bins/seis_time"], s["bins/seis_distance"]
+        point, j, k = (a.ravel() for a in np.meshgrid(np.arange(len(rate)), np.arange(len(te) - 1),
+                                                       np.arange(len(de) - 1), indexing="ij"))
+        values = {"point": point.astype(np.int64), "time_lo": te[j], "time_hi": te[j + 1], "distance_lo": de[k],
+                  "distance_hi": de[k + 1], "rate": rate[point, j, k]}
+    values["point"] = values["point"].astype(np.int64)
+    return Table(columns, [_structured(columns, values)])
+
+
 def _whole(table):
     parts = list(table.parts)
     if not parts:
@@ -293,8 +318,14 @@ def peaks(path, frame=False):
     return _result(_peaks(summary.read(path)).parts[0], frame)
 
 
+def seismicity(path, frame=False):
+    """The seismicity around the large events of a summary: one row per point, time bin and distance bin,
+    with the rate of events per mainshock per block per unit T nu (none before summary format 5)."""
+    return _result(_seismicity(summary.read(path)).parts[0], frame)
+
+
 def columns(path, table):
-    """{column: (unit, meaning)} of one table ("events", "tasks", "curves", "numbers", "peaks")."""
+    """{column: (unit, meaning)} of one table ("events", "tasks", "curves", "numbers", "peaks", "seismicity")."""
     return dict(_tables(path, [table])[0][table].columns)
 
 
@@ -309,7 +340,7 @@ def as_dataframe(arr):
 
 
 CATALOG_TABLES = ("events", "tasks")
-SUMMARY_TABLES = ("curves", "numbers", "peaks")
+SUMMARY_TABLES = ("curves", "numbers", "peaks", "seismicity")
 
 
 def source_kind(path):
@@ -354,7 +385,8 @@ def _tables(path, names, chunk=catalog.READ_CHUNK, partial=True):
         build = {"events": lambda: _events(path, chunk), "tasks": lambda: _tasks(path)}
         return {name: build[name]() for name in names}, statement
     s = summary.read(path)
-    build = {"curves": lambda: _curves(s), "numbers": lambda: _numbers(s), "peaks": lambda: _peaks(s)}
+    build = {"curves": lambda: _curves(s), "numbers": lambda: _numbers(s), "peaks": lambda: _peaks(s),
+             "seismicity": lambda: _seismicity(s)}
     a = s["attrs"]
     settings = (f"reduced from {a.get('catalog', '?')} with "
                 + ", ".join(f"{k} = {a[k]}" for k in SUMMARY_SETTINGS if k in a))
@@ -418,7 +450,7 @@ FORMATS = {"csv": (".csv", write_csv)}   # format -> (file suffix, writer(path, 
 
 
 def write(source, directory, fmt="csv", force=False, chunk=catalog.READ_CHUNK, partial=False):
-    """Every table of a catalog (events, tasks) or a summary (curves, numbers, peaks) into files
+    """Every table of a catalog (events, tasks) or a summary (curves, numbers, peaks, seismicity) into files
     DIRECTORY/<table><suffix>; returns their paths.
 
     Refuses (checks.UsageError naming the path, nothing written) a directory that cannot be made

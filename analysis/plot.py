@@ -1,7 +1,9 @@
 """Figures from one or more summaries: R(mu) of every point overlaid, with bootstrap bands;
 recurrence-time distributions, one panel per point, each with its main peak enlarged in an inset;
 the slow side (creep episodes): their size and duration densities, of the points that have any,
-and the aseismic slip fraction against the swept parameter.
+and the aseismic slip fraction against the swept parameter; the seismicity around large events,
+one map per point: the rate of events at (distance from a mainshock's epicenter, time from its onset)
+over the point's background rate, on a logarithmic colour scale centred on 1.
 Points of several summaries are labelled by the parameters that differ between all the plotted
 points (legend_labels).
 
@@ -297,6 +299,45 @@ def creep(summaries, fig, keys, labels, names):
                title_fontsize=FONT + 1, ncol=min(len(texts), 4), frameon=False)
 
 
+SEISMICITY_DECADES = 2   # the colour scale of the maps: rate / background from 10^-2 to 10^2
+
+
+def seismicity(summaries, fig, labels, names):
+    """One map per point (the grid of the recurrence panels): log10 of the rate at (distance, time) over the
+    point's background rate, white where nothing was exposed; the numbers' regions outlined (near and ring,
+    just before and after, some time before)."""
+    points = [(s, i, label) for (s, i), label in zip(_points(summaries), labels) if summary_file.has_seismicity(s)]
+    if not points:
+        raise summary_file.SummaryError(
+            f"{', '.join(map(str, names))}: no seismicity around large events (a summary before format 5 did "
+            "not reduce it: reduce its catalogs again)")
+    rows, cols = _grid(len(points))
+    mesh = None
+    for k, (s, i, label) in enumerate(points):
+        ax = fig.add_subplot(rows, cols, k + 1)
+        background = s["points/numbers/background_rate"][i][0]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            relative = np.log10(s["points/seismicity_rate"][i] / background)
+        relative = np.where(np.isfinite(relative), relative, np.where(relative == -np.inf, -SEISMICITY_DECADES, np.nan))
+        mesh = ax.pcolormesh(s["bins/seis_distance"], s["bins/seis_time"], np.ma.masked_invalid(relative),
+                             cmap="RdBu_r", vmin=-SEISMICITY_DECADES, vmax=SEISMICITY_DECADES, shading="flat")
+        a = s["attrs"]
+        for (d0, d1), (t0, t1), style in ((((0, a["seis_near"]), (-a["seis_short"], a["seis_short"]), "-")),
+                                          ((a["seis_near"], a["seis_ring"]), (-a["seis_long"], 0), ":")):
+            ax.plot([d0, d1, d1, d0, d0], [t0, t0, t1, t1, t0], style, color="k", lw=0.9)
+        ax.axhline(0.0, color="k", lw=0.5, alpha=0.5)
+        ax.set_title(f"{label}\n{count_text(s['points/numbers/n_large'][i][0])} mainshocks "
+                     f"(mu >= {a['mu_c']:g})", fontsize=FONT + 1)
+        ax.set_xlabel("distance from the mainshock's epicenter (blocks)")
+        ax.set_ylabel(r"time from its onset, $T\nu$")
+        ax.tick_params(labelsize=FONT)
+    bar = fig.colorbar(mesh, cax=fig.add_axes([0.89, 0.2, 0.015, 0.6]))
+    bar.set_label(r"$\log_{10}$(rate / background rate)", fontsize=FONT + 1)
+    bar.ax.tick_params(labelsize=FONT)
+    fig.text(0.01, 0.01, "solid: near the epicenter, just before and after the onset; dotted: the ring, "
+             "some time before to the onset; white: not observed", fontsize=FONT)
+
+
 def _values(values, fmt="{}"):
     """Distinct values, " / " between them."""
     return " / ".join(dict.fromkeys(fmt.format(v) for v in values))
@@ -328,6 +369,9 @@ def title_text(summaries, names, title=None, kind=None):
     (events reduced of expected), whatever the title."""
     levels = " / ".join(dict.fromkeys(level_text(s["attrs"]["level"]) for s in summaries))
     bands = f"bands: {levels} bootstrap over {_values(_units(s) for s in summaries)}"
+    if kind == "seismicity":   # a map has no band: its numbers (analysis report) have the intervals
+        bands = (f"\nmaps without intervals; the numbers' {levels} intervals (analysis report) over "
+                 f"{_values(_units(s) for s in summaries)}")
     if kind == "creep":
         description = f"{_creep_sizes(summaries)}; {bands}"
     else:
@@ -343,7 +387,7 @@ def title_text(summaries, names, title=None, kind=None):
 
 
 def figure(summaries, kind, title=None, names=None):
-    """The figure `kind` ("magnitude", "recurrence" or "creep") of the points of one summary (a dict from
+    """The figure `kind` ("magnitude", "recurrence", "creep" or "seismicity") of the points of one summary (a dict from
     summary.read) or several (a list), laid out and ready to save. names: the summaries' paths
     or names (to tell points of equal parameters apart)."""
     if isinstance(summaries, dict):
@@ -361,6 +405,13 @@ def figure(summaries, kind, title=None, names=None):
         fig = plt.figure(figsize=(13, 4.6 + 0.25 * math.ceil((n + 1) / 4)), dpi=DPI)
         creep(summaries, fig, keys, labels, names)
         _layout(fig, text, 0.45 + 0.2 * math.ceil((n + 1) / 4))   # the figure legend below the panels
+    elif kind == "seismicity":
+        rows, cols = _grid(n)
+        fig = plt.figure(figsize=(5.2 * cols + 1.2, 4.2 * rows + 0.8), dpi=DPI)
+        fig.subplots_adjust(left=0.09, right=0.86, bottom=(0.55 + 0.3) / fig.get_figheight(),
+                            top=1 - 1.1 / fig.get_figheight(), hspace=0.55, wspace=0.3)
+        seismicity(summaries, fig, labels, names)
+        fig.suptitle(text, fontsize=FONT + 1, wrap=True)
     else:
         rows, cols = _grid(n)
         fig = plt.figure(figsize=(5.5 * cols, 4 * rows + 0.4), dpi=DPI)

@@ -34,6 +34,12 @@ PARAMS = ("N", "l", "nu", *LAW_KEYS)
 # at N = 100, b = 8..18.5 (aging law), creep slips reach mu = -11 and durations 10^-6.4 / nu
 CREEP_MU_BINS = "-12:3:75"
 CREEP_DURATION_BINS = "-7:3:50"
+# default bins and regions of the seismicity around large events (analysis/statistics/seismicity.py), chosen
+# for the aging law at b = 20, N = 800 (inter-event times of about 37 T nu, large events recurring
+# after T nu ~ 530): time from the mainshock's onset (T nu) and distance from its epicenter (blocks)
+SEIS_TIME_BINS = "-1000:1000:40"
+SEIS_DISTANCE_BINS = "0:40:20"
+SEIS_NEAR, SEIS_RING, SEIS_SHORT, SEIS_LONG = 2.0, 10.0, 50.0, 500.0
 
 
 @dataclass(frozen=True)
@@ -50,6 +56,12 @@ class Options:
     chunk: int = 1 << 16
     creep_mu_edges: np.ndarray = field(default_factory=lambda: parse_bins(CREEP_MU_BINS))
     creep_duration_edges: np.ndarray = field(default_factory=lambda: parse_bins(CREEP_DURATION_BINS))
+    seis_time_edges: np.ndarray = field(default_factory=lambda: parse_bins(SEIS_TIME_BINS))
+    seis_distance_edges: np.ndarray = field(default_factory=lambda: parse_bins(SEIS_DISTANCE_BINS))
+    seis_near: float = SEIS_NEAR      # blocks: the epicentral neighbourhood is distance < seis_near
+    seis_ring: float = SEIS_RING      # blocks: the ring around it is seis_near <= distance < seis_ring
+    seis_short: float = SEIS_SHORT    # T nu: "just before" is [-seis_short, 0), "just after" [0, seis_short)
+    seis_long: float = SEIS_LONG      # T nu: "some time before" is [-seis_long, -seis_short)
 
 
 # every statistic of analysis/statistics/, laid out: its tables, numbers and curves in the registry's order
@@ -109,11 +121,13 @@ def reduce_task(chunks, written, nu, n_blocks_chain, opt, rows=None, layout=LAYO
                 src, T, interior = scanner.feed(ev["t"], ev["epicenter"], ev["mu"], ev["boundary"])
                 rec = ((src * k) // written, T * nu, interior)
             lo = hi
-        seen = Rows(part, inertial, ev, block, creep, creep_block, rec, t_before, nu, opt)
+        seen = Rows(part, inertial, ev, block, creep, creep_block, rec, t_before, nu, opt, n_blocks_chain,
+                    ev is not None and lo == written)
         for statistic in layout.statistics:
             statistic.feed(out, seen)
         if ev is not None:
             t_before = ev["t"][-1]
+    out.carry.clear()    # the statistics' carry of this task ends with it
     return out
 
 
@@ -146,7 +160,7 @@ def reduce_tasks(path, task_indices, opt):
 # -- per point ------------------------------------------------------------------------------
 
 NUMBERS = tuple(n.name for n in LAYOUT.numbers)
-CREEP_NUMBERS = NUMBERS[NUMBERS.index("n_creep"):]
+CREEP_NUMBERS = tuple(n.name for s in LAYOUT.statistics if s.name == "creep" for n in s.numbers)   # the slow side's
 # Fewer resampling units than this and the bootstrap intervals are not to be trusted (a
 # percentile interval from a handful of seeds is too narrow and jumps with each one added).
 MIN_UNITS = 10

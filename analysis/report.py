@@ -101,7 +101,12 @@ def table(s):
     lines = [partial_text(s)] if partial_text(s) else []
     lines += [f"summary of {a['catalog']}: mu_c = {a['mu_c']}, window = {a['window']} blocks, "
               f"GR b above mu = {a['b_cut']}, {level_text(a['level'])} intervals from "
-              f"{a['bootstrap']} bootstrap resamples", ""]
+              f"{a['bootstrap']} bootstrap resamples"]
+    if summary.has_seismicity(s):
+        lines.append(f"seismicity around mainshocks (mu >= mu_c): near = distance < {a['seis_near']:g} blocks, ring = "
+                     f"up to {a['seis_ring']:g}; just before/after = {a['seis_short']:g} T*nu, some time before = "
+                     f"from -{a['seis_long']:g}; rates per mainshock per block per T*nu")
+    lines.append("")
     for i in range(len(s["points/N"])):
         lines.append(f"point {i}: " + point_label(s, i, list(PARAMS)) +
                      f"  (resampling {s['points/method'][i]}, {s['points/units'][i]} units)")

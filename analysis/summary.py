@@ -22,12 +22,17 @@
     /points/{creep_mu, creep_duration}_density  the same for the creep episodes (format 3)
     /points/numbers/<name>                      (points, 3): estimate, lo, hi (see reduce.NUMBERS)
     /points/peaks                               (points, max peaks, 3): T*nu position, lo, hi (NaN pad)
+    /bins/seis_time, /bins/seis_distance        bin edges of the seismicity around large events (format 5)
+    /per_task/{seis_pairs, seis_exposure}       (tasks, stretches, time x distance bins) its counts and exposures
+    /per_task/seismicity                        (tasks, stretches, 3) its mainshocks and background
+    /points/seismicity_rate                     (points, time bins, distance bins) its map
     attributes: format; catalogs (the catalogs' paths, in the order given: /tasks/catalog indexes
                 them) and configs (their stored configs, same order); config (the one catalog's
                 config, only when there is one); catalog (the catalog's path, or for several a
                 short description of them, for titles); partial ("" or the one-line statement of
                 an unfinished reduction: events reduced of expected, which catalogs); mu_c, window,
-                b_cut, bootstrap, level, blocks, seed (the options)
+                b_cut, bootstrap, level, blocks, seed, seis_near, seis_ring, seis_short, seis_long
+                (the options)
 
 The tasks of a point are its resampling units in the order of their streams, (seed_entropy,
 spawn_key); its bootstrap draws from SeedSequence(seed, spawn_key from its parameters)
@@ -57,19 +62,22 @@ from ensemble import catalog, checks, filekind
 
 from . import reduce
 from .reduce import MIN_UNITS, NUMBERS, PARAMS
+from .statistics import bin_names
 
-FORMAT = filekind.SUMMARY_FORMAT_PREFIX + "4"   # 4: the intervals statistic (/per_task/intervals, cv_tnu,
-# mean_gap, cv_gap). 3: the creep episodes (bins, per-task counts and sums, densities, CREEP_NUMBERS). 2: GR b
-# and its standard error, 9 per-task sums, peaks by prominence; several catalogs (catalogs, configs, partial,
-# /tasks/catalog, catalog_task, catalog_point)
-# formats 3 and 2 still read, without the datasets that came after them (a number a summary lacks is not shown)
-READS = (FORMAT, filekind.SUMMARY_FORMAT_PREFIX + "3", filekind.SUMMARY_FORMAT_PREFIX + "2")
+FORMAT = filekind.SUMMARY_FORMAT_PREFIX + "5"   # 5: the seismicity around large events (/bins/seis_*,
+# /per_task/seis_*, /per_task/seismicity, /points/seismicity_rate, its numbers, the seis_* attributes). 4: the
+# intervals statistic (/per_task/intervals, cv_tnu, mean_gap, cv_gap). 3: the creep episodes (bins, per-task
+# counts and sums, densities, CREEP_NUMBERS). 2: GR b and its standard error, 9 per-task sums, peaks by
+# prominence; several catalogs (catalogs, configs, partial, /tasks/catalog, catalog_task, catalog_point)
+# formats 4, 3 and 2 still read, without the datasets that came after them (a number a summary lacks is not shown)
+READS = (FORMAT, *(filekind.SUMMARY_FORMAT_PREFIX + n for n in "432"))
 
 # Every dataset, one line each: (unit, shape, meaning), units as in ensemble/catalog.py's DATASETS
 # (T nu, the plate's displacement during a recurrence time, is a model length).
 _POINTS = "(points,)"
 _INTERVAL = "(points, 3): estimate, lo, hi (lo, hi: the bootstrap interval at `level`, NaN with one unit)"
 _CURVE = "(points, {} bins)"   # the curve's variable
+SEIS_ATTRS = ("seis_near", "seis_ring", "seis_short", "seis_long")   # the regions of the seismicity's numbers
 LAYOUT = reduce.LAYOUT   # the statistics (analysis/statistics/): their tables, curves and numbers
 CURVES = {   # name -> (its bins, its variable, whose variable, the density's unit), in the curves' order
     c.name: (LAYOUT.tables[c.table].bins, c.variable, c.whose, c.unit) for c in LAYOUT.curves}
@@ -79,6 +87,8 @@ _BINS = {   # name -> (unit, what its edges bin)
     "tnu": ("model length", "T nu bins"),
     "creep_mu": ("log10 model length", "creep episodes' mu bins (reduce --creep-mu-bins)"),
     "creep_duration": ("log10(duration nu)", "creep episodes' log10(duration nu) bins (reduce --creep-duration-bins)"),
+    "seis_time": ("model length", "time (T nu) from a mainshock's onset, negative before it (reduce --seis-time-bins)"),
+    "seis_distance": ("blocks", "distance from a mainshock's epicenter (reduce --seis-distance-bins)"),
 }
 
 
@@ -86,7 +96,7 @@ def _table_entry(name):
     """DATASETS' line of /per_task/<table>: from the statistics that declare it."""
     t = LAYOUT.tables[name]
     if t.bins:
-        return (t.unit, f"(tasks, stretches, {t.bins} bins)", t.meaning)
+        return (t.unit, f"(tasks, stretches, {' x '.join(bin_names(t))} bins)", t.meaning)
     columns = LAYOUT.columns[name]
     return (t.unit, f"(tasks, stretches, {len(columns)})",
             f"{', '.join(columns)} (analysis/statistics/) per task and stretch")
@@ -164,7 +174,7 @@ def write(path, inputs, per_task, points, opt, force=False):
         h5.attrs.update({"format": FORMAT, **_source_attrs(inputs),
                          "mu_c": opt.mu_c, "window": opt.window, "b_cut": opt.b_cut,
                          "bootstrap": opt.bootstrap, "level": opt.level, "blocks": opt.blocks,
-                         "seed": opt.seed})
+                         "seed": opt.seed, **{k: getattr(opt, k) for k in SEIS_ATTRS}})
         edges = reduce.bin_edges(opt)
         for name, values in edges.items():
             h5[f"bins/{name}"] = values
@@ -187,13 +197,20 @@ def write(path, inputs, per_task, points, opt, force=False):
             start += n
         for i, name in enumerate(NUMBERS):
             h5[f"points/numbers/{name}"] = np.stack([p["numbers"][i] for p in points])
-        most = max([len(p["peaks"]) for p in points] + [1])
-        peaks = np.full((len(points), most, 3), np.nan)
-        for i, p in enumerate(points):
-            peaks[i, :len(p["peaks"])] = p["peaks"]
-        h5["points/peaks"] = peaks
+        for st in LAYOUT.statistics:   # each statistic's extras, NaN-padded to the largest of the points'
+            for name in st.extra_datasets:
+                h5[f"points/{name}"] = _padded([np.asarray(p[name], dtype=float) for p in points])
         _describe(h5)
     os.replace(tmp, path)
+
+
+def _padded(arrays):
+    """(points, ...) of arrays of one rank, each padded with NaN to the largest extent (at least 1) of every axis."""
+    shape = tuple(max([a.shape[d] for a in arrays] + [1]) for d in range(arrays[0].ndim))
+    out = np.full((len(arrays), *shape), np.nan)
+    for i, a in enumerate(arrays):
+        out[(i, *(slice(0, n) for n in a.shape))] = a
+    return out
 
 
 def read(path):
@@ -232,6 +249,11 @@ def point_laws(s):
 def has_creep(s):
     """Whether summary `s` (read) holds the creep statistics (format 3; format 2 reduced none)."""
     return "points/numbers/n_creep" in s
+
+
+def has_seismicity(s):
+    """Whether summary `s` (read) holds the seismicity around large events (format 5)."""
+    return "points/seismicity_rate" in s
 
 
 def creeping(s):

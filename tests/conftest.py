@@ -36,6 +36,7 @@ os.environ["PATH"] = os.path.dirname(sys.executable) + os.pathsep + os.environ.g
 QUICK = {
     "test_creep.py": ["test_a_cluster_too_soft_to_creep_hands_over_to_an_event", "test_above_the_block_stiffness_nothing_creeps"],
     "test_intervals.py": ["test_every_statistic_is_the_same_whatever_the_chunks"],
+    "test_seismicity.py": ["test_a_hand_built_chain_gives_its_known_counts_and_exposures"],
     "test_new_statistic.py": ["test_a_statistic_is_one_file"],
     "test_summary_identity.py": ["test_a_reduction_gives_the_committed_summary"],
     "test_slip_law.py": ["test_two_blocks_at_the_paper_rate_alternate_without_small_events"],

@@ -43,6 +43,15 @@ here the slow and obvious way, from the raw events:
   n_creep, creep_share = n_creep / (n_creep + n_events), taken_over_share = (ending 2) / n_creep
   and aseismic_fraction = creep slip / (creep slip + inertial slip), NaN where nothing is shared;
   per stretch: n_creep, n_taken_over, creep slip, inertial slip;
+- the seismicity around large events: every pair (mainshock m: mu_m >= mu_c; event i != m of the same
+  task, any size) with dt = t_i nu - t_m nu in the seis_time bins and d = |epicenter_i - epicenter_m| in
+  the seis_distance bins, counted in the mainshock's stretch; a mainshock's exposure of a cell is the
+  length of its time bin (shifted to the mainshock's onset) within [t nu of the task's first inertial
+  event, of its last] times the number of blocks 0..N-1 at a distance in its distance bin; its map is the
+  summed counts over the summed exposures (NaN where 0); its numbers: background = (events - 1) / (N x
+  span) summed over tasks, the rates of the cells lying wholly inside near (d < seis_near) x just before
+  [-seis_short, 0) and x just after [0, seis_short), and the ratios of near to the ring (seis_near <= d <
+  seis_ring) in [-seis_long, -seis_short) and in [-seis_short, 0); defaults SEIS below;
 - a reduction is partial if a catalog's name ends in .partial or one of its tasks is not
   finished (status 1) or holds fewer than events_per_task events; the summary then states the
   events reduced of those expected and names those catalogs.
@@ -69,6 +78,11 @@ PER_TASK_COLUMNS = ("n_events", "n_large", "n_rec", "sum_tnu", "n_rec_int", "sum
                     "n_gr", "sum_mu_gr", "sum_mu2_gr")
 CREEP_COLUMNS = ("n_creep", "n_taken_over", "sum_slip_creep", "sum_slip_events")   # of /per_task/creep
 INTERVAL_COLUMNS = ("sum_tnu2", "n_gaps", "sum_gap", "sum_gap2")   # of /per_task/intervals
+SEISMICITY_NUMBERS = ("background_rate", "foreshock_rate", "aftershock_rate", "quiescence_ratio", "doughnut_ratio")
+# the documented defaults of reduce --seis-time-bins -1000:1000:40, --seis-distance-bins 0:40:20, --seis-near 2,
+# --seis-ring 10, --seis-short 50, --seis-long 500
+SEIS = {"seis_time_edges": np.linspace(-1000, 1000, 41), "seis_distance_edges": np.linspace(0, 40, 21),
+        "seis_near": 2.0, "seis_ring": 10.0, "seis_short": 50.0, "seis_long": 500.0}
 # the chain's parameters and every friction law's keys (NaN where a key is not the task's law's)
 PARAMS = ("N", "l", "nu", "a", "b", "c", "alpha", "sigma")
 MIN_SEEDS = 10
@@ -212,7 +226,29 @@ def ks_distance(mu, edges, cut, b):
 
 
 def edges_of(opt, name):
-    return opt[name] if name in opt else CREEP_EDGES[name]
+    return opt[name] if name in opt else {**CREEP_EDGES, **SEIS}[name]
+
+
+def seis_cell(dt, d, opt):
+    """Flat cell index (time bin * distance bins + distance bin) of a pair, or None outside the bins."""
+    te, de = edges_of(opt, "seis_time_edges"), edges_of(opt, "seis_distance_edges")
+    if not (te[0] <= dt < te[-1] and de[0] <= d < de[-1]):
+        return None
+    rows = [j for j in range(len(te) - 1) if te[j] <= dt < te[j + 1]]
+    cols = [k for k in range(len(de) - 1) if de[k] <= d < de[k + 1]]
+    if dt >= te[-1] or not rows or not cols:
+        return None
+    return rows[-1] * (len(de) - 1) + cols[-1]
+
+
+def seis_region(opt, time, distance):
+    """Mask of the flat cells whose bins lie wholly within time [lo, hi) x distance [lo, hi)."""
+    te, de = edges_of(opt, "seis_time_edges"), edges_of(opt, "seis_distance_edges")
+    def inside(edges, lo, hi):
+        tol = 1e-9 * min(edges[q + 1] - edges[q] for q in range(len(edges) - 1))
+        return [edges[q] >= lo - tol and edges[q + 1] <= hi + tol for q in range(len(edges) - 1)]
+    rows, cols = inside(te, *time), inside(de, *distance)
+    return np.array([r and c for r in rows for c in cols])
 
 
 def quotient(a, b):
@@ -228,7 +264,8 @@ def cv(values):
     return math.sqrt(sum((v - mean) ** 2 for v in x) / (len(x) - 1)) / mean
 
 
-def statistics(mu, tnu, interior, event_slip, creep_mu, creep_log_duration, creep_taken, creep_slip, gaps, opt):
+def statistics(mu, tnu, interior, event_slip, creep_mu, creep_log_duration, creep_taken, creep_slip, gaps,
+               seis_cells, seis_exposure, block_span, opt):
     """Curves and numbers of pooled raw data: mu (all inertial events), tnu and interior
     (recurrences), event_slip (the inertial events' slips), the creep episodes' mu, log10(duration
     nu), taken over (ending 2) and slip, and the inter-event times (times nu) of the inertial events."""
@@ -259,6 +296,22 @@ def statistics(mu, tnu, interior, event_slip, creep_mu, creep_log_duration, cree
     numbers.update({"n_creep": m, "creep_share": quotient(m, m + n),
                     "taken_over_share": quotient(int(np.count_nonzero(creep_taken)), m),
                     "aseismic_fraction": quotient(creep_sum, creep_sum + sum(float(x) for x in event_slip))})
+    counts, exposure = seis_sums(seis_cells, seis_exposure, opt)
+    def rate(region):
+        e = sum(float(x) for x in exposure[region])
+        return int(counts[region].sum()) / e if e > 0 else math.nan
+    def ratio(a, b):
+        return a / b if b != 0 and not math.isnan(b) else (math.nan if a == 0 or math.isnan(a) or math.isnan(b)
+                                                           else math.copysign(math.inf, a))
+    near, ring = (0.0, edges_of(opt, "seis_near")), (edges_of(opt, "seis_near"), edges_of(opt, "seis_ring"))
+    short, long_ = edges_of(opt, "seis_short"), edges_of(opt, "seis_long")
+    before, after, earlier = (-short, 0.0), (0.0, short), (-long_, -short)
+    fore = rate(seis_region(opt, before, near))
+    quiet_near, quiet_ring = rate(seis_region(opt, earlier, near)), rate(seis_region(opt, earlier, ring))
+    numbers.update({"background_rate": quotient(len(gaps), sum(float(x) for x in block_span)),
+                    "foreshock_rate": fore, "aftershock_rate": rate(seis_region(opt, after, near)),
+                    "quiescence_ratio": ratio(quiet_near, quiet_ring),
+                    "doughnut_ratio": ratio(fore, rate(seis_region(opt, before, ring)))})
     ce, de = edges_of(opt, "creep_mu_edges"), edges_of(opt, "creep_duration_edges")
     curves = {"mu": density(histogram(mu, me), me, n),
               "tnu": density(h_t, te, len(tnu)),
@@ -268,12 +321,30 @@ def statistics(mu, tnu, interior, event_slip, creep_mu, creep_log_duration, cree
     return curves, numbers
 
 
+def seis_sums(cells, exposure, opt):
+    """(counts, exposures) of the flat cells from pooled pairs (their cells) and mainshocks' exposures."""
+    width = (len(edges_of(opt, "seis_time_edges")) - 1) * (len(edges_of(opt, "seis_distance_edges")) - 1)
+    counts = np.bincount(np.asarray(cells, dtype=np.int64), minlength=width)
+    total = np.zeros(width)
+    for row in exposure:
+        total += row
+    return counts, total
+
+
+def seis_rate_map(units, opt):
+    """(time bins, distance bins) summed counts over summed exposures of all units, NaN where nothing exposed."""
+    counts, total = seis_sums(np.concatenate([u[9] for u in units]), [r for u in units for r in u[10]], opt)
+    shape = (len(edges_of(opt, "seis_time_edges")) - 1, len(edges_of(opt, "seis_distance_edges")) - 1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(total > 0, counts / np.where(total > 0, total, 1), np.nan).reshape(shape)
+
+
 # -- the whole summary ------------------------------------------------------------------
 
 class Task:
     """One task's raw events and its recurrences (T nu), each with its stretch."""
 
-    def __init__(self, ev, nu, opt):
+    def __init__(self, ev, nu, opt, n_blocks=0):
         rows = len(ev["t"])
         kind = np.asarray(ev["kind"]) if "kind" in ev else np.zeros(rows, dtype=np.int8)
         k = opt["blocks"]
@@ -306,16 +377,45 @@ class Task:
         t = [float(x) for x in ev["t"]]
         self.gaps = np.array([(t[i] - t[i - 1]) * nu for i in range(1, n)], dtype=float)
         self.gap_stretch = self.stretch[1:]
+        self.block_span = self.gaps * n_blocks
+        self.seis(ev, nu, n_blocks, opt)
+
+    def seis(self, ev, nu, n_blocks, opt):
+        """Every pair's cell and stretch (of its mainshock), every mainshock's exposure row and stretch."""
+        T = [float(x) * nu for x in ev["t"]]
+        x = [int(e) for e in ev["epicenter"]]
+        te, de = edges_of(opt, "seis_time_edges"), edges_of(opt, "seis_distance_edges")
+        cells, cell_stretch, exposure, main_stretch = [], [], [], []
+        for m in range(self.n):
+            if float(ev["mu"][m]) < opt["mu_c"]:
+                continue
+            for i in range(self.n):
+                if i != m:
+                    c = seis_cell(T[i] - T[m], abs(x[i] - x[m]), opt)
+                    if c is not None:
+                        cells.append(c)
+                        cell_stretch.append(self.stretch[m])
+            blocks = [sum(1 for b in range(n_blocks) if de[k] <= abs(b - x[m]) < de[k + 1]) for k in range(len(de) - 1)]
+            cover = [max(0.0, min(T[m] + te[j + 1], T[-1]) - max(T[m] + te[j], T[0])) for j in range(len(te) - 1)]
+            exposure.append(np.array([c * b for c in cover for b in blocks], dtype=float))
+            main_stretch.append(self.stretch[m])
+        self.seis_cells = np.array(cells, dtype=np.int64)
+        self.seis_cell_stretch = np.array(cell_stretch, dtype=np.int64)
+        width = (len(te) - 1) * (len(de) - 1)
+        self.seis_exposure = np.array(exposure).reshape(-1, width)
+        self.seis_main_stretch = np.array(main_stretch, dtype=np.int64)
 
     def unit(self, stretch=None):
         """(mu, tnu, interior, event slip, creep mu, creep log10(duration nu), creep taken over,
         creep slip) of the whole task or of one stretch."""
         creep = (self.creep_mu, self.creep_log_duration, self.creep_taken, self.creep_slip)
         if stretch is None:
-            return (self.mu, self.tnu, self.interior, self.event_slip, *creep, self.gaps)
+            return (self.mu, self.tnu, self.interior, self.event_slip, *creep, self.gaps, self.seis_cells,
+                    self.seis_exposure, self.block_span)
         e, r, c = self.stretch == stretch, self.rec_stretch == stretch, self.creep_stretch == stretch
         return (self.mu[e], self.tnu[r], self.interior[r], self.event_slip[e], *(x[c] for x in creep),
-                self.gaps[self.gap_stretch == stretch])
+                self.gaps[self.gap_stretch == stretch], self.seis_cells[self.seis_cell_stretch == stretch],
+                self.seis_exposure[self.seis_main_stretch == stretch], self.block_span[self.gap_stretch == stretch])
 
     def per_stretch(self, opt):
         k, me, te = opt["blocks"], opt["mu_edges"], opt["tnu_edges"]
@@ -328,16 +428,22 @@ class Task:
         cd_h = np.zeros((k, len(de) - 1), dtype=np.int64)
         creep = np.zeros((k, len(CREEP_COLUMNS)))
         intervals = np.zeros((k, len(INTERVAL_COLUMNS)))
+        width = (len(edges_of(opt, "seis_time_edges")) - 1) * (len(edges_of(opt, "seis_distance_edges")) - 1)
+        pairs, seis_exposure = np.zeros((k, width), dtype=np.int64), np.zeros((k, width))
+        seis_columns = np.zeros((k, 3))
         for s in range(k):
-            mu, tnu, interior, event_slip, creep_mu, creep_log_duration, taken, creep_slip, gaps = self.unit(s)
+            (mu, tnu, interior, event_slip, creep_mu, creep_log_duration, taken, creep_slip, gaps, cells,
+             exposure, block_span) = self.unit(s)
             intervals[s] = [(tnu ** 2).sum(), len(gaps), gaps.sum(), (gaps ** 2).sum()]
+            pairs[s], seis_exposure[s] = seis_sums(cells, exposure, opt)
+            seis_columns[s] = [len(exposure), len(gaps), block_span.sum()]
             mu_h[s], t_h[s], ti_h[s] = histogram(mu, me), histogram(tnu, te), histogram(tnu[interior], te)
             cm_h[s], cd_h[s] = histogram(creep_mu, ce), histogram(creep_log_duration, de)
             creep[s] = [len(creep_mu), np.count_nonzero(taken), creep_slip.sum(), event_slip.sum()]
             gr = mu[mu >= opt["b_cut"]]
             numbers[s] = [len(mu), np.count_nonzero(mu >= opt["mu_c"]), len(tnu), tnu.sum(),
                           interior.sum(), tnu[interior].sum(), len(gr), gr.sum(), (gr ** 2).sum()]
-        return mu_h, t_h, ti_h, numbers, cm_h, cd_h, creep, intervals
+        return mu_h, t_h, ti_h, numbers, cm_h, cd_h, creep, intervals, pairs, seis_exposure, seis_columns
 
 
 def _pool(units, pick):
@@ -379,6 +485,7 @@ def point(tasks, params, opt):
         else:
             out["numbers"][name] = (est, math.nan, math.nan)
     out["peaks"], out["tied"] = _peaks(units, m, opt, rng, q)
+    out["seismicity_rate"] = seis_rate_map(units, opt)
     return out
 
 
@@ -485,13 +592,14 @@ def expected_summary(catalogs, opt):
     per_task = []
     for path, events, tasks in catalogs:
         per_task += [Task({c: events[c][events["task"] == k] for c in events if c != "task"},
-                          float(tasks["nu"][k]), opt) for k in range(len(tasks["point"]))]
+                          float(tasks["nu"][k]), opt, int(tasks["N"][k])) for k in range(len(tasks["point"]))]
     exp = {"bins/mu": opt["mu_edges"], "bins/tnu": opt["tnu_edges"],
            "bins/creep_mu": edges_of(opt, "creep_mu_edges"),
-           "bins/creep_duration": edges_of(opt, "creep_duration_edges")}
+           "bins/creep_duration": edges_of(opt, "creep_duration_edges"),
+           "bins/seis_time": edges_of(opt, "seis_time_edges"), "bins/seis_distance": edges_of(opt, "seis_distance_edges")}
     stacks = [t.per_stretch(opt) for t in per_task]
     for j, name in enumerate(("mu", "tnu", "tnu_interior", "numbers", "creep_mu", "creep_duration", "creep",
-                              "intervals")):
+                              "intervals", "seis_pairs", "seis_exposure", "seismicity")):
         exp[f"per_task/{name}"] = np.stack([s[j] for s in stacks])
     results = []
     for params, rows in points:
@@ -506,8 +614,9 @@ def expected_summary(catalogs, opt):
     for name in CURVES:
         for j, suffix in enumerate(("density", "lo", "hi")):
             exp[f"points/{name}_{suffix}"] = np.stack([r["curves"][name][j] for r in results])
-    for name in NUMBERS + CREEP_NUMBERS:
+    for name in NUMBERS + CREEP_NUMBERS + SEISMICITY_NUMBERS:
         exp[f"points/numbers/{name}"] = np.array([r["numbers"][name] for r in results], dtype=float)
+    exp["points/seismicity_rate"] = np.stack([r["seismicity_rate"] for r in results])
     most = max([len(r["peaks"]) for r in results] + [1])
     peaks = np.full((len(results), most, 3), np.nan)
     for i, r in enumerate(results):
@@ -548,19 +657,21 @@ def check_summary(s, expected, opt):
     """Every dataset and attribute of summary `s` (read_summary) against expected_summary."""
     tasks = expected["tasks"]
     tasks_keys = {f"tasks/{k}" for k in tasks}
-    numbers = {f"points/numbers/{n}" for n in NUMBERS + CREEP_NUMBERS}
+    numbers = {f"points/numbers/{n}" for n in NUMBERS + CREEP_NUMBERS + SEISMICITY_NUMBERS}
     curves = {f"points/{c}_{x}" for c in CURVES for x in ("density", "lo", "hi")}
     known = ({"bins/mu", "bins/tnu", "bins/creep_mu", "bins/creep_duration", "points/method", "points/units",
-              "points/law",
+              "points/law", "bins/seis_time", "bins/seis_distance", "points/seismicity_rate",
               "points/peaks", "attrs"}
-             | {f"per_task/{k}" for k in ("mu", "tnu", "tnu_interior", "numbers",
-                                          "creep_mu", "creep_duration", "creep", "intervals")}
+             | {f"per_task/{k}" for k in ("mu", "tnu", "tnu_interior", "numbers", "creep_mu", "creep_duration",
+                                          "creep", "intervals", "seis_pairs", "seis_exposure", "seismicity")}
              | {f"points/{p}" for p in PARAMS} | tasks_keys | numbers | curves)
     # a new output must get its brute-force check here
     assert set(s) == known, f"unchecked {set(s) - known}, missing {known - set(s)}"
     a = s["attrs"]
     for key in ("mu_c", "window", "b_cut", "bootstrap", "level", "blocks", "seed"):
         assert a[key] == opt[key], key
+    for key in ("seis_near", "seis_ring", "seis_short", "seis_long"):
+        assert a[key] == edges_of(opt, key), key
     paths = expected["paths"]
     assert a["format"].startswith("bk-summary-")
     configs = []
@@ -592,6 +703,11 @@ def check_summary(s, expected, opt):
     got, want = s["per_task/creep"], expected["per_task/creep"]
     np.testing.assert_array_equal(got[..., :2], want[..., :2], err_msg="per_task/creep counts")
     np.testing.assert_allclose(got, want, rtol=RTOL, atol=0, err_msg="per_task/creep sums")
+    for key in ("bins/seis_time", "bins/seis_distance", "per_task/seis_pairs"):
+        np.testing.assert_array_equal(s[key], expected[key], err_msg=key)
+    for key in ("per_task/seis_exposure", "per_task/seismicity", "points/seismicity_rate"):
+        np.testing.assert_allclose(s[key], expected[key], rtol=RTOL, atol=0, err_msg=key)
+    np.testing.assert_array_equal(s["per_task/seismicity"][..., :2], expected["per_task/seismicity"][..., :2])
     got, want = s["per_task/intervals"], expected["per_task/intervals"]
     np.testing.assert_array_equal(got[..., 1], want[..., 1], err_msg="per_task/intervals counts")
     np.testing.assert_allclose(got, want, rtol=RTOL, atol=0, err_msg="per_task/intervals sums")

@@ -190,6 +190,7 @@ def test_every_summary_dataset_per_point_is_exported(files):
     s = summary.read(files / "cat.summary.h5")
     tables = {t: export.columns(files / "cat.summary.h5", t) for t in export.SUMMARY_TABLES}
     covered = {f"points/{c}" for c in tables["numbers"]} | {"points/peaks"}
+    covered |= {"points/seismicity_rate"} if "rate" in tables["seismicity"] else set()
     covered |= {f"points/numbers/{c}" for c in tables["numbers"]}
     covered |= {f"points/{c}_{p}" for c in summary.CURVES for p in ("density", "lo", "hi")}
     assert {k for k in s if k.startswith("points/")} <= covered
@@ -349,7 +350,7 @@ def test_api_given_the_other_kind_says_so(files):
         export.events(files / "cat.summary.h5")
     with pytest.raises(summary.SummaryError, match="not a reduction summary .reduce it first"):
         export.numbers(files / "cat.h5")
-    with pytest.raises(ValueError, match="its tables are curves, numbers, peaks, not events"):
+    with pytest.raises(ValueError, match="its tables are curves, numbers, peaks, seismicity, not events"):
         export.columns(files / "cat.summary.h5", "events")
 
 

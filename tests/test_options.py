@@ -41,6 +41,12 @@ BAD = {
     "tnu_bins": ["nan:2000:80", "0:inf:80", "0:2000:inf", "0:1e308:10000000000", "2000:0:80", "0:0:80"],
     "creep_mu_bins": ["nan:3:75", "-12:inf:75", "-12:3:0", "3:-12:75", "-12:3", "-1e308:1e308:10"],
     "creep_duration_bins": ["-7:nan:50", "-inf:3:50", "-7:3:1e400", "-7:-7:50", "0:1e308:10000000000"],
+    "seis_time_bins": ["-1000:nan:40", "-inf:1000:40", "1000:-1000:40", "-1000:1000:0", "0:1e308:10000000000"],
+    "seis_distance_bins": ["0:nan:20", "0:40", "40:0:20", "0:40:1e400"],
+    "seis_near": ["nan", "inf", "-1", "1e400", "x"],
+    "seis_ring": ["nan", "inf", "-1", "1e400"],
+    "seis_short": ["nan", "inf", "-1", "1e400"],
+    "seis_long": ["nan", "inf", "-0.5", "1e400"],
 }
 ENV = child_env(PYTHONPATH=str(ROOT))   # this checkout's packages, wherever the command runs
 OPTION = {dest: "--" + dest.replace("_", "-") for dest in BAD}

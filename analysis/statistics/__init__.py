@@ -7,8 +7,12 @@ A statistic (a module of this package that defines STATISTIC) declares
   of counts and sums (`columns`); statistics may share a table of columns, each adding its own
   columns (the columns are laid out in the order of the statistics, then of their declaration).
   Additive, so that merging tasks and ranks and resampling units are exact: every estimate is a
-  function of a sum over units.
-- `feed(acc, rows)`: add one chunk of a task's rows to the tables (rows: `Rows`, below).
+  function of a sum over units. `bins` may name two sets of bins, (rows, columns): a 2-d histogram
+  stored flattened, row by row; `weights` makes a histogram table hold float sums instead of counts.
+- `feed(acc, rows)`: add one chunk of a task's rows to the tables (rows: `Rows`, below). What a statistic
+  must carry from one chunk of a task to the next (events waiting for their partners) it keeps in
+  `acc.carry[<its name>]`, a dict the engine gives each task and drops at its end; `rows.last` tells the
+  chunk that holds the task's last inertial event.
 - its numbers (name, unit, meaning) and `estimate(u, opt)`: their values from summed tables `u`
   (u.table(name) the array, u.column(table, column) one column), in the order declared.
 - its curves: densities of a histogram table (`table`), normalised by a count column (`total`), over
@@ -34,8 +38,9 @@ class Table:
     name: str
     unit: str
     meaning: str
-    bins: str = ""
+    bins: object = ""      # a bins name, or (rows, columns) of a 2-d histogram (flattened row by row)
     columns: tuple = ()
+    weights: bool = False  # a histogram of float sums (weights), not of counts
 
 
 @dataclass(frozen=True)
@@ -111,15 +116,12 @@ class Layout:
                     self.columns[t.name] += list(t.columns)
         self.numbers = [n for s in statistics for n in s.numbers]
         self.curves = [c for s in statistics for c in s.curves]
-        self.bins = sorted({t.bins for t in self.tables.values() if t.bins}, key=self._bins_order)
-
-    def _bins_order(self, name):
-        return [t.bins for t in self.tables.values() if t.bins].index(name)
+        self.bins = list(dict.fromkeys(name for t in self.tables.values() if t.bins for name in bin_names(t)))
 
     def width(self, table, edges):
-        """Entries per unit of `table`: its bins, or its columns."""
+        """Entries per unit of `table`: its bins (of a 2-d histogram, their product), or its columns."""
         t = self.tables[table]
-        return len(edges[t.bins]) - 1 if t.bins else len(self.columns[table])
+        return int(np.prod([len(edges[name]) - 1 for name in bin_names(t)])) if t.bins else len(self.columns[table])
 
     def column(self, table, name):
         return self.columns[table].index(name)
@@ -131,8 +133,13 @@ class Layout:
     def empty(self, blocks, edges):
         """Zeroed tables of one task: {table: (blocks, width)} (histograms int64, columns float64)."""
         return Tables(self, {name: np.zeros((blocks, self.width(name, edges)),
-                                            np.int64 if t.bins else np.float64)
+                                            np.int64 if t.bins and not t.weights else np.float64)
                              for name, t in self.tables.items()})
+
+
+def bin_names(table):
+    """The bins names of a histogram table: (name,) or (rows, columns) of a 2-d one."""
+    return (table.bins,) if isinstance(table.bins, str) else tuple(table.bins)
 
 
 class Tables(dict):
@@ -141,6 +148,7 @@ class Tables(dict):
     def __init__(self, layout, arrays):
         super().__init__(arrays)
         self.layout = layout
+        self.carry = {}     # what statistics keep between the chunks of one task (their name -> anything)
 
     def column(self, table, name):
         return self[table][..., self.layout.column(table, name)]
@@ -164,7 +172,8 @@ class Rows:
     events' columns; block: the stretch of each inertial event; creep: mask of its creep episodes and
     creep_block their stretches; recurrences: (stretch of the starting event, T nu, interior) of the
     recurrences closed in this chunk, or None when no statistic asks for them; t_before: the time of the
-    task's last inertial event before this chunk (NaN before its first); nu, opt.
+    task's last inertial event before this chunk (NaN before its first); nu, opt; n_blocks: N, the blocks of
+    the chain; last: whether this chunk holds the task's last inertial event (none come after it).
     """
     part: dict
     inertial: np.ndarray
@@ -176,3 +185,5 @@ class Rows:
     t_before: float
     nu: float
     opt: object
+    n_blocks: int = 0
+    last: bool = False

@@ -1,0 +1,210 @@
+"""Seismicity around large events: the events before and after each mainshock (an inertial event with
+mu >= mu_c), stacked by their time from its onset and their distance from its epicenter.
+
+Every pair (mainshock m, inertial event i != m of the same task, of any size, a mainshock too) with
+dt = T_i - T_m in the time bins (T = t nu, the loader's displacement; negative dt: before the mainshock)
+and d = |epicenter_i - epicenter_m| in the distance bins (blocks) is counted in the 2-d histogram
+`seis_pairs` (time bins x distance bins), in the stretch of the mainshock. Pairs are found across the
+chunks in which a task streams: the events of the last max(|lo|, |hi|) of T nu are carried to the next
+chunk, and a pair is counted in the chunk of its later event.
+
+The rates are honest about what was observed: a mainshock's exposure in a cell (time bin j, distance
+bin k) is the time of bin j that lies within the task's observed span [T of its first inertial event,
+T of its last] (a window cut by the start or the end of the task's rows counts only what it covers),
+times the number of blocks of the chain (0 .. N-1) at a distance in bin k of the epicenter (fewer near
+the chain's ends). A mainshock's exposure is added when its window has been seen to its end, or with
+the task's last inertial event; so it is added once, the same way whatever the chunks. The map is the
+counts over the summed exposures: events per mainshock per block per unit T nu, like the background
+rate: every inertial event after the task's first, over the blocks of the chain times the task's span.
+
+The numbers take the cells whose bins lie wholly within a region (options seis_near, seis_ring,
+seis_short, seis_long: put them on the bins' edges): near = distance < seis_near, ring = seis_near <=
+distance < seis_ring; just before = [-seis_short, 0), just after = [0, seis_short), some time before =
+[-seis_long, -seis_short). A rate of a region is its counts over its exposures, summed over its cells.
+"""
+import numba as nb
+import numpy as np
+
+import ensemble.model  # noqa: F401  (first: numba caches the kernel in the package's cache, ensemble/kernel_cache.py)
+
+from . import Number, Statistic, Table
+
+NAME = "seismicity"
+_EDGE = 1e-9    # a region's bound matches a bin edge within this share of the bin's width
+
+
+@nb.njit(cache=True)
+def count_pairs(T, epicenter, main, stretch, n_old, time_edges, distance_edges, out):
+    """Count into out (stretches, time bins * distance bins) every pair (mainshock m, event i != m) of
+    the events T (T nu, in time order), epicenter, main (mu >= mu_c), stretch (of each event) with
+    dt = T[i] - T[m] in [time_edges[0], time_edges[-1]) and |epicenter[i] - epicenter[m]| in the
+    distance bins, of which at least one of m, i is new (index >= n_old: the events before are the
+    carried ones, whose pairs among themselves were counted before)."""
+    lo, hi = time_edges[0], time_edges[-1]
+    n_distance = distance_edges.shape[0] - 1
+    n = T.shape[0]
+    for m in range(n):
+        if not main[m]:
+            continue
+        if m >= n_old:   # the events before m: old or new, one of the pair is new
+            i = m - 1
+            while i >= 0 and T[i] - T[m] >= lo:
+                _add(T[i] - T[m], abs(epicenter[i] - epicenter[m]), stretch[m], time_edges, distance_edges,
+                     hi, n_distance, out)
+                i -= 1
+        i = max(m + 1, n_old)
+        while i < n and T[i] - T[m] < hi:
+            _add(T[i] - T[m], abs(epicenter[i] - epicenter[m]), stretch[m], time_edges, distance_edges,
+                 hi, n_distance, out)
+            i += 1
+
+
+@nb.njit(cache=True)
+def _add(dt, d, s, time_edges, distance_edges, hi, n_distance, out):
+    if dt < time_edges[0] or dt >= hi:
+        return
+    j = np.searchsorted(time_edges, dt, side="right") - 1
+    k = np.searchsorted(distance_edges, d, side="right") - 1
+    if 0 <= k < n_distance:
+        out[s, j * n_distance + k] += 1
+
+
+def sites(epicenter, n_blocks, distance_edges):
+    """(mainshocks, distance bins): the blocks 0 .. n_blocks - 1 at a distance in each bin of each epicenter."""
+    d = np.abs(np.arange(n_blocks)[None, :] - np.asarray(epicenter)[:, None])
+    k = np.searchsorted(distance_edges, d, side="right") - 1
+    inside = (k >= 0) & (k < len(distance_edges) - 1)
+    out = np.zeros((len(d), len(distance_edges) - 1))
+    rows = np.broadcast_to(np.arange(len(d))[:, None], d.shape)
+    np.add.at(out, (rows[inside], k[inside]), 1)
+    return out
+
+
+def coverage(T, start, end, time_edges):
+    """(mainshocks, time bins): the T nu of each bin of each mainshock's window (onset T) within [start, end]."""
+    a = T[:, None] + time_edges[None, :-1]
+    b = T[:, None] + time_edges[None, 1:]
+    return np.maximum(np.minimum(b, end) - np.maximum(a, start), 0.0)
+
+
+BATCH = 1024   # mainshocks whose exposures are added at once (their (mainshocks, N) and (mainshocks, cells) arrays)
+
+
+def _expose(acc, carry, take, end, opt):
+    """Add the exposures of the pending mainshocks `take` (a mask, in time order) with the span ending at `end`,
+    one after the other (np.add.at adds in order: the sums are the same whatever the chunks and batches)."""
+    which = np.flatnonzero(take)
+    for a in range(0, len(which), BATCH):
+        pick = which[a:a + BATCH]
+        cov = coverage(carry["pending_T"][pick], carry["start"], end, opt.seis_time_edges)
+        space = sites(carry["pending_x"][pick], carry["n_blocks"], opt.seis_distance_edges)
+        exposure = (cov[:, :, None] * space[:, None, :]).reshape(len(cov), -1)
+        np.add.at(acc["seis_exposure"], carry["pending_s"][pick], exposure)
+
+
+def feed(acc, rows):
+    if rows.ev is None:
+        return
+    opt = rows.opt
+    edges = opt.seis_time_edges
+    T = rows.ev["t"] * rows.nu
+    x = rows.ev["epicenter"].astype(np.int64)
+    main = rows.ev["mu"] >= opt.mu_c
+    carry = acc.carry.get(NAME)
+    if carry is None:   # the task's first inertial event opens its span
+        carry = acc.carry[NAME] = {
+            "start": T[0], "n_blocks": rows.n_blocks, "T": T[:0], "x": x[:0], "main": main[:0], "s": rows.block[:0],
+            "pending_T": T[:0], "pending_x": x[:0], "pending_s": rows.block[:0]}
+    # the background: every event after the task's first closes a gap of the whole chain
+    t = np.concatenate([[rows.t_before], rows.ev["t"]])
+    gap = np.diff(t) * rows.nu
+    first = 0 if np.isfinite(rows.t_before) else 1
+    acc.add(NAME, "n_gaps", rows.block[first:], 1)
+    acc.add(NAME, "block_span", rows.block[first:], gap[first:] * rows.n_blocks)
+    acc.add(NAME, "n_main", rows.block[main], 1)
+    # the pairs: the carried events, then this chunk's
+    n_old = len(carry["T"])
+    allT = np.concatenate([carry["T"], T])
+    allx = np.concatenate([carry["x"], x])
+    allm = np.concatenate([carry["main"], main])
+    alls = np.concatenate([carry["s"], rows.block])
+    count_pairs(allT, allx, allm, alls.astype(np.int64), n_old, edges, opt.seis_distance_edges,
+                acc["seis_pairs"])
+    keep = allT >= allT[-1] - max(abs(edges[0]), abs(edges[-1]))
+    carry.update(T=allT[keep], x=allx[keep], main=allm[keep], s=alls[keep])
+    # the exposures: of every mainshock whose window has been seen to its end, in time order
+    for key, new in (("pending_T", T[main]), ("pending_x", x[main]), ("pending_s", rows.block[main])):
+        carry[key] = np.concatenate([carry[key], new])
+    seen = T[-1] - carry["pending_T"] >= edges[-1]
+    if rows.last:
+        _expose(acc, carry, seen, np.inf, opt)
+        _expose(acc, carry, ~seen, T[-1], opt)      # windows cut by the task's end
+        seen[:] = True
+    else:
+        _expose(acc, carry, seen, np.inf, opt)
+    for key in ("pending_T", "pending_x", "pending_s"):
+        carry[key] = carry[key][~seen]
+
+
+def _cells(edges, lo, hi):
+    """The bins lying wholly within [lo, hi) (bounds matched to edges within _EDGE of a bin's width)."""
+    tol = _EDGE * np.min(np.diff(edges))
+    return (edges[:-1] >= lo - tol) & (edges[1:] <= hi + tol)
+
+
+def rate(u, opt, time, distance):
+    """Events per mainshock per block per T nu in the cells of time [lo, hi) x distance [lo, hi)."""
+    nt, nd = len(opt.seis_time_edges) - 1, len(opt.seis_distance_edges) - 1
+    pick = np.ix_(_cells(opt.seis_time_edges, *time), _cells(opt.seis_distance_edges, *distance))
+    counts = u["seis_pairs"].reshape(nt, nd)[pick].sum()
+    exposure = u["seis_exposure"].reshape(nt, nd)[pick].sum()
+    return counts / exposure if exposure > 0 else np.nan
+
+
+def estimate(u, opt):
+    near, ring = (0.0, opt.seis_near), (opt.seis_near, opt.seis_ring)
+    before, after, earlier = (-opt.seis_short, 0.0), (0.0, opt.seis_short), (-opt.seis_long, -opt.seis_short)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return [u.column(NAME, "n_gaps") / u.column(NAME, "block_span"),
+                rate(u, opt, before, near), rate(u, opt, after, near),
+                rate(u, opt, earlier, near) / rate(u, opt, earlier, ring),
+                rate(u, opt, before, near) / rate(u, opt, before, ring)]
+
+
+def rate_map(units, opt, rng):
+    """The map of a point: its summed counts over its summed exposures, (time bins, distance bins)."""
+    nt, nd = len(opt.seis_time_edges) - 1, len(opt.seis_distance_edges) - 1
+    counts = units["seis_pairs"].sum(axis=0).reshape(nt, nd).astype(float)
+    exposure = units["seis_exposure"].sum(axis=0).reshape(nt, nd)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return {"seismicity_rate": np.where(exposure > 0, counts / exposure, np.nan)}
+
+
+RATE = "1/(block model length)"   # events per mainshock per block per unit T nu
+STATISTIC = Statistic(
+    NAME, 60,
+    tables=(Table("seis_pairs", "count", "events (any size) at (time from a mainshock's onset, distance from its "
+                                         "epicenter), per task and stretch of the mainshock",
+                  bins=("seis_time", "seis_distance")),
+            Table("seis_exposure", "block model length", "the mainshocks' exposure of each cell: the T nu of its "
+                                                         "time bin within the task's span times the chain's blocks "
+                                                         "in its distance bin", bins=("seis_time", "seis_distance"),
+                  weights=True),
+            Table(NAME, "count or sum", "mainshocks, and the events and block x T nu of the background",
+                  columns=("n_main", "n_gaps", "block_span"))),
+    numbers=(Number("background_rate", RATE, "inertial events per block per unit T nu over the whole chain and "
+                                             "task (the events after the task's first over N times its span)",
+                    "background rate"),
+             Number("foreshock_rate", RATE, "events per mainshock per block per T nu at distance < seis_near from "
+                                            "its epicenter in [-seis_short, 0) before its onset", "foreshock rate"),
+             Number("aftershock_rate", RATE, "the same in [0, seis_short) after its onset (the mainshock left out)",
+                    "aftershock rate"),
+             Number("quiescence_ratio", "1", "rate at distance < seis_near over the rate at seis_near <= distance < "
+                                             "seis_ring, both in [-seis_long, -seis_short) (< 1: quiet epicenter, "
+                                             "active ring)", "quiescence ratio"),
+             Number("doughnut_ratio", "1", "the same ratio just before the onset, in [-seis_short, 0)",
+                    "doughnut ratio")),
+    feed=feed, estimate=estimate, extra=rate_map,
+    extra_datasets={"seismicity_rate": (RATE, "(points, seis_time bins, seis_distance bins)",
+                                        "events per mainshock per block per unit T nu at (time from the mainshock's "
+                                        "onset, distance from its epicenter); NaN where nothing was exposed")})
