@@ -226,6 +226,8 @@ def recurrence(summaries, fig, labels):
               "all large events", "C0")
         _band(ax, x, s["points/tnu_interior_density"][i], s["points/tnu_interior_lo"][i],
               s["points/tnu_interior_hi"][i], "interior events (the rupture reaches neither end)", "C3", style="--")
+        if "points/numbers/cv_tnu" in s:       # (summaries before format 4 have no intervals statistic)
+            label += "\nCV of $T\\nu$ " + interval_text(*s["points/numbers/cv_tnu"][i])
         ax.set_title(label, fontsize=FONT + 1)
         ax.set_xlabel(r"$T\nu$")
         ax.set_ylabel(r"$P(T\nu)$")
@@ -233,6 +235,13 @@ def recurrence(summaries, fig, labels):
         ax.set_ylim(0, ax.get_ylim()[1])
     handles, texts = fig.axes[0].get_legend_handles_labels()
     fig.legend(handles, texts, loc="lower center", ncol=2, fontsize=FONT + 1, frameon=False)
+
+
+def interval_text(est, lo, hi):
+    """'0.84 [0.77, 0.91]' (or the estimate alone, or 'n/a')."""
+    if not np.isfinite(est):
+        return "n/a"
+    return f"{est:.2f} [{lo:.2f}, {hi:.2f}]" if np.isfinite(lo) and np.isfinite(hi) else f"{est:.2f}"
 
 
 def place_insets(summaries, fig):

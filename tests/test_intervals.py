@@ -73,3 +73,26 @@ def test_every_statistic_is_the_same_whatever_the_chunks(tmp_path):
             for name in whole:
                 np.testing.assert_array_equal(whole[name], pieces[name], err_msg=name)
             assert whole["intervals"][:, 1].sum() == args[0] - 1      # every gap between its events, once
+
+
+def test_the_recurrence_figure_gives_each_panel_its_cv(tmp_path):
+    """`analysis plot --figure recurrence`: each panel's title carries its point's CV of T nu with its interval,
+    as the summary has them; a summary without the statistic (before format 4) keeps the plain title."""
+    from analysis import plot, summary
+    from .test_summary_identity import REFERENCE
+    s = summary.read(gunzip(REFERENCE, tmp_path / "summary.h5"))
+    fig = plot.figure(s, "recurrence")
+    try:
+        titles = [ax.get_title() for ax in fig.axes if ax.get_title()]
+        cvs = s["points/numbers/cv_tnu"]
+        assert len(titles) == len(cvs) == 2
+        for title, (est, lo, hi) in zip(titles, cvs):
+            assert title.endswith(f"CV of $T\\nu$ {est:.2f} [{lo:.2f}, {hi:.2f}]"), title
+    finally:
+        plot.plt.close(fig)
+    old = {k: v for k, v in s.items() if k != "points/numbers/cv_tnu"}
+    fig = plot.figure(old, "recurrence")
+    try:
+        assert not any("CV" in ax.get_title() for ax in fig.axes)
+    finally:
+        plot.plt.close(fig)
