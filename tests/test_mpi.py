@@ -129,11 +129,17 @@ def start_and_interrupt(cfg, out, how, writer="auto"):
         return proc.wait(TIMEOUT, f"the run after {how}"), proc.output
 
 
+# (marked slow: the same paths again with another signal or rank; `make test-all` runs them, CI's `make test`
+# the three that take every path: both ranks, one rank, and the rank-0 writer with the other rank signalled)
+SLOW = pytest.mark.slow
+
+
 @pytest.mark.parametrize("sig,which,writer", [
-    (signal.SIGTERM, "all", "auto"), (signal.SIGUSR1, "one", "auto"), (signal.SIGINT, "all", "auto"),
+    (signal.SIGTERM, "all", "auto"), (signal.SIGUSR1, "one", "auto"),
+    pytest.param(signal.SIGINT, "all", "auto", marks=SLOW),
     # the rank-0 writer: rank 0 must serve the other rank's last rows and its "done", wherever they arrive
-    (signal.SIGTERM, "one", "rank0"), (signal.SIGTERM, "other", "rank0"), (signal.SIGTERM, "all", "rank0"),
-    (signal.SIGUSR1, "other", "rank0")])
+    pytest.param(signal.SIGTERM, "one", "rank0", marks=SLOW), (signal.SIGTERM, "other", "rank0"),
+    pytest.param(signal.SIGTERM, "all", "rank0", marks=SLOW), pytest.param(signal.SIGUSR1, "other", "rank0", marks=SLOW)])
 def test_resume_after_signal_equals_uninterrupted(four_tasks, sig, which, writer):
     """Every rank checkpoints and exits 75 (also when only one rank got the signal); resume completes."""
     d, cfg = four_tasks

@@ -14,6 +14,7 @@ import os
 import sys
 
 import numpy as np
+import pytest
 
 from ensemble.config import Integrator, Model
 from ensemble.integrators import kernel_params
@@ -74,7 +75,7 @@ def test_nonfinite_parameters_are_named():
 # Runs in a subprocess compiled with NUMBA_BOUNDSCHECK=1; prints one JSON line
 # {"hard": {case: "ok" or the error}, "bad": {input: status code or the error}}.
 BOUNDSCHECK_SCRIPT = r"""
-import dataclasses, json, math
+import dataclasses, json, math, os
 import numpy as np
 from ensemble.config import Config, Integrator, Model, Run
 from ensemble.runner import SimulationError, Trajectory
@@ -82,10 +83,11 @@ from ensemble.tasks import task_list
 from tests.test_hard_cases import CASES
 from tests.test_nonfinite import run_simulate
 
+METHODS = json.loads(os.environ["BOUNDSCHECK_METHODS"])
 hard, bad = {}, {}
 for name, (model, rk4_dt, _) in CASES.items():
     model = dataclasses.replace(model, N=min(model.N, 30))
-    for method in ("rk4", "ark4"):
+    for method in METHODS:
         for budget in (None, 50):     # whole events, and events paused every ~50 block-steps
             integ = Integrator(method="rk4", dt=rk4_dt) if method == "rk4" else Integrator(method=method)
             cfg = Config(model=model, run=Run(), integrator=integ)
@@ -109,32 +111,33 @@ for name, block, column, value in (("NaN force", 7, 0, math.nan), ("-inf force",
                                    ("inf psi", 5, 1, math.inf), ("NaN psi", 29, 1, math.nan)):
     state = initial(model)
     state[column][block] = value
-    for method in ("rk4", "ark4"):
+    for method in METHODS:
         try:
             bad[f"{name} [{method}]"] = int(run_simulate(model, *state, method=method)[0])
         except IndexError as err:
             bad[f"{name} [{method}]"] = "IndexError: " + str(err)
 huge = Model(N=30, b=1e300, nu=1e-20)
 try:
-    bad["b = 1e300, nu = 1e-20"] = int(run_simulate(huge, *initial(huge))[0])
+    bad["b = 1e300, nu = 1e-20"] = int(run_simulate(huge, *initial(huge), method=METHODS[0])[0])
 except IndexError as err:
     bad["b = 1e300, nu = 1e-20"] = "IndexError: " + str(err)
 print(json.dumps({"hard": hard, "bad": bad}))
 """
 
 
-def test_bounds_checked_hard_cases_and_bad_inputs(tmp_path):
-    """Hard cases (small N, rk4 and ark4, with and without pauses) run; NaN/inf inputs give NONFINITE.
-
-    Under a minute (30-50 s here), most of it the bounds-checked compilation.
-    """
+@pytest.mark.parametrize("methods", [("exp4",), pytest.param(("rk4", "ark4", "exp4"), marks=pytest.mark.slow)])
+def test_bounds_checked_hard_cases_and_bad_inputs(methods, tmp_path):
+    """Hard cases (small N, with and without pauses) run; NaN/inf inputs give NONFINITE. Most of the time is
+    the bounds-checked compilation, about a minute per method here: `make test` checks the aging law's
+    default, exp4; the slow case (make test-all) rk4, ark4 and exp4."""
     env = dict(os.environ, NUMBA_BOUNDSCHECK="1", NUMBA_CACHE_DIR=str(tmp_path / "numba"),
-               PYTHONPATH=str(ROOT), OMP_NUM_THREADS="1", NUMBA_NUM_THREADS="1")
+               PYTHONPATH=str(ROOT), OMP_NUM_THREADS="1", NUMBA_NUM_THREADS="1",
+               BOUNDSCHECK_METHODS=json.dumps(list(methods)))
     res = run_bounded([sys.executable, "-c", BOUNDSCHECK_SCRIPT], 600, cwd=ROOT, env=env)
     assert res.returncode == 0, res.stderr
     outcome = json.loads(res.stdout.strip().splitlines()[-1])
     for kind in ("hard", "bad"):
         print("\n".join(f"{kind}: {k}: {v}" for k, v in outcome[kind].items()))
-    assert len(outcome["hard"]) == 28 and len(outcome["bad"]) == 9
+    assert len(outcome["hard"]) == 7 * 2 * len(methods) and len(outcome["bad"]) == 4 * len(methods) + 1
     assert outcome["hard"] == {key: "ok" for key in outcome["hard"]}
     assert outcome["bad"] == {key: NONFINITE for key in outcome["bad"]}
