@@ -110,7 +110,7 @@ def _events(path, chunk=catalog.READ_CHUNK):
 
 
 INTEGRATOR_MEANINGS = {   # key -> (unit, meaning), the keys of ensemble.config.Integrator
-    "method": ("text", "event integrator (ark4, ark3, ark5 adaptive IMEX; rk4 fixed step)"),
+    "method": ("text", "event integrator (exp4 exponential in the aging law's state, its default; ark4, ark3, ark5 adaptive IMEX; rk4 fixed step)"),
     "dt": ("model time", "step of rk4; first step of the adaptive methods"),
     "rtol": ("1", "adaptive methods: relative tolerance of the local error per step"),
     "atol": ("model length", "adaptive methods: absolute tolerance (slip, velocity)"),
