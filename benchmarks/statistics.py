@@ -179,13 +179,13 @@ def table(rows, floor, title):
     return lines
 
 
-def plot(rows, floor, path, title, xlabel="events per second (one core)"):
+def plot(rows, floor, path, title, xlabel="events per second (one core)", floor_label="noise floor (reference halves)"):
     plt = pyplot()
     fig, axes = plt.subplots(2, 2, figsize=(9, 7))
     ref = rows[0]
     for ax, key in zip(axes.flat, [f"{n}_{s}" for s in SAMPLES for n in DISTANCES]):
         band = floor[key]
-        ax.axhspan(band["min"], band["max"], color="0.85", label="noise floor (reference halves)")
+        ax.axhspan(band["min"], band["max"], color="0.85", label=floor_label)
         ax.axhline(band["mean"], color="0.6", lw=1)
         for k, r in enumerate(rows[1:]):
             if r["status"] == "ok" and np.isfinite(r[key]) and np.isfinite(r["events_per_second"]):
@@ -467,7 +467,9 @@ def compare_catalogs(args):
                               "task_events_per_second": s["points"][point]["rates"]} for s in settings]}
         write_outputs(args.out, stem, data, lines)
         plot(rows, floor, f"{args.out}/{stem}.png", title,
-             xlabel="events per second (mean over the catalog's tasks, as its run measured)")
+             xlabel="events per second (mean over the catalog's tasks, as its run measured)",
+             floor_label="noise floor (halves of the reference and its rerun, and their distance)" if rerun
+             else "noise floor (reference halves)")
         results[stem] = data
     return results
 
