@@ -1,7 +1,7 @@
 """What a file is, in words, so that a wrong argument gets a one-line answer, not a traceback.
 
 The commands take three kinds of files: run configs (TOML), event catalogs (HDF5 whose root
-attribute `format` starts with "bk-catalog-", ensemble/catalog.py) and reduction summaries (HDF5,
+attribute `format` starts with "bk-catalog-", ensemble/store/) and reduction summaries (HDF5,
 `format` "bk-summary-N", analysis/summary.py). A catalog and its summary sit side by side, both
 *.h5, so giving one for the other is an easy slip; `require` says what was given and what to give:
 

@@ -5,7 +5,9 @@ import sys
 import numpy as np
 import pytest
 
-from ensemble import catalog
+from ensemble.store import reader, writers
+from ensemble.store.errors import CatalogError
+from ensemble.store.files import partial_path
 from ensemble.config import Integrator, Model
 from ensemble.events import advance_to_onset, check, run_event
 from ensemble.integrators import kernel_params
@@ -100,7 +102,7 @@ def pytest_configure(config):
     # stderr itself, kept for the watchdog: during a test fd 2 is pytest's capture file
     config.stash[_STDERR] = os.dup(sys.stderr.fileno())
     # `make test` sets up the parallel stack and says so: then no test may skip for want of MPI-IO
-    if os.environ.get("ENSEMBLE_TEST_STACK") == "parallel" and not catalog.has_parallel_hdf5():
+    if os.environ.get("ENSEMBLE_TEST_STACK") == "parallel" and not writers.has_parallel_hdf5():
         raise pytest.UsageError("ENSEMBLE_TEST_STACK=parallel, but this h5py has no MPI support "
                                 "(rerun `make test`, or `make test STACK=wheels` to skip the MPI-IO tests)")
 
@@ -109,7 +111,7 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         if item.originalname in QUICK.get(item.path.name, ()):
             item.add_marker(pytest.mark.quick)
-    if catalog.has_parallel_hdf5():
+    if writers.has_parallel_hdf5():
         return
     skip = pytest.mark.skip(reason="h5py without MPI (the wheel stack): the parallel writer is not "
                                    "tested here; `make test` sets up the parallel stack and tests it")
@@ -179,8 +181,8 @@ def run_cli(*args, cwd=None, timeout=600):
 def committed(out):
     """True once the run writing catalog `out` has committed a batch of events (readable, not yet renamed)."""
     try:
-        _, tasks, _ = catalog.read_tasks(catalog.partial_path(out))
-    except catalog.CatalogError:
+        _, tasks, _ = reader.read_tasks(partial_path(out))
+    except CatalogError:
         return False      # not created yet, or open for writing at that moment
     return tasks["events_written"].sum() > 0
 
