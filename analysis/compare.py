@@ -309,5 +309,5 @@ def write(points, opt, out_dir, command, force=False, inputs=()):
                    for j, name in enumerate(NUMBERS)}} for p in points]
     with open(os.path.join(out_dir, "comparison.json"), "w") as f:
         json.dump({"options": opt.__dict__, "points": numbers}, f, indent=1)
-    figures(points, opt, out_dir)
+    figures(points, opt, out_dir, MU_EDGES)
     return [os.path.join(out_dir, n) for n in OUTPUTS]

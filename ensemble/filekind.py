@@ -17,6 +17,8 @@ import os
 import stat
 from contextlib import contextmanager
 
+from .sections import SECTION_NAMES, SWEEP
+
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 CATALOG_FORMAT_PREFIX = "bk-catalog-"
 SUMMARY_FORMAT_PREFIX = "bk-summary-"
@@ -126,8 +128,7 @@ def _text_kind(head):
         doc = tomllib.loads(head.decode("utf-8"))
     except (UnicodeDecodeError, tomllib.TOMLDecodeError):
         return "other", ""
-    from .config import SECTIONS
-    if doc and set(doc) <= set(SECTIONS) | {"sweep"}:
+    if doc and set(doc) <= {*SECTION_NAMES, SWEEP}:
         return "config", ""
     return "toml", ""
 

@@ -86,6 +86,9 @@ QUICK = {
     "test_benchmarks.py": ["test_distances_agree_with_scipy", "test_settings_are_validated"],
     "test_time_to_statistics.py": ["test_schedule_replays_the_counter"],
     "test_options.py": ["test_every_numeric_option_is_checked_and_attacked", "test_huge_bins_are_refused_before_any_file_is_read"],
+    "test_imports.py": ["test_no_module_imports_itself_round_a_circle",
+                        "test_the_graph_sees_imports_inside_functions_and_relative_ones",
+                        "test_the_store_modules_are_small"],
     "test_quick_tier.py": ["test_every_test_named_in_the_quick_tier_exists",
                            "test_every_test_file_is_in_the_quick_tier_or_says_why_not"],
 }
