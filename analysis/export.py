@@ -316,9 +316,10 @@ SUMMARY_TABLES = ("curves", "numbers", "peaks")
 
 def source_kind(path):
     """"summary" or "catalog"; anything else raises the catalog's error saying what the file is."""
-    if filekind.identify(path)[0] == "summary":
+    found = filekind.identify(path)
+    if found[0] == "summary":
         return "summary"
-    filekind.require(path, "catalog", CatalogError)
+    filekind.require(path, "catalog", CatalogError, found)
     return "catalog"
 
 

@@ -133,9 +133,9 @@ def _text_kind(head):
     return "toml", ""
 
 
-def describe(path):
-    """What `path` is, as the predicate of "PATH ...", e.g. "is a directory"."""
-    kind, detail = identify(path)
+def describe(path, found=None):
+    """What `path` is, as the predicate of "PATH ...", e.g. "is a directory" (found: its identify(), if known)."""
+    kind, detail = identify(path) if found is None else found
     words = KINDS[kind]
     if not detail:
         return words
@@ -144,9 +144,13 @@ def describe(path):
     return f"{words} ({detail})"
 
 
-def require(path, wanted, error=FileKindError):
-    """Raise error(one line) unless `path` is of kind `wanted` ("catalog", "summary" or "config")."""
-    kind, _ = identify(path)
+def require(path, wanted, error=FileKindError, found=None):
+    """Raise error(one line) unless `path` is of kind `wanted` ("catalog", "summary" or "config").
+
+    found: identify(path) where the caller has it already (the file is looked at once).
+    """
+    found = identify(path) if found is None else found
+    kind = found[0]
     if kind == wanted:
         return
     if kind == "missing":
@@ -155,9 +159,9 @@ def require(path, wanted, error=FileKindError):
             message += (f" ({path}.partial does: a run that has not finished; continue it with "
                         f"`python -m ensemble resume {path}`)")
     elif kind in ("unreadable", "damaged"):
-        message = f"{path} {describe(path)}"
+        message = f"{path} {describe(path, found)}"
     else:
-        message = f"{path} {describe(path)}, not {NOUNS[wanted]}"
+        message = f"{path} {describe(path, found)}, not {NOUNS[wanted]}"
         hint = HINTS.get((kind, wanted))
         if hint:
             message += f" ({hint.format(path=path)})"
