@@ -57,7 +57,7 @@ class Trajectory:
         self.discarded = cfg.run.discarded if discarded is None else discarded
         self.integrator = cfg.integrator if integrator is None else integrator
         self.ws = Workspace(task.model.N)
-        # a chain that can creep keeps its creep phase's state in its checkpoints (carries_creep)
+        # a chain that can creep keeps its creep phase's state in its checkpoints (store/checkpoint.py)
         self.creeps = carries_creep(task.model)
         if checkpoint is None:
             self.ws.load(*initial_state(cfg, task))
@@ -101,7 +101,7 @@ class Trajectory:
 
 
 def event_rows(task, t, epicenter, diag):
-    """Kernel output -> catalog columns (see schema.EVENT_FIELDS)."""
+    """Kernel output -> catalog columns (EVENT_FIELDS, ensemble/store/schema.py)."""
     first = diag[:, D_FIRST].astype(np.int64)
     last = diag[:, D_LAST].astype(np.int64)
     return {
