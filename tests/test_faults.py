@@ -21,7 +21,7 @@ from ensemble import lock
 from ensemble.store import reader, schema
 from ensemble.store.errors import CatalogError
 from ensemble.store.files import partial_path
-from ensemble.integrity import commit_crc
+from ensemble.store.integrity import commit_crc
 
 from .conftest import committed, write_config
 from .inject import CRASH_CODE
