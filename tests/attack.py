@@ -24,10 +24,10 @@ import h5py  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ensemble import lock  # noqa: E402
-from ensemble.store import reader, schema
-from ensemble.store.errors import CatalogError
-from ensemble.store.files import partial_path
 from ensemble.model.workspace import Workspace  # noqa: E402
+from ensemble.store import reader, schema  # noqa: E402
+from ensemble.store.errors import CatalogError  # noqa: E402
+from ensemble.store.files import partial_path  # noqa: E402
 from tests.processes import child_env, run_bounded, wait_for  # noqa: E402
 
 DEADLINE = 120        # seconds for any command: what they take is a few (a hang fails the attack)
