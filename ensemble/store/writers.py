@@ -1,8 +1,9 @@
 """The two writers of a run's catalog, with one API: every rank writes its own tasks (ParallelWriter,
 mpio), or rank 0 writes what the others send it (Rank0Writer); both produce the same catalog.
 
-This is the only module that touches HDF5 under MPI: the collective steps (create, open, close) are
-here; after creation nothing collective is left (layout.py), so each rank writes its rows independently.
+The store is the only package that touches HDF5 under MPI, and its collective steps (create, open,
+close) are here: the layout every rank makes alike is create.py's, and after creation nothing collective
+is left (layout.py), so each rank writes its rows independently.
 """
 import h5py
 
