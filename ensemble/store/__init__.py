@@ -11,5 +11,6 @@
     tables.py       checks of the tables fixed at creation and of each task's record
     errors.py       CatalogError; a failed write as one
 
-No other package touches HDF5 under MPI. Nothing is imported here: callers import the module they use (`from ensemble.store import reader`).
+No other package touches HDF5 under MPI. Nothing is imported here: callers import the module they use
+(`from ensemble.store import reader`).
 """
