@@ -26,7 +26,7 @@ import os
 import sys
 
 from ensemble import checks, filekind
-from ensemble.catalog import CatalogError
+from ensemble.store.errors import CatalogError
 
 from . import merge, summary
 from .reduce import (CREEP_DURATION_BINS, CREEP_MU_BINS, LAYOUT, NUMBERS, SEIS_DISTANCE_BINS, SEIS_LONG, SEIS_NEAR,

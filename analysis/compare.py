@@ -32,7 +32,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ensemble import catalog, checks, filekind
+from ensemble import checks, filekind
+from ensemble.store import reader, schema
+from ensemble.store.errors import CatalogError
 
 from . import merge, stats
 from .recurrence import RecurrenceScanner
@@ -152,8 +154,8 @@ class Units:
 def task_units(path, task, opt):
     """Stretches of one task's inertial events (/events/kind 0; its creep episodes are no events here):
     (sizes, mu, [T per stretch])."""
-    with filekind.reading(path, "the event catalog", catalog.CatalogError), catalog.Reader(path) as cat:
-        written = cat.count(task, catalog.KIND_EVENT)
+    with filekind.reading(path, "the event catalog", CatalogError), reader.Reader(path) as cat:
+        written = cat.count(task, schema.KIND_EVENT)
         n_blocks, nu = int(cat.tasks["N"][task]), float(cat.tasks["nu"][task])
         k = opt.blocks
         sizes = np.zeros((k, n_blocks + 1), np.int64)
@@ -161,7 +163,7 @@ def task_units(path, task, opt):
         T = [[] for _ in range(k)]
         scanner = RecurrenceScanner(n_blocks, 0.5, opt.window)
         lo = 0
-        for ev in cat.task_events(task, kind=catalog.KIND_EVENT):
+        for ev in cat.task_events(task, kind=schema.KIND_EVENT):
             hi = lo + len(ev["t"])
             block = (np.arange(lo, hi) * k) // max(written, 1)
             n = ev["n_slipped"].astype(np.int64)
@@ -307,5 +309,5 @@ def write(points, opt, out_dir, command, force=False, inputs=()):
                    for j, name in enumerate(NUMBERS)}} for p in points]
     with open(os.path.join(out_dir, "comparison.json"), "w") as f:
         json.dump({"options": opt.__dict__, "points": numbers}, f, indent=1)
-    figures(points, opt, out_dir)
+    figures(points, opt, out_dir, MU_EDGES)
     return [os.path.join(out_dir, n) for n in OUTPUTS]

@@ -8,7 +8,6 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .compare import MU_EDGES  # noqa: E402
 from .plot import _band  # noqa: E402
 from .stats import centers  # noqa: E402
 
@@ -29,7 +28,9 @@ def _legend(ax):
     ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
 
 
-def figures(points, opt, out_dir):
+def figures(points, opt, out_dir, mu_edges):
+    """size.png, magnitude.png and recurrence.png of the points; mu_edges: the magnitude bins of their
+    R(mu) (compare.MU_EDGES, passed in: compare.py imports this module)."""
     colors = _colors(len(points))
 
     fig, ax = plt.subplots(figsize=(9.6, 4.4))
@@ -53,7 +54,7 @@ def figures(points, opt, out_dir):
 
     fig, ax = plt.subplots(figsize=(9.6, 4.4))
     for p, color in zip(points, colors):
-        _band(ax, centers(MU_EDGES), p["mu_density"], p["mu_lo"], p["mu_hi"], _with_events(p), color, log=True)
+        _band(ax, centers(mu_edges), p["mu_density"], p["mu_lo"], p["mu_hi"], _with_events(p), color, log=True)
     lowest = min(p["mu_density"][p["mu_density"] > 0].min() for p in points)
     ax.set_ylim(bottom=lowest / 3)      # a lower bound of 0 would stretch the axis to 1e-300
     ax.set(yscale="log", xlabel="mu = log10(total slip) (each law's own scale)", ylabel="R(mu)",

@@ -15,7 +15,7 @@
 
 Events join tasks on `task`; curves and peaks join numbers on `point` (the row of the summary's
 /points datasets). Units and meanings come from the tables that also describe the HDF5 datasets
-(ensemble/catalog.py's and analysis/summary.py's DATASETS), so the files and the exports say the
+(ensemble/store/schema.py's and analysis/summary.py's DATASETS), so the files and the exports say the
 same. Text is returned on one line (newlines as spaces); a task's [integrator] is split into
 typed columns integrator_<key>.
 
@@ -37,7 +37,7 @@ one line, "PARTIAL export of an unfinished run (...): events written of expected
 without comment lines would carry that line in its metadata), as the tables of a --partial
 reduction carry the summary's statement.
 
-A catalog is streamed in chunks of catalog.READ_CHUNK rows, each verified as it is read (ranges,
+A catalog is streamed in chunks of schema.READ_CHUNK rows, each verified as it is read (ranges,
 and each task's checksum after its last chunk); the files of an export are written beside their
 names and renamed into place only when all are complete, so an export that fails writes nothing.
 """
@@ -47,7 +47,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ensemble import __version__, catalog, checks, filekind
+from ensemble import __version__, checks, filekind
+from ensemble.store import reader, schema
+from ensemble.store.errors import CatalogError
 from ensemble.config import LAW_KEYS
 
 from . import merge, summary
@@ -92,14 +94,14 @@ def _structured(columns, values):
     return out
 
 
-def _events(path, chunk=catalog.READ_CHUNK):
-    names = list(catalog.EVENT_FIELDS)
-    columns = {name: catalog.DATASETS[f"events/{name}"][::2] for name in names}
-    dtype = [(name, catalog.EVENT_FIELDS[name]) for name in names]
+def _events(path, chunk=schema.READ_CHUNK):
+    names = list(schema.EVENT_FIELDS)
+    columns = {name: schema.DATASETS[f"events/{name}"][::2] for name in names}
+    dtype = [(name, schema.EVENT_FIELDS[name]) for name in names]
 
     def parts():
         # the catalog checks each chunk's ranges as it streams and each task's checksum after it
-        with filekind.reading(path, "the event catalog", catalog.CatalogError), catalog.Reader(path) as cat:
+        with filekind.reading(path, "the event catalog", CatalogError), reader.Reader(path) as cat:
             for task in range(len(cat.tasks["point"])):
                 for part in cat.task_events(task, chunk):
                     out = np.empty(len(part["t"]), dtype=dtype)
@@ -127,7 +129,7 @@ def _integrator_columns(path, texts):
         try:
             parsed.append(tomllib.loads(text))
         except tomllib.TOMLDecodeError as err:
-            raise catalog.CatalogError(f"{path}: task {k}: stored integrator cannot be read ({err})") from None
+            raise CatalogError(f"{path}: task {k}: stored integrator cannot be read ({err})") from None
     keys = list(dict.fromkeys(key for p in parsed for key in p))
     out = {}
     for key in keys:
@@ -140,10 +142,10 @@ def _integrator_columns(path, texts):
 
 
 def _tasks(path):
-    with filekind.reading(path, "the event catalog", catalog.CatalogError):
-        _, tasks, _ = catalog.read_tasks(path)
-    described = {**{name.split("/", 1)[1]: entry for name, entry in catalog.DATASETS.items()
-                    if name.startswith("tasks/")}, **catalog.READER_TASKS}
+    with filekind.reading(path, "the event catalog", CatalogError):
+        _, tasks, _ = reader.read_tasks(path)
+    described = {**{name.split("/", 1)[1]: entry for name, entry in schema.DATASETS.items()
+                    if name.startswith("tasks/")}, **schema.READER_TASKS}
     values = {"task": np.arange(len(tasks["point"]), dtype=np.int64)}
     columns = {"task": ("index", "task index (events join on it)")}
     first = ("point", "seed_index", "N", "l", "nu", "law", *LAW_KEYS, "events_written", "events_done",
@@ -269,7 +271,7 @@ def _seismicity(s):
 def _whole(table):
     parts = list(table.parts)
     if not parts:
-        return np.zeros(0, dtype=[(name, catalog.EVENT_FIELDS[name]) for name in table.columns])
+        return np.zeros(0, dtype=[(name, schema.EVENT_FIELDS[name]) for name in table.columns])
     return np.concatenate(parts) if len(parts) > 1 else parts[0]
 
 
@@ -282,14 +284,14 @@ def _result(arr, frame):
 def events(path, frame=False):
     """Every committed event of a catalog (structured array, tasks in order; verified).
 
-    Fields: catalog.EVENT_FIELDS (task, t, epicenter, mu, slip, first, last, n_slipped, boundary,
+    Fields: schema.EVENT_FIELDS (task, t, epicenter, mu, slip, first, last, n_slipped, boundary,
     duration, kind, ending): inertial events (kind 0) and creep episodes (kind 1) alike. Holds the
     whole catalog in memory: iter_events streams it.
     """
     return _result(_whole(_events(path)), frame)
 
 
-def iter_events(path, chunk=catalog.READ_CHUNK):
+def iter_events(path, chunk=schema.READ_CHUNK):
     """The catalog's committed events as structured arrays of at most `chunk` rows, verified as
     they stream (a task's checksum after its last chunk: consume them all)."""
     return iter(_events(path, chunk).parts)
@@ -345,9 +347,10 @@ SUMMARY_TABLES = ("curves", "numbers", "peaks", "seismicity")
 
 def source_kind(path):
     """"summary" or "catalog"; anything else raises the catalog's error saying what the file is."""
-    if filekind.identify(path)[0] == "summary":
+    found = filekind.identify(path)
+    if found[0] == "summary":
         return "summary"
-    filekind.require(path, "catalog", catalog.CatalogError)
+    filekind.require(path, "catalog", CatalogError, found)
     return "catalog"
 
 
@@ -355,8 +358,8 @@ def _unfinished_run(path):
     """("", "") for a finished run, else (why, statement): why it is unfinished, worded as reduce's
     refusal (analysis/merge.py, which counts its tasks the same way: not finished, or with fewer
     events than events_per_task; or a run's *.partial), and the line every table's header states."""
-    with filekind.reading(path, "the event catalog", catalog.CatalogError):
-        per_task, tasks, _ = catalog.read_tasks(path)
+    with filekind.reading(path, "the event catalog", CatalogError):
+        per_task, tasks, _ = reader.read_tasks(path)
     n_open, named = merge._unfinished(path, tasks, per_task)
     if not (n_open or named):
         return "", ""
@@ -367,7 +370,7 @@ def _unfinished_run(path):
     return why, f"PARTIAL export of an unfinished run ({why}): {written} of {expected} events{share}"
 
 
-def _tables(path, names, chunk=catalog.READ_CHUNK, partial=True):
+def _tables(path, names, chunk=schema.READ_CHUNK, partial=True):
     """({name: Table}, a line of the reduction's settings, or of what an unfinished run lacks, or "")
     of a catalog's or a summary's tables; an unfinished run is refused unless partial."""
     kind = source_kind(path)
@@ -379,7 +382,7 @@ def _tables(path, names, chunk=catalog.READ_CHUNK, partial=True):
         why, statement = _unfinished_run(path)
         if why and not partial:
             path = str(path)
-            raise catalog.CatalogError(
+            raise CatalogError(
                 f"{path} is an unfinished run ({why}); continue it with `python -m ensemble resume "
                 f"{path.removesuffix('.partial')}`, or export what it holds with --partial")
         build = {"events": lambda: _events(path, chunk), "tasks": lambda: _tasks(path)}
@@ -449,13 +452,13 @@ def write_csv(path, name, table, source, settings=""):
 FORMATS = {"csv": (".csv", write_csv)}   # format -> (file suffix, writer(path, name, table, source, settings))
 
 
-def write(source, directory, fmt="csv", force=False, chunk=catalog.READ_CHUNK, partial=False):
+def write(source, directory, fmt="csv", force=False, chunk=schema.READ_CHUNK, partial=False):
     """Every table of a catalog (events, tasks) or a summary (curves, numbers, peaks, seismicity) into files
     DIRECTORY/<table><suffix>; returns their paths.
 
     Refuses (checks.UsageError naming the path, nothing written) a directory that cannot be made
     or written, the source as the directory or a table, and a table that exists unless force. An
-    unfinished run (a *.partial catalog, unfinished tasks) is refused (catalog.CatalogError, as
+    unfinished run (a *.partial catalog, unfinished tasks) is refused (CatalogError, as
     reduce refuses it) unless partial; then every table's header says what it lacks. Files are
     written beside their names and renamed into place when all are complete.
     """

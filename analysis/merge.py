@@ -22,7 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ensemble import catalog, filekind
+from ensemble import filekind
+from ensemble.store import reader, schema
+from ensemble.store.errors import CatalogError
 from ensemble.config import loads
 
 from .reduce import PARAMS, reduce_tasks
@@ -76,7 +78,7 @@ def _streams(tasks, config_text):
 
 def _unfinished(path, tasks, per_task):
     """Unfinished tasks of a catalog: (count, True if the file is a run's *.partial)."""
-    open_ = (tasks["status"] != catalog.FINISHED) | (tasks["events_written"] < per_task)
+    open_ = (tasks["status"] != schema.FINISHED) | (tasks["events_written"] < per_task)
     return int(np.count_nonzero(open_)), str(path).endswith(".partial")
 
 
@@ -84,14 +86,14 @@ def read(paths, allow_partial=False):
     """Inputs of the catalogs at `paths`; every check is made here, before any work."""
     paths = [str(p) for p in paths]
     for i, a in enumerate(paths):
-        filekind.require(a, "catalog", catalog.CatalogError)
+        filekind.require(a, "catalog", CatalogError)
         for b in paths[:i]:
             if os.path.samefile(a, b):
                 raise MergeError(f"{a} is given twice (also as {b}): give each catalog once")
     tables, configs, per_tasks, unfinished = [], [], [], []
     for path in paths:
-        with filekind.reading(path, "the event catalog", catalog.CatalogError):
-            per_task, tasks, attrs = catalog.read_tasks(path)
+        with filekind.reading(path, "the event catalog", CatalogError):
+            per_task, tasks, attrs = reader.read_tasks(path)
         tasks["seed_entropy"], tasks["spawn_key"] = _streams(tasks, attrs["config"])
         tables.append(tasks)
         configs.append(str(attrs["config"]))
@@ -102,7 +104,7 @@ def read(paths, allow_partial=False):
         path, tasks, (n_open, named) = next((p, t, u) for p, t, u in zip(paths, tables, unfinished)
                                             if u[0] or u[1])
         what = f"{n_open} of {len(tasks['point'])} tasks unfinished" if n_open else "named *.partial"
-        raise catalog.CatalogError(
+        raise CatalogError(
             f"{path} is an unfinished run ({what}); continue it with `python -m ensemble resume "
             f"{path.removesuffix('.partial')}`, or reduce what it holds with --partial")
     tasks = _concatenate(tables)

@@ -18,7 +18,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ensemble import catalog, checks, filekind
+from ensemble import checks, filekind
+from ensemble.store import reader, schema
+from ensemble.store.errors import CatalogError
 from ensemble.config import LAW_KEYS
 
 from . import stats
@@ -108,8 +110,8 @@ def reduce_task(chunks, written, nu, n_blocks_chain, opt, rows=None, layout=LAYO
     lo = row = 0
     t_before = np.nan
     for part in chunks:
-        inertial = part["kind"] == catalog.KIND_EVENT
-        creep = part["kind"] == catalog.KIND_CREEP
+        inertial = part["kind"] == schema.KIND_EVENT
+        creep = part["kind"] == schema.KIND_CREEP
         creep_block = _creep_stretches(inertial, creep, lo, row, written, rows, k) if creep.any() else None
         row += len(inertial)
         ev = block = rec = None
@@ -146,12 +148,12 @@ def reduce_tasks(path, task_indices, opt):
     out = {}
     # the catalog checks the ranges of the rows as they stream (an epicenter outside the chain
     # would also overflow RecurrenceScanner's buffers) and each task's checksum after its last chunk
-    with filekind.reading(path, "the event catalog", catalog.CatalogError), catalog.Reader(path) as cat:
+    with filekind.reading(path, "the event catalog", CatalogError), reader.Reader(path) as cat:
         tasks = cat.tasks
         for k in task_indices:
             # every row read once: reduce_task keeps the creep episodes out of R(mu) and the recurrences
             rows = int(tasks["events_written"][k])
-            out[k] = reduce_task(cat.task_events(k, opt.chunk), cat.count(k, catalog.KIND_EVENT),
+            out[k] = reduce_task(cat.task_events(k, opt.chunk), cat.count(k, schema.KIND_EVENT),
                                  float(tasks["nu"][k]), int(tasks["N"][k]), opt, rows)
             out[k].rows = rows
     return out

@@ -58,7 +58,8 @@ import os
 import h5py
 import numpy as np
 
-from ensemble import catalog, checks, filekind
+from ensemble import checks, filekind
+from ensemble.store import schema as catalog_schema
 
 from . import reduce
 from .reduce import MIN_UNITS, NUMBERS, PARAMS
@@ -72,7 +73,7 @@ FORMAT = filekind.SUMMARY_FORMAT_PREFIX + "5"   # 5: the seismicity around large
 # formats 4, 3 and 2 still read, without the datasets that came after them (a number a summary lacks is not shown)
 READS = (FORMAT, *(filekind.SUMMARY_FORMAT_PREFIX + n for n in "432"))
 
-# Every dataset, one line each: (unit, shape, meaning), units as in ensemble/catalog.py's DATASETS
+# Every dataset, one line each: (unit, shape, meaning), units as in ensemble/store/schema.py's DATASETS
 # (T nu, the plate's displacement during a recurrence time, is a model length).
 _POINTS = "(points,)"
 _INTERVAL = "(points, 3): estimate, lo, hi (lo, hi: the bootstrap interval at `level`, NaN with one unit)"
@@ -105,8 +106,8 @@ def _table_entry(name):
 DATASETS = {
     **{f"bins/{name}": (unit, f"({name} bins + 1,)", f"edges of the {what}, half-open [lo, hi), the last one too")
        for name, (unit, what) in _BINS.items()},
-    **{name: entry for name, entry in catalog.DATASETS.items() if name.startswith("tasks/")},
-    **{f"tasks/{name}": entry for name, entry in catalog.READER_TASKS.items()},
+    **{name: entry for name, entry in catalog_schema.DATASETS.items() if name.startswith("tasks/")},
+    **{f"tasks/{name}": entry for name, entry in catalog_schema.READER_TASKS.items()},
     # the columns a summary of one or more catalogs (analysis/merge.py) sets or adds
     "tasks/point": ("index", "(tasks,)", "parameter point the task pools into (row of /points)"),
     "tasks/seed_entropy": ("1", "(tasks,)", "the task's stream is SeedSequence(seed_entropy, spawn_key=(spawn_key,)); "
@@ -119,7 +120,7 @@ DATASETS = {
                             "the task's parameter point in its catalog (position in the product of its [sweep] lists)"),
     **{f"per_task/{name}": _table_entry(name) for name in LAYOUT.tables},
     **{f"points/{name}": (unit, _POINTS, f"{meaning}, of the point's tasks")
-       for name, (unit, _, meaning) in ((n, catalog.DATASETS[f"tasks/{n}"]) for n in PARAMS)},
+       for name, (unit, _, meaning) in ((n, catalog_schema.DATASETS[f"tasks/{n}"]) for n in PARAMS)},
     "points/law": ("text", _POINTS, "friction law of the point's tasks (a point is a law and its parameters)"),
     "points/method": ("text", _POINTS, "resampling units of the intervals: 'seeds' (the point's tasks, "
                                        f"when it has at least {MIN_UNITS}) or 'blocks' (the stretches of all its tasks)"),
@@ -135,14 +136,14 @@ DATASETS = {
 
 def schema():
     """The table of datasets as text, one line per dataset."""
-    return catalog.schema(DATASETS)
+    return catalog_schema.schema(DATASETS)
 
 
 def _describe(h5):
     """Give every dataset its line of DATASETS as `description` (one missing there gets none)."""
     def visit(name, obj):
         if isinstance(obj, h5py.Dataset) and name in DATASETS:
-            obj.attrs["description"] = catalog.description(DATASETS[name])
+            obj.attrs["description"] = catalog_schema.description(DATASETS[name])
     h5.visititems(visit)
 
 

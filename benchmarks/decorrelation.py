@@ -52,7 +52,7 @@ import itertools
 import numpy as np
 
 from ensemble.config import Config, Model, Run
-from ensemble.catalog import Checkpoint
+from ensemble.store.checkpoint import Checkpoint
 from ensemble.model.workspace import D_NSLIP
 from ensemble.runner import Trajectory
 from ensemble.tasks import branch_rng, perturb, task_list

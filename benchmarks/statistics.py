@@ -53,8 +53,9 @@ import tomllib
 import numpy as np
 
 from analysis.recurrence import RecurrenceScanner
-from ensemble import catalog
-from ensemble.catalog import KIND_EVENT
+from ensemble.store import reader
+from ensemble.store.errors import CatalogError
+from ensemble.store.schema import KIND_EVENT
 from ensemble.config import LAW_KEYS, Integrator, Model
 from ensemble.integrators import INTEGRATORS
 from ensemble.model import laws
@@ -251,7 +252,7 @@ def main(argv=None):
         except Refused as err:
             print(f"error: {err}", file=sys.stderr)
             raise SystemExit(2) from None
-        except catalog.CatalogError as err:
+        except CatalogError as err:
             print(f"error: {err}", file=sys.stderr)
             raise SystemExit(1) from None
     reference = parse_setting(args.reference)
@@ -335,7 +336,7 @@ def point_of(tasks, k):
 def read_catalog(path, mu_c, window):
     """One catalog -> its setting: root seed, transient, and per point each task's samples
     (seed_samples, as a simulated trajectory's), events/s, committed and planned events."""
-    with catalog.Reader(path) as cat:
+    with reader.Reader(path) as cat:
         tasks = cat.tasks
         config = tomllib.loads(str(cat.attrs["config"]))
         out = {"path": str(path), "label": integrator_label(tasks["integrator"]),

@@ -27,8 +27,8 @@ import os
 
 import numpy as np
 
-from ensemble import catalog
-from ensemble.catalog import KIND_EVENT
+from ensemble.store import reader
+from ensemble.store.schema import KIND_EVENT
 from ensemble.model import laws
 
 FLOOR_DRAWS = 400
@@ -78,7 +78,7 @@ def main(argv=None):
     rng = np.random.default_rng(args.seed)
     results = []
     for path in args.catalogs:
-        events, tasks, attrs = catalog.read(path)
+        events, tasks, attrs = reader.read(path)
         if int(attrs["transient"]) != 0:
             raise SystemExit(f"error: {path}: run.transient is {int(attrs['transient'])}; "
                              "the measurement needs the events from the first one (run.transient = 0)")

@@ -8,7 +8,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .catalog import FAILED, OPEN, Checkpoint
+from .store.checkpoint import Checkpoint
+from .store.schema import FAILED, OPEN
 from .model.workspace import CR_EP, CR_KEEP
 from .tasks import Task, branch_rng, perturb, point_tasks, spinups
 
@@ -24,7 +25,7 @@ class Spin:
 def spins_needed(cfg, tasks, stored=None, rerun=None):
     """The spin-ups a run needs: those of the points with a task still to start from its branch point.
 
-    stored: the catalog's tasks (catalog.read_tasks) when resuming, None for a new run.
+    stored: the catalog's tasks (reader.read_tasks) when resuming, None for a new run.
     """
     needed = []
     for spin in spinups(cfg, tasks):

@@ -11,7 +11,9 @@ import sys
 
 from . import __version__
 from .abort import abort
-from .catalog import CatalogError, partial_path, read_tasks
+from .store.errors import CatalogError
+from .store.files import partial_path
+from .store.reader import read_tasks
 from .config import ConfigError, load, loads, parse_override, replace
 from .lock import LockError
 

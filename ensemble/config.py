@@ -14,6 +14,7 @@ from dataclasses import dataclass, field, fields
 
 from . import filekind
 from .model import laws
+from .sections import SECTION_NAMES
 
 
 class ConfigError(ValueError):
@@ -156,7 +157,8 @@ _RULES = {
     ("output", "path"): (lambda x: len(x) > 0, "a non-empty string"),
 }
 
-SECTIONS = {"model": Model, "run": Run, "integrator": Integrator, "output": Output}
+# (the names in sections.py, where filekind.py reads them too)
+SECTIONS = dict(zip(SECTION_NAMES, (Model, Run, Integrator, Output), strict=True))
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,7 @@ import sys
 import h5py
 import mpi4py
 
-from . import catalog
+from .store import writers
 
 
 def mpi_line():
@@ -25,7 +25,7 @@ def mpi_line():
 
 def hdf5_line():
     """The HDF5 library h5py is built on, and whether that build has MPI (needed by the parallel writer)."""
-    mpi = "with" if catalog.has_parallel_hdf5() else "without"
+    mpi = "with" if writers.has_parallel_hdf5() else "without"
     return f"hdf5: {h5py.version.hdf5_version} {mpi} MPI (h5py {h5py.__version__})"
 
 
@@ -37,10 +37,10 @@ def stack():
 def writer_line(name):
     """What output.writer = name gives on one rank and on more, in the run log's words.
 
-    Raises ConfigError where the run would refuse the writer (catalog.writer_key).
+    Raises ConfigError where the run would refuse the writer (writers.writer_key).
     """
-    parallel = catalog.has_parallel_hdf5()
-    one, more = (catalog.WRITERS[catalog.writer_key(name, n, parallel)].label(n) for n in (1, 2))
+    parallel = writers.has_parallel_hdf5()
+    one, more = (writers.WRITERS[writers.writer_key(name, n, parallel)].label(n) for n in (1, 2))
     if name == "auto" and not parallel:
         more += " (h5py has no MPI)"
     if one == more:

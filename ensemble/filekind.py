@@ -1,7 +1,7 @@
 """What a file is, in words, so that a wrong argument gets a one-line answer, not a traceback.
 
 The commands take three kinds of files: run configs (TOML), event catalogs (HDF5 whose root
-attribute `format` starts with "bk-catalog-", ensemble/catalog.py) and reduction summaries (HDF5,
+attribute `format` starts with "bk-catalog-", ensemble/store/) and reduction summaries (HDF5,
 `format` "bk-summary-N", analysis/summary.py). A catalog and its summary sit side by side, both
 *.h5, so giving one for the other is an easy slip; `require` says what was given and what to give:
 
@@ -16,6 +16,8 @@ SummaryError, exit 1, as a missing catalog always was). Exit 2 stays for bad opt
 import os
 import stat
 from contextlib import contextmanager
+
+from .sections import SECTION_NAMES, SWEEP
 
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 CATALOG_FORMAT_PREFIX = "bk-catalog-"
@@ -126,15 +128,14 @@ def _text_kind(head):
         doc = tomllib.loads(head.decode("utf-8"))
     except (UnicodeDecodeError, tomllib.TOMLDecodeError):
         return "other", ""
-    from .config import SECTIONS
-    if doc and set(doc) <= set(SECTIONS) | {"sweep"}:
+    if doc and set(doc) <= {*SECTION_NAMES, SWEEP}:
         return "config", ""
     return "toml", ""
 
 
-def describe(path):
-    """What `path` is, as the predicate of "PATH ...", e.g. "is a directory"."""
-    kind, detail = identify(path)
+def describe(path, found=None):
+    """What `path` is, as the predicate of "PATH ...", e.g. "is a directory" (found: its identify(), if known)."""
+    kind, detail = identify(path) if found is None else found
     words = KINDS[kind]
     if not detail:
         return words
@@ -143,9 +144,13 @@ def describe(path):
     return f"{words} ({detail})"
 
 
-def require(path, wanted, error=FileKindError):
-    """Raise error(one line) unless `path` is of kind `wanted` ("catalog", "summary" or "config")."""
-    kind, _ = identify(path)
+def require(path, wanted, error=FileKindError, found=None):
+    """Raise error(one line) unless `path` is of kind `wanted` ("catalog", "summary" or "config").
+
+    found: identify(path) where the caller has it already (the file is looked at once).
+    """
+    found = identify(path) if found is None else found
+    kind = found[0]
     if kind == wanted:
         return
     if kind == "missing":
@@ -154,9 +159,9 @@ def require(path, wanted, error=FileKindError):
             message += (f" ({path}.partial does: a run that has not finished; continue it with "
                         f"`python -m ensemble resume {path}`)")
     elif kind in ("unreadable", "damaged"):
-        message = f"{path} {describe(path)}"
+        message = f"{path} {describe(path, found)}"
     else:
-        message = f"{path} {describe(path)}, not {NOUNS[wanted]}"
+        message = f"{path} {describe(path, found)}, not {NOUNS[wanted]}"
         hint = HINTS.get((kind, wanted))
         if hint:
             message += f" ({hint.format(path=path)})"

@@ -12,8 +12,13 @@ import tomllib
 
 import numpy as np
 
-from . import catalog, checks, environment, filekind, space
-from .catalog import FAILED, FINISHED, Checkpoint, CatalogError
+from . import checks, environment, filekind, space
+from .store import reader, writers
+from .store.checkpoint import Checkpoint, carries_creep
+from .store.create import estimate_bytes
+from .store.errors import CatalogError
+from .store.files import partial_path
+from .store.schema import FAILED, FINISHED
 from .config import ConfigError, from_dict, loads, section_lines
 from .integrators import kernel_params
 from .lock import RunLock
@@ -52,8 +57,8 @@ class Trajectory:
         self.discarded = cfg.run.discarded if discarded is None else discarded
         self.integrator = cfg.integrator if integrator is None else integrator
         self.ws = Workspace(task.model.N)
-        # a chain that can creep keeps its creep phase's state in its checkpoints (catalog.carries_creep)
-        self.creeps = catalog.carries_creep(task.model)
+        # a chain that can creep keeps its creep phase's state in its checkpoints (store/checkpoint.py)
+        self.creeps = carries_creep(task.model)
         if checkpoint is None:
             self.ws.load(*initial_state(cfg, task))
             self.clock = np.zeros(2)
@@ -96,7 +101,7 @@ class Trajectory:
 
 
 def event_rows(task, t, epicenter, diag):
-    """Kernel output -> catalog columns (see catalog.EVENT_FIELDS)."""
+    """Kernel output -> catalog columns (EVENT_FIELDS, ensemble/store/schema.py)."""
     first = diag[:, D_FIRST].astype(np.int64)
     last = diag[:, D_LAST].astype(np.int64)
     return {
@@ -200,7 +205,7 @@ class TaskRunner:
         if cfg.run.branch and task.point in self.spin_failed:
             return None     # recorded as failed (and counted) by the rank that spun its point up
         rec = self.writer.record(task.index)
-        if rec.damaged:     # (tables.py) a damaged byte, or a run killed while writing the record
+        if rec.damaged:     # (store/tables.py) a damaged byte, or a run killed while writing the record
             print(f"note: rank {self.coord.rank}: task {task.index}: {rec.damaged}; it is rerun from its start",
                   file=sys.stderr, flush=True)
             self.writer.start(task.index, integrator_text(cfg.integrator))
@@ -353,7 +358,7 @@ def _check_output(path, inputs):
     a name that is not UTF-8, one of the run's inputs (its config), a directory, a missing or read-only
     folder. Whether the catalog exists is _prepare's to judge (--resume, --force)."""
     try:
-        for p in (str(path), catalog.partial_path(path)):
+        for p in (str(path), partial_path(path)):
             checks.output(p, inputs=inputs, force=True, what="catalog")
     except checks.UsageError as err:
         raise Refused(str(err)) from None
@@ -365,18 +370,18 @@ def _prepare(cfg, path, resume, force, rerun=None):
 
     rerun: the failed tasks are to be rerun with this [integrator] (which may differ from the stored one).
     """
-    final, partial = str(path), catalog.partial_path(path)
+    final, partial = str(path), partial_path(path)
     if resume:
         if not os.path.exists(partial):
             if os.path.exists(final):
-                _, _, attrs = catalog.read_tasks(final)
+                _, _, attrs = reader.read_tasks(final)
                 diffs = config_differences(attrs["config"], cfg)
                 if diffs:
                     raise ConfigError(f"{final}: --resume with a different config ({'; '.join(diffs)}); "
                                       f"the catalog is complete")
                 return "complete", f"{final} is complete; nothing to resume", []
             raise Refused(f"{partial}: no interrupted run to resume")
-        _, tasks, attrs = catalog.read_tasks(partial, damaged_ok=True)
+        _, tasks, attrs = reader.read_tasks(partial, damaged_ok=True)
         diffs = config_differences(attrs["config"], cfg, ("model", "run") if rerun else
                                    ("model", "run", "integrator"))
         if diffs:
@@ -400,7 +405,7 @@ def _prepare(cfg, path, resume, force, rerun=None):
         raise Refused(f"{partial}: an interrupted run exists (use --resume to continue it, "
                       f"--force to start over)")
     tasks = task_list(cfg)
-    _fits(partial, lambda: space.check_fits(partial, catalog.estimate_bytes(cfg, tasks)))
+    _fits(partial, lambda: space.check_fits(partial, estimate_bytes(cfg, tasks)))
     return "new", None, spins_needed(cfg, tasks)
 
 
@@ -477,8 +482,8 @@ def run(cfg, path, comm, resume=False, force=False, log=print, rerun=None, comma
 def _run_locked(cfg, path, comm, mode, spins, log, say, rerun, lock):
     tasks = task_list(cfg)
     n_ranks = comm.Get_size()
-    Writer = catalog.choose_writer(cfg.output.writer, comm)
-    partial = catalog.partial_path(path)
+    Writer = writers.choose_writer(cfg.output.writer, comm)
+    partial = partial_path(path)
     for line in environment.stack():
         say(line)
     say(f"writing {partial} with {n_ranks} rank(s): {Writer.label(n_ranks)}")
@@ -509,7 +514,7 @@ def _run_locked(cfg, path, comm, mode, spins, log, say, rerun, lock):
 
 def _serve(cfg, path, comm, tasks, spins, writer, coord, progress, worker, log, t_start):
     rank = comm.Get_rank()
-    partial = catalog.partial_path(path)
+    partial = partial_path(path)
     try:
         _compile_kernels(cfg, tasks[0], coord, log if rank == 0 else (lambda *a, **k: None))
         progress.restart_clock()

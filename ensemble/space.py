@@ -5,7 +5,7 @@ made (and closing it may crash the process), under MPI one rank fails inside a c
 the others wait in forever. So a run first proves, with plain files, that its catalog fits: the
 file-size limit (RLIMIT_FSIZE) is compared with the catalog's size, and that many bytes are
 reserved (fallocate) in a scratch file beside the catalog and freed again. Only then is the catalog
-made (and its own blocks reserved, catalog._reserve_space). A resume reserves the blocks of the
+made (and its own blocks reserved, store/files.py: reserve_space). A resume reserves the blocks of the
 file it continues, which a run on a file system without fallocate never reserved.
 """
 import ctypes

@@ -10,7 +10,10 @@ import os
 
 import numpy as np
 
-from . import catalog, lock
+from . import lock
+from .store import reader, schema
+from .store.errors import CatalogError
+from .store.files import partial_path
 from .config import loads
 
 RESUME = "python -m ensemble resume"
@@ -18,7 +21,7 @@ RESUME = "python -m ensemble resume"
 
 def _state(path):
     """(file to read or None, one-line state) of the run whose final catalog is `path`."""
-    final, partial = str(path), catalog.partial_path(path)
+    final, partial = str(path), partial_path(path)
     info = lock.read_info(final)
     if lock.is_held(final):
         line = f"running ({lock.describe(info)})"
@@ -30,7 +33,7 @@ def _state(path):
         return partial, f"interrupted{died}; continue with `{RESUME} {final}`"
     if os.path.exists(final):
         return final, "complete"
-    raise catalog.CatalogError(f"{final}: no such catalog (nor {partial})")
+    raise CatalogError(f"{final}: no such catalog (nor {partial})")
 
 
 def summary(path):
@@ -39,10 +42,10 @@ def summary(path):
     source, state = _state(path)
     if source is None:
         return f"{path}: {state}\n(the catalog is being created)"
-    with catalog.Reader(source) as cat:
+    with reader.Reader(source) as cat:
         per_task, tasks, attrs, spinups = cat.per_task, cat.tasks, cat.attrs, cat.spinups
     cfg = loads(attrs["config"])
-    failed = np.flatnonzero(tasks["status"] == catalog.FAILED)
+    failed = np.flatnonzero(tasks["status"] == schema.FAILED)
     if len(failed) and not state.startswith("running"):
         state = (f"failed: tasks {', '.join(map(str, failed))} (the others go on with `{RESUME} {path}`; "
                  f"rerun the failed ones with `{RESUME} {path} --set integrator.KEY=VALUE`)")
@@ -54,14 +57,14 @@ def summary(path):
     for k in range(len(tasks["point"])):
         written = int(tasks["events_written"][k])
         rate = tasks["events_per_second"][k]
-        st = catalog.STATUS_NAMES[int(tasks["status"][k])]
+        st = schema.STATUS_NAMES[int(tasks["status"][k])]
         lines.append(f"{k:4d} {tasks['point'][k]:5d} {tasks['seed_index'][k]:4d} {tasks['N'][k]:5d} "
                      + "".join(f"{tasks[key][k]:8g}" for key in keys) + " "
                      f"{int(tasks['events_done'][k]):8d} {written:9d} {st:>9s}  {tasks['rank'][k]:4d}  "
                      f"{'' if np.isnan(rate) else f'{rate:8.1f}'}")
     for k in failed:
         lines.append(f"  task {k} failed: {tasks['error'][k]}")
-    done = int(np.sum(tasks["status"] == catalog.FINISHED))
+    done = int(np.sum(tasks["status"] == schema.FINISHED))
     for point, spun in zip(spinups.get("point", []), spinups["events_done"]):
         lines.append(f"spin-up of point {point}: {spun}/{cfg.run.transient} events "
                      f"({'done' if spun >= cfg.run.transient else 'not done'}; its tasks branch from it)")

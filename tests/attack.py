@@ -23,8 +23,11 @@ if str(ROOT) not in sys.path:
 import h5py  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ensemble import catalog, lock  # noqa: E402
+from ensemble import lock  # noqa: E402
 from ensemble.model.workspace import Workspace  # noqa: E402
+from ensemble.store import reader, schema  # noqa: E402
+from ensemble.store.errors import CatalogError  # noqa: E402
+from ensemble.store.files import partial_path  # noqa: E402
 from tests.processes import child_env, run_bounded, wait_for  # noqa: E402
 
 DEADLINE = 120        # seconds for any command: what they take is a few (a hang fails the attack)
@@ -152,8 +155,8 @@ class Workshop:
     def copy(self, which, name):
         """A copy of the finished ('full') or interrupted ('crashed': its .partial) catalog; its final path."""
         dest = self.root / name
-        source = self.full if which == "full" else catalog.partial_path(self.crashed)
-        shutil.copy(source, dest if which == "full" else catalog.partial_path(dest))
+        source = self.full if which == "full" else partial_path(self.crashed)
+        shutil.copy(source, dest if which == "full" else partial_path(dest))
         return dest
 
 
@@ -251,8 +254,8 @@ def flipped_table(name):
         bad = w.copy("full", f"flip-{name}.h5")
         _flip(bad, f"tasks/{name}")
         try:
-            catalog.read_tasks(bad)
-        except catalog.CatalogError as err:
+            reader.read_tasks(bad)
+        except CatalogError as err:
             assert "damaged" in str(err) or "corrupt" in str(err), err
         else:
             raise AssertionError(f"a flipped byte in /tasks/{name} was read without a word")
@@ -269,15 +272,15 @@ def flipped_table_every_command(name):
         one_line(_python("analysis", "export", bad, "-o", w.root / f"cmd-{name}-export"), (1,), str(bad))
         part = w.copy("crashed", f"res-{name}.h5")
         try:
-            _flip(catalog.partial_path(part), f"tasks/{name}")
+            _flip(partial_path(part), f"tasks/{name}")
         except Skip:
             return      # (not written yet in the interrupted run)
         res = _python("ensemble", "resume", part)
         if name in ("status", "wall_time"):      # a task's record: the task is rerun, the catalog completes
             assert res.returncode == 0 and "rerun from its start" in res.stderr, res.stderr
-            a, _, _ = catalog.read(part)
-            b, _, _ = catalog.read(w.full)
-            for column in catalog.EVENT_FIELDS:
+            a, _, _ = reader.read(part)
+            b, _, _ = reader.read(w.full)
+            for column in schema.EVENT_FIELDS:
                 np.testing.assert_array_equal(a[column], b[column], err_msg=column)
         else:
             one_line(res, (1,), "damaged")
@@ -288,7 +291,7 @@ def changed_config(where):
     """One changed byte in the stored config ("b = 20.0" -> "b = 30.0"): every command refuses."""
     def attack(w):
         bad = w.copy(where, f"config-{where}.h5")
-        path = bad if where == "full" else catalog.partial_path(bad)
+        path = bad if where == "full" else partial_path(bad)
         _replace_bytes(path, b"b = 20.0", b"b = 30.0")
         one_line(_python("ensemble", "status", bad), (1,), "stored config")
         one_line(_python("ensemble", "resume", bad), (1, 2))
@@ -308,14 +311,14 @@ def an_older_format(w):
     - bk-catalog-3, that catalog without tables_crc and /tasks/record_crc.
     """
     old = w.older()
-    events, tasks, attrs = catalog.read(old)
+    events, tasks, attrs = reader.read(old)
     assert attrs["format"] == "bk-catalog-4"
     with h5py.File(old, "r") as h5:
         assert "kind" not in h5["events"] and "creep" not in h5["checkpoint"]
     assert len(events["t"]) == len(tasks["point"]) * int(attrs["events_per_task"])
     assert np.all(events["kind"] == 0) and np.all(events["ending"] == 0)
-    now, _, _ = catalog.read(w.full)       # (the aging law at b = 20 is unchanged by the creep phase)
-    for column in catalog.EVENT_FIELDS:
+    now, _, _ = reader.read(w.full)       # (the aging law at b = 20 is unchanged by the creep phase)
+    for column in schema.EVENT_FIELDS:
         np.testing.assert_array_equal(events[column], now[column], err_msg=column)
     res = _python("analysis", "reduce", old, "-o", w.root / "format4.summary.h5")
     assert res.returncode == 0, res.stderr
@@ -324,15 +327,15 @@ def an_older_format(w):
     lines = (w.root / "format4-export" / "events.csv").read_text().splitlines()
     assert next(line for line in lines if not line.startswith("#")).endswith(",kind,ending"), lines[:20]
     part = w.root / "format4-resume.h5"
-    shutil.copy(old, catalog.partial_path(part))     # (an interrupted run of that format, as far as resume sees)
+    shutil.copy(old, partial_path(part))     # (an interrupted run of that format, as far as resume sees)
     one_line(_python("ensemble", "resume", part), (1,), "bk-catalog-4")
     three = w.root / "format3.h5"
-    shutil.copy(old, catalog.partial_path(three))
-    with h5py.File(catalog.partial_path(three), "r+") as h5:
+    shutil.copy(old, partial_path(three))
+    with h5py.File(partial_path(three), "r+") as h5:
         h5.attrs["format"] = "bk-catalog-3"
         del h5.attrs["tables_crc"]
         del h5["tasks/record_crc"]
-    events, _, _ = catalog.read(catalog.partial_path(three))
+    events, _, _ = reader.read(partial_path(three))
     assert np.all(events["kind"] == 0)
     one_line(_python("ensemble", "resume", three), (1,), "bk-catalog-3")
 
@@ -343,16 +346,16 @@ def format_5_with_creep(w):
     config (the creep's slips are unchanged, only its energy is kept now) and its states unpack with their
     own layout; a run of it is not continued (its checkpoints could not be restored): one line naming it."""
     old = w.older(5)
-    events, tasks, attrs = catalog.read(old)
+    events, tasks, attrs = reader.read(old)
     assert attrs["format"] == "bk-catalog-5"
     assert np.count_nonzero(events["kind"] == 1) > 20
     now = w.root / "format5-now.h5"
     res = _python("ensemble", "run", w.creep_config(), "-o", now)
     assert res.returncode == 0, res.stderr
-    events_now, _, _ = catalog.read(now)
-    for column in catalog.EVENT_FIELDS:
+    events_now, _, _ = reader.read(now)
+    for column in schema.EVENT_FIELDS:
         np.testing.assert_array_equal(events[column], events_now[column], err_msg=column)
-    with catalog.Reader(old) as cat:
+    with reader.Reader(old) as cat:
         creeps = cat.layout.creep
         assert creeps.any() and not creeps.all()
         for k in range(len(tasks["point"])):
@@ -360,7 +363,7 @@ def format_5_with_creep(w):
             assert (state.creep is None if not creeps[k]
                     else len(state.creep) == Workspace.creep_size(int(tasks["N"][k]), 14))
     part = w.root / "format5-resume.h5"
-    shutil.copy(old, catalog.partial_path(part))
+    shutil.copy(old, partial_path(part))
     one_line(_python("ensemble", "resume", part), (1,), "bk-catalog-5")
 
 
@@ -369,8 +372,8 @@ def flipped_creep_layout(w):
     bad = w.copy("full", "flip-creep.h5")
     _flip(bad, "checkpoint/creep", 0, 0)
     try:
-        catalog.read_tasks(bad)
-    except catalog.CatalogError as err:
+        reader.read_tasks(bad)
+    except CatalogError as err:
         assert "damaged" in str(err), err
     else:
         raise AssertionError("a flipped byte in /checkpoint/creep was read without a word")
@@ -443,7 +446,7 @@ def bad_analysis_numbers(w):
 
 def export_of_an_unfinished_run(w):
     part = w.copy("crashed", "unfinished.h5")
-    one_line(_python("analysis", "export", catalog.partial_path(part), "-o", w.root / "unfinished"), (1, 2),
+    one_line(_python("analysis", "export", partial_path(part), "-o", w.root / "unfinished"), (1, 2),
              "--partial")
 
 
@@ -489,12 +492,12 @@ ATTACKS = {
     "export of an unfinished run": export_of_an_unfinished_run,
     **{f"mpi: {target} fails on rank {rank} ({writer})": one_rank_fails(target, rank, writer)
        for target, rank, writer in (
-           ("ensemble.catalog:_Layout.create", 1, "parallel"),
-           ("ensemble.catalog:_reserve_space", 0, "parallel"),
-           ("ensemble.catalog:_Layout.create", 0, "rank0"),
+           ("ensemble.store.create:create_layout", 1, "parallel"),
+           ("ensemble.store.files:reserve_space", 0, "parallel"),
+           ("ensemble.store.create:create_layout", 0, "rank0"),
            ("ensemble.parallel:Coordinator.__init__", 1, "parallel"),
-           ("ensemble.catalog:ParallelWriter.close", 1, "parallel"),
-           ("ensemble.catalog:Rank0Writer.close", 1, "rank0"),
+           ("ensemble.store.writers:ParallelWriter.close", 1, "parallel"),
+           ("ensemble.store.writers:Rank0Writer.close", 1, "rank0"),
            ("ensemble.parallel:Coordinator.close", 0, "parallel"),
            ("ensemble.runner:_compile_kernels", 1, "parallel"))},
     "mpi: a spin-up fails on the rank that takes it (run.branch)": one_rank_fails(

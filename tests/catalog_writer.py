@@ -1,10 +1,11 @@
-"""Catalogs written through the project's own writer (catalog.Rank0Writer on one process) from
+"""Catalogs written through the project's own writer (writers.Rank0Writer on one process) from
 given events: real, verified catalogs whose contents a test chooses."""
 import itertools
 
 import numpy as np
 
-from ensemble import catalog
+from ensemble.store import schema, writers
+from ensemble.store.checkpoint import Checkpoint, carries_creep
 from ensemble.config import loads
 from ensemble.model.workspace import Workspace
 from ensemble.runner import integrator_text
@@ -22,18 +23,18 @@ def write_events(path, config_text, parts, streams=None):
     tasks = task_list(cfg)
     assert len(tasks) == len(parts)
     streams = streams or [(cfg.run.seed, t.index) for t in tasks]
-    writer = catalog.Rank0Writer(str(path), MPI.COMM_SELF, cfg, tasks, integrator_text(cfg.integrator))
+    writer = writers.Rank0Writer(str(path), MPI.COMM_SELF, cfg, tasks, integrator_text(cfg.integrator))
     for task, ev in zip(tasks, parts):
         n = len(ev["t"])
         writer.record(task.index)
         start, sizes = 0, itertools.cycle(np.roll([1, 57, 100, 13], task.index))
         N = task.model.N
-        creep = np.zeros(Workspace.creep_size(N)) if catalog.carries_creep(task.model) else None
-        ev = {**{name: np.full(n, value, dtype=catalog.EVENT_FIELDS[name])
-                 for name, value in catalog.SUPPLIED.items()}, **ev}
+        creep = np.zeros(Workspace.creep_size(N)) if carries_creep(task.model) else None
+        ev = {**{name: np.full(n, value, dtype=schema.EVENT_FIELDS[name])
+                 for name, value in schema.SUPPLIED.items()}, **ev}
         while start < n:
             size = min(int(next(sizes)), n - start)
-            state = catalog.Checkpoint(np.zeros(N), np.zeros(N), np.zeros((N, 2)), np.zeros(2),
+            state = Checkpoint(np.zeros(N), np.zeros(N), np.zeros((N, 2)), np.zeros(2),
                                        cfg.run.transient + start + size, creep)
             writer.commit(task.index, start, {c: v[start:start + size] for c, v in ev.items()}, state)
             start += size

@@ -5,7 +5,9 @@ import sys
 import numpy as np
 import pytest
 
-from ensemble import catalog
+from ensemble.store import reader, writers
+from ensemble.store.errors import CatalogError
+from ensemble.store.files import partial_path
 from ensemble.config import Integrator, Model
 from ensemble.events import advance_to_onset, check, run_event
 from ensemble.integrators import kernel_params
@@ -86,6 +88,9 @@ QUICK = {
     "test_benchmarks.py": ["test_distances_agree_with_scipy", "test_settings_are_validated"],
     "test_time_to_statistics.py": ["test_schedule_replays_the_counter"],
     "test_options.py": ["test_every_numeric_option_is_checked_and_attacked", "test_huge_bins_are_refused_before_any_file_is_read"],
+    "test_imports.py": ["test_no_module_imports_itself_round_a_circle",
+                        "test_the_graph_sees_imports_inside_functions_and_relative_ones",
+                        "test_the_store_modules_are_small"],
     "test_quick_tier.py": ["test_every_test_named_in_the_quick_tier_exists",
                            "test_every_test_file_is_in_the_quick_tier_or_says_why_not"],
 }
@@ -102,7 +107,7 @@ def pytest_configure(config):
     # stderr itself, kept for the watchdog: during a test fd 2 is pytest's capture file
     config.stash[_STDERR] = os.dup(sys.stderr.fileno())
     # `make test` sets up the parallel stack and says so: then no test may skip for want of MPI-IO
-    if os.environ.get("ENSEMBLE_TEST_STACK") == "parallel" and not catalog.has_parallel_hdf5():
+    if os.environ.get("ENSEMBLE_TEST_STACK") == "parallel" and not writers.has_parallel_hdf5():
         raise pytest.UsageError("ENSEMBLE_TEST_STACK=parallel, but this h5py has no MPI support "
                                 "(rerun `make test`, or `make test STACK=wheels` to skip the MPI-IO tests)")
 
@@ -111,7 +116,7 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         if item.originalname in QUICK.get(item.path.name, ()):
             item.add_marker(pytest.mark.quick)
-    if catalog.has_parallel_hdf5():
+    if writers.has_parallel_hdf5():
         return
     skip = pytest.mark.skip(reason="h5py without MPI (the wheel stack): the parallel writer is not "
                                    "tested here; `make test` sets up the parallel stack and tests it")
@@ -181,8 +186,8 @@ def run_cli(*args, cwd=None, timeout=600):
 def committed(out):
     """True once the run writing catalog `out` has committed a batch of events (readable, not yet renamed)."""
     try:
-        _, tasks, _ = catalog.read_tasks(catalog.partial_path(out))
-    except catalog.CatalogError:
+        _, tasks, _ = reader.read_tasks(partial_path(out))
+    except CatalogError:
         return False      # not created yet, or open for writing at that moment
     return tasks["events_written"].sum() > 0
 

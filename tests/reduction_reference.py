@@ -585,7 +585,7 @@ def expected_summary(catalogs, opt):
     met), 'tasks' (the /tasks table), 'partial' (expected_partial) and 'raw' (per-task data).
 
     catalogs: [(path, events, tasks)] in the order given to reduce; events: dict of columns of
-    every committed event of the catalog (catalog.read), tasks: its task table.
+    every committed event of the catalog (ensemble/store/reader.py: read), tasks: its task table.
     opt: mu_edges, tnu_edges, mu_c, window, b_cut, bootstrap, level, blocks, seed.
     """
     table, points = expected_tasks(catalogs)

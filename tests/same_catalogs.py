@@ -6,17 +6,17 @@ import sys
 
 import numpy as np
 
-from ensemble import catalog
+from ensemble.store import reader, schema
 
 
 def assert_same_events(path_a, path_b):
-    a, ta, _ = catalog.read(path_a)
-    b, tb, _ = catalog.read(path_b)
+    a, ta, _ = reader.read(path_a)
+    b, tb, _ = reader.read(path_b)
     assert len(a["t"]) == len(b["t"]) > 0, f"{len(a['t'])} and {len(b['t'])} events"
     order_a, order_b = np.lexsort((a["t"], a["task"])), np.lexsort((b["t"], b["task"]))
-    for name in catalog.EVENT_FIELDS:
+    for name in schema.EVENT_FIELDS:
         np.testing.assert_array_equal(a[name][order_a], b[name][order_b], err_msg=name)
-    for name in catalog.TASK_FIELDS:
+    for name in schema.TASK_FIELDS:
         np.testing.assert_array_equal(ta[name], tb[name], err_msg=name)
 
 

@@ -9,7 +9,7 @@ import pytest
 
 from analysis import stats, summary
 from analysis.recurrence import RecurrenceScanner
-from ensemble import catalog
+from ensemble.store import reader
 from ensemble.config import loads
 
 from . import reduction_reference as ref
@@ -49,7 +49,7 @@ def brute_force_recurrence(t, epi, mu, boundary, mu_c, window):
 
 
 def test_merged_histograms_equal_histogram_of_pooled_events(reduced):
-    events, tasks, _ = catalog.read(reduced / "cat.h5")
+    events, tasks, _ = reader.read(reduced / "cat.h5")
     s = summary.read(reduced / "sum.h5")
     edges = s["bins/mu"]
     for point in (0, 1):
@@ -74,7 +74,7 @@ def test_merged_histograms_equal_histogram_of_pooled_events(reduced):
 def test_real_summary_equals_brute_force(reduced):
     """Every dataset of the real catalog's summary (and so of its 2-rank twin, which
     test_serial_and_mpi_reduction_agree finds identical) against the plain reference."""
-    events, tasks, _ = catalog.read(reduced / "cat.h5")
+    events, tasks, _ = reader.read(reduced / "cat.h5")
     opt = {"mu_edges": np.linspace(0, 7, 71), "tnu_edges": np.linspace(0, 2000, 81), "mu_c": 3.5,
            "window": 10, "b_cut": 3.0, "bootstrap": 200, "level": 0.95, "blocks": 20, "seed": 0}
     expected = ref.expected_summary([(reduced / "cat.h5", events, tasks)], opt)
@@ -209,7 +209,7 @@ REDUCE_OPTIONS = ("--bootstrap", "200", "--mu-c", "3.5", "--level", "0.5")
 
 @pytest.fixture(scope="module")
 def merged(reduced):
-    events, tasks, attrs = catalog.read(reduced / "cat.h5")
+    events, tasks, attrs = reader.read(reduced / "cat.h5")
     cfg = loads(attrs["config"])
     for name, (b_values, source) in SPLIT.items():
         text = dataclasses.replace(cfg, sweep=(("b", b_values),),
@@ -258,7 +258,7 @@ def test_merged_catalogs_equal_one_catalog_of_both(merged):
 def test_merged_summary_equals_brute_force(merged):
     """The merged summary against the reference (pooling, task order and bootstrap streams as
     documented), from the catalogs' own events."""
-    inputs = [(merged / f"{n}.h5", *catalog.read(merged / f"{n}.h5")[:2]) for n in "AB"]
+    inputs = [(merged / f"{n}.h5", *reader.read(merged / f"{n}.h5")[:2]) for n in "AB"]
     opt = {"mu_edges": np.linspace(0, 7, 71), "tnu_edges": np.linspace(0, 2000, 81), "mu_c": 3.5,
            "window": 10, "b_cut": 3.0, "bootstrap": 200, "level": 0.5, "blocks": 20, "seed": 0}
     expected = ref.expected_summary(inputs, opt)

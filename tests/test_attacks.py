@@ -30,19 +30,19 @@ def test_a_flipped_parameter_table_and_record_are_refused(workshop):
                                   # creep states in the slots (b below the block stiffness), spin-ups too
                                   ["run.branch=true", "run.seeds=3", "sweep.b=[10, 15]", "run.events=10"]])
 def test_the_size_checked_before_creation_bounds_the_catalog(tmp_path, sets):
-    """space.check_fits asks for catalog.estimate_bytes: it must not be below the file HDF5 makes (then a
+    """space.check_fits asks for estimate_bytes: it must not be below the file HDF5 makes (then a
     disk that passed the check could still fill inside HDF5's collective create), nor far above it."""
     import os
 
     import h5py
 
-    from ensemble import catalog
+    from ensemble.store.create import create_layout, estimate_bytes
     from ensemble.config import load
     from ensemble.tasks import task_list
     cfg = load(attack.ROOT / "examples" / "small.toml", sets)
     tasks = task_list(cfg)
     path = tmp_path / "c.h5"
     with h5py.File(path, "w") as h5:
-        catalog._Layout.create(h5, cfg, tasks, "method = 'ark4'", "software")
-    actual, estimate = os.path.getsize(path), catalog.estimate_bytes(cfg, tasks)
+        create_layout(h5, cfg, tasks, "method = 'ark4'", "software")
+    actual, estimate = os.path.getsize(path), estimate_bytes(cfg, tasks)
     assert actual <= estimate <= 1.5 * actual + 2 ** 20, (actual, estimate)

@@ -103,7 +103,7 @@ def brute_recurrences(t, epicenter, mu, mu_c=4.0, window=10):
 
 
 def test_statistics_from_catalogs(tmp_path, capsys):
-    from ensemble import catalog
+    from ensemble.store import reader
     from .conftest import run_cli, write_config
     cfg = write_config(tmp_path / "c.toml", model={"N": 30}, sweep={"b": [20.0, 50.0]},
                        run={"events": 300, "transient": 50, "seeds": 2}, integrator={"method": "ark4"})
@@ -114,7 +114,7 @@ def test_statistics_from_catalogs(tmp_path, capsys):
     # the reference is also a candidate: its distance to itself is 0
     data = statistics.main(["--catalogs", str(ref), str(cand), str(ref), "--name", "tol", "--out", str(tmp_path)])
     assert sorted(data) == ["tol_N30_b20", "tol_N30_b50"]
-    events, tasks, _ = catalog.read(ref)
+    events, tasks, _ = reader.read(ref)
     for b in (20, 50):
         stem = f"tol_N30_b{b}"
         d = data[stem]

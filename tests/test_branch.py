@@ -15,7 +15,8 @@ import h5py
 import numpy as np
 import pytest
 
-from ensemble import catalog
+from ensemble.store import reader, schema
+from ensemble.store.files import partial_path
 from ensemble.config import DECORRELATION_PER_BLOCK, ConfigError, loads
 
 from .conftest import run_cli, write_config
@@ -70,8 +71,8 @@ def test_unperturbed_branches_continue_the_spun_up_trajectory_exactly(branched, 
     res = run_cli("run", cfg, "-o", tmp_path / "plain.h5", "--set", "run.branch=false",
                   "--set", f"run.transient={SPINUP + DECORRELATE}")
     assert res.returncode == 0, res.stderr
-    zero, _, _ = catalog.read(tmp_path / "zero.h5")
-    plain, _, _ = catalog.read(tmp_path / "plain.h5")
+    zero, _, _ = reader.read(tmp_path / "zero.h5")
+    plain, _, _ = reader.read(tmp_path / "plain.h5")
     for k in range(2 * SEEDS):
         a, b = per_task(zero, k), per_task(plain, k - k % SEEDS)
         assert len(a["t"]) == EVENTS
@@ -81,7 +82,7 @@ def test_unperturbed_branches_continue_the_spun_up_trajectory_exactly(branched, 
 
 def test_branches_differ_and_the_catalog_records_their_branch_point(branched):
     d, _ = branched
-    events, tasks, attrs = catalog.read(d / "full.h5")
+    events, tasks, attrs = reader.read(d / "full.h5")
     np.testing.assert_array_equal(tasks["branch_of"], np.repeat([0, 1], SEEDS))
     np.testing.assert_array_equal(tasks["events_written"], EVENTS)
     np.testing.assert_array_equal(tasks["events_done"], DECORRELATE + EVENTS)
@@ -90,9 +91,9 @@ def test_branches_differ_and_the_catalog_records_their_branch_point(branched):
         np.testing.assert_array_equal(h5["spinup/point"][...], [0, 1])
         np.testing.assert_array_equal(h5["spinup/spawn_key"][...], [0, SEEDS])   # each point's seed 0
         assert "run.branch" in h5["tasks/branch_of"].attrs["description"]
-    assert_described(d / "full.h5", catalog.DATASETS)
-    assert set(descriptions(d / "full.h5")) == set(catalog.DATASETS)
-    with catalog.Reader(d / "full.h5") as cat:
+    assert_described(d / "full.h5", schema.DATASETS)
+    assert set(descriptions(d / "full.h5")) == set(schema.DATASETS)
+    with reader.Reader(d / "full.h5") as cat:
         for point in (0, 1):
             head = cat.layout.head(2 * SEEDS + point)
             assert head.done == SPINUP and head.written == 0
@@ -125,7 +126,7 @@ def interrupted_spin_up(ranks, out, cfg):
     res = injected(ranks, f"inject.signal_in_spin_up({int(signal.SIGTERM)}, 1, {SPINUP // 3})",
                    "run", cfg, "-o", out, "--set", "run.poll_seconds=0.0001")
     assert res.returncode == 75, res.stdout + res.stderr
-    with catalog.Reader(catalog.partial_path(out)) as cat:
+    with reader.Reader(partial_path(out)) as cat:
         assert cat.tasks["events_written"].sum() == 0
         heads = [cat.layout.head(k) for k in range(cat.layout.n_tasks, cat.layout.n_records)]
     return [0 if h is None else h.done for h in heads]
@@ -150,7 +151,7 @@ def test_interrupt_while_branching_resumes_to_the_uninterrupted_catalog(branched
     out = tmp_path / "branches.h5"
     res = injected(ranks, f"inject.signal_at_write({int(signal.SIGTERM)})", "run", cfg, "-o", out)
     assert res.returncode == 75, res.stdout + res.stderr
-    _, tasks, _ = catalog.read_tasks(catalog.partial_path(out))
+    _, tasks, _ = reader.read_tasks(partial_path(out))
     assert 0 < tasks["events_written"].sum() < 2 * SEEDS * EVENTS
     res = mpirun(2, "resume", out) if ranks else run_cli("resume", out)
     assert res.returncode == 0, res.stderr
@@ -163,17 +164,17 @@ def test_a_failed_spin_up_fails_its_points_tasks_and_a_rerun_completes_them(bran
     res = injected(0, "inject.fail_spin_up(1, 50)", "run", cfg, "-o", out)
     assert res.returncode == 1, res.stdout + res.stderr
     assert re.search(r"task [345]: spin-up of point 1 event \d+: injected failure", res.stdout)
-    events, tasks, _ = catalog.read(catalog.partial_path(out))
-    np.testing.assert_array_equal(tasks["status"], [catalog.FINISHED] * SEEDS + [catalog.FAILED] * SEEDS)
+    events, tasks, _ = reader.read(partial_path(out))
+    np.testing.assert_array_equal(tasks["status"], [schema.FINISHED] * SEEDS + [schema.FAILED] * SEEDS)
     assert all("spin-up of point 1" in e for e in tasks["error"][SEEDS:])
-    full, _, _ = catalog.read(d / "full.h5")
+    full, _, _ = reader.read(d / "full.h5")
     for k in range(SEEDS):      # the other point is unaffected
         np.testing.assert_array_equal(per_task(events, k)["t"], per_task(full, k)["t"])
     res = run_cli("resume", out)
     assert res.returncode == 1 and "failed: 3 of 6 tasks" in res.stdout
     res = run_cli("resume", out, "--set", "integrator.rtol=1e-6")
     assert res.returncode == 0, res.stderr
-    _, tasks, _ = catalog.read(out)
+    _, tasks, _ = reader.read(out)
     np.testing.assert_array_equal(tasks["events_written"], EVENTS)
     assert all("rtol = 1e-06" in text for text in tasks["integrator"][SEEDS:])
     assert all("rtol = 1e-05" in text for text in tasks["integrator"][:SEEDS])
@@ -216,7 +217,7 @@ def test_a_branch_lowers_the_blocks_at_rest_and_keeps_the_creeping_ones_in_balan
     res = run_cli("run", cfg_path, "-o", tmp_path / "creep.h5")
     assert res.returncode == 0, res.stderr
     cfg = load(cfg_path)
-    with catalog.Reader(tmp_path / "creep.h5") as cat:
+    with reader.Reader(tmp_path / "creep.h5") as cat:
         layout = cat.layout
         spun = layout.read_state(layout.n_tasks, layout.head(layout.n_tasks))
     moving = creeping(spun)

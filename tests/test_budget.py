@@ -12,7 +12,7 @@ workspace, against at least 8 and 3.
 import numpy as np
 import pytest
 
-from ensemble.catalog import Checkpoint
+from ensemble.store.checkpoint import Checkpoint
 from ensemble.config import Config, Integrator, Model, Run
 from ensemble.integrators import kernel_params
 from ensemble.model.chain import simulate

@@ -16,7 +16,10 @@ import numpy as np
 import pytest
 
 from analysis import export, summary
-from ensemble import catalog
+from ensemble.store import layout, reader, schema, writers
+from ensemble.store.checkpoint import Checkpoint, carries_creep
+from ensemble.store.errors import CatalogError
+from ensemble.store.files import partial_path
 from ensemble.model.workspace import CS_NCREEP, NCSTATE, Workspace
 
 from . import reduction_reference as ref
@@ -57,8 +60,8 @@ def tasks_of(tasks, b):
 
 def test_a_creeping_chain_writes_both_kinds_and_keeps_its_creep_state(creeping):
     d, _ = creeping
-    events, tasks, attrs = catalog.read(d / "full.h5")
-    assert attrs["format"] == catalog.FORMAT == "bk-catalog-6"
+    events, tasks, attrs = reader.read(d / "full.h5")
+    assert attrs["format"] == schema.FORMAT == "bk-catalog-6"
     kind, ending = events["kind"], events["ending"]
     assert kind.dtype == ending.dtype == np.int8
     for k in tasks_of(tasks, CREEPING):
@@ -78,7 +81,7 @@ def test_a_creeping_chain_writes_both_kinds_and_keeps_its_creep_state(creeping):
         np.testing.assert_array_equal(h5["checkpoint/offset"][...], np.concatenate([[0], np.cumsum(2 * slot)[:-1]]))
         assert h5["checkpoint/state"].shape == (2 * slot.sum(),)
         assert "0 an inertial event, 1 a creep episode" in h5["events/kind"].attrs["description"]
-    with catalog.Reader(d / "full.h5") as cat:
+    with reader.Reader(d / "full.h5") as cat:
         for k in range(len(tasks["point"])):
             state = cat.layout.read_state(k, cat.layout.head(k))
             if flags[k]:
@@ -90,7 +93,7 @@ def test_a_creeping_chain_writes_both_kinds_and_keeps_its_creep_state(creeping):
     table = export.events(d / "full.h5")
     np.testing.assert_array_equal(table["kind"], kind)
     np.testing.assert_array_equal(table["ending"], ending)
-    assert export.columns(d / "full.h5", "events")["ending"] == catalog.DATASETS["events/ending"][::2]
+    assert export.columns(d / "full.h5", "events")["ending"] == schema.DATASETS["events/ending"][::2]
 
 
 def test_reduce_counts_the_inertial_events_alone(creeping):
@@ -101,8 +104,8 @@ def test_reduce_counts_the_inertial_events_alone(creeping):
     res = run_bounded([sys.executable, "-m", "analysis", "reduce", d / "full.h5", "-o", out, "--bootstrap", "200",
                        "--mu-c", "3.5"], TIMEOUT, env=child_env())
     assert res.returncode == 0, res.stderr
-    events, tasks, _ = catalog.read(d / "full.h5")
-    inertial = {name: column[events["kind"] == catalog.KIND_EVENT] for name, column in events.items()}
+    events, tasks, _ = reader.read(d / "full.h5")
+    inertial = {name: column[events["kind"] == schema.KIND_EVENT] for name, column in events.items()}
     opt = {"mu_edges": np.linspace(0, 7, 71), "tnu_edges": np.linspace(0, 2000, 81), "mu_c": 3.5,
            "window": 10, "b_cut": 3.0, "bootstrap": 200, "level": 0.95, "blocks": 20, "seed": 0}
     expected = ref.expected_summary([(d / "full.h5", events, tasks)], opt)   # the reference keeps kind 0 apart
@@ -113,7 +116,7 @@ def test_reduce_counts_the_inertial_events_alone(creeping):
     assert s["points/numbers/n_events"][creeping_point][0] == np.count_nonzero(
         np.isin(inertial["task"], tasks_of(tasks, CREEPING))) < SEEDS * EVENTS
     assert s["points/numbers/n_recurrences"][creeping_point][0] > 10
-    creep_mu = events["mu"][events["kind"] == catalog.KIND_CREEP]
+    creep_mu = events["mu"][events["kind"] == schema.KIND_CREEP]
     assert np.count_nonzero((creep_mu >= 0) & (creep_mu < 7)) > 50     # they would land in R(mu)'s bins
 
 
@@ -121,11 +124,11 @@ def test_compare_counts_the_inertial_events_alone(creeping):
     """`analysis compare`'s units (sizes, magnitudes, recurrences) read the kind-0 rows alone."""
     from analysis import compare
     d, _ = creeping
-    events, tasks, _ = catalog.read(d / "full.h5")
+    events, tasks, _ = reader.read(d / "full.h5")
     opt = compare.Options(blocks=5, window=10, n_large=40, n_min=1)
     for k in tasks_of(tasks, CREEPING):
         sizes, mu_counts, _ = compare.task_units(str(d / "full.h5"), int(k), opt)
-        inertial = (events["task"] == k) & (events["kind"] == catalog.KIND_EVENT)
+        inertial = (events["task"] == k) & (events["kind"] == schema.KIND_EVENT)
         np.testing.assert_array_equal(sizes.sum(axis=0), np.bincount(events["n_slipped"][inertial], minlength=51))
         assert mu_counts.sum() == np.count_nonzero(inertial)
 
@@ -141,7 +144,7 @@ def test_resume_with_creep_in_flight_gives_the_uninterrupted_catalog(creeping, t
              f"inject.signal_when_creeping({int(signal.SIGTERM)}, paused={paused})")
     res = injected(setup, "run", cfg, "-o", out, "--set", "run.poll_seconds=1e-5")
     assert res.returncode == 75, res.stdout + res.stderr
-    with catalog.Reader(catalog.partial_path(out)) as cat:
+    with reader.Reader(partial_path(out)) as cat:
         states = [cat.layout.read_state(k, cat.layout.head(k)) for k in tasks_of(cat.tasks, CREEPING)
                   if cat.layout.head(k) is not None]
         stopped = [k for k in range(len(cat.tasks["point"])) if 0 < cat.tasks["events_done"][k] < TRANSIENT + EVENTS]
@@ -151,9 +154,9 @@ def test_resume_with_creep_in_flight_gives_the_uninterrupted_catalog(creeping, t
     res = run_cli("resume", out, timeout=TIMEOUT)
     assert res.returncode == 0, res.stdout + res.stderr
     assert_same_events(d / "full.h5", out)
-    a, _, _ = catalog.read(d / "full.h5")
-    b, _, _ = catalog.read(out)
-    for name in catalog.EVENT_FIELDS:          # and in the same order of rows
+    a, _, _ = reader.read(d / "full.h5")
+    b, _, _ = reader.read(out)
+    for name in schema.EVENT_FIELDS:          # and in the same order of rows
         np.testing.assert_array_equal(a[name], b[name], err_msg=name)
 
 
@@ -167,7 +170,7 @@ def test_two_ranks_write_the_serial_catalog(creeping, tmp_path, writer):
                        "-o", str(out), "--set", f'output.writer="{writer}"'], TIMEOUT, env=child_env())
     assert res.returncode == 0, res.stdout + res.stderr
     assert_same_events(d / "full.h5", out)
-    _, tasks, _ = catalog.read(out)
+    _, tasks, _ = reader.read(out)
     assert set(tasks["rank"]) == {0, 1}
     with h5py.File(d / "full.h5", "r") as one, h5py.File(out, "r") as two:
         np.testing.assert_array_equal(one["checkpoint/creep"][...], two["checkpoint/creep"][...])
@@ -176,14 +179,14 @@ def test_two_ranks_write_the_serial_catalog(creeping, tmp_path, writer):
 def test_a_checkpoint_packs_its_creep_state_and_a_slot_of_another_size_is_refused(tmp_path):
     n = 5
     rng = np.random.default_rng(3)
-    cp = catalog.Checkpoint(rng.random(n), rng.random(n), rng.random((n, 2)), rng.random(2), 7,
+    cp = Checkpoint(rng.random(n), rng.random(n), rng.random((n, 2)), rng.random(2), 7,
                             rng.random(Workspace.creep_size(n)))
     flat = cp.pack()
     assert len(flat) == 4 * n + 2 + Workspace.creep_size(n)
-    back = catalog.Checkpoint.unpack(flat, 7, n)
+    back = Checkpoint.unpack(flat, 7, n)
     for name in ("force", "psi", "since", "clock", "creep"):
         np.testing.assert_array_equal(getattr(back, name), getattr(cp, name), err_msg=name)
-    assert catalog.Checkpoint.unpack(flat[:4 * n + 2], 7, n).creep is None
+    assert Checkpoint.unpack(flat[:4 * n + 2], 7, n).creep is None
     # a writer refuses a checkpoint that does not fit the record's slots (with or without a creep state)
     from mpi4py import MPI
 
@@ -191,19 +194,19 @@ def test_a_checkpoint_packs_its_creep_state_and_a_slot_of_another_size_is_refuse
     from ensemble.runner import integrator_text
     from ensemble.tasks import task_list
     cfg = loads(f"[model]\nN = {n}\nb = 15.0\n[run]\nevents = 4\ntransient = 0\n")
-    assert catalog.carries_creep(cfg.model) and not catalog.carries_creep(loads("[model]\nN = 5\n").model)
-    writer = catalog.Rank0Writer(str(tmp_path / "c.h5"), MPI.COMM_SELF, cfg, task_list(cfg),
+    assert carries_creep(cfg.model) and not carries_creep(loads("[model]\nN = 5\n").model)
+    writer = writers.Rank0Writer(str(tmp_path / "c.h5"), MPI.COMM_SELF, cfg, task_list(cfg),
                                  integrator_text(cfg.integrator))
     try:
         writer.record(0)
-        no_creep = catalog.Checkpoint(cp.force, cp.psi, cp.since, cp.clock, 0)
-        with pytest.raises(catalog.CatalogError,
+        no_creep = Checkpoint(cp.force, cp.psi, cp.since, cp.clock, 0)
+        with pytest.raises(CatalogError,
                            match=r"a checkpoint of 22 values for slots of \d+ \(with a creep state\)"):
             writer.commit(0, 0, None, no_creep)
-        writer.commit(0, 0, None, catalog.Checkpoint(cp.force, cp.psi, cp.since, cp.clock, 0, cp.creep))
+        writer.commit(0, 0, None, Checkpoint(cp.force, cp.psi, cp.since, cp.clock, 0, cp.creep))
     finally:
         writer.close()
-    with catalog.Reader(tmp_path / "c.h5") as cat:
+    with reader.Reader(tmp_path / "c.h5") as cat:
         np.testing.assert_array_equal(cat.layout.read_state(0, cat.layout.head(0)).creep, cp.creep)
 
 
@@ -228,16 +231,16 @@ def test_unperturbed_branches_carry_the_spun_up_creep_state(tmp_path):
     res = run_cli("run", cfg, "-o", tmp_path / "plain.h5", "--set", "run.branch=false",
                   "--set", f"run.transient={chain.done + 20}", timeout=TIMEOUT)
     assert res.returncode == 0, res.stdout + res.stderr
-    zero, _, _ = catalog.read(tmp_path / "zero.h5")
-    plain, _, _ = catalog.read(tmp_path / "plain.h5")
+    zero, _, _ = reader.read(tmp_path / "zero.h5")
+    plain, _, _ = reader.read(tmp_path / "plain.h5")
     seed0 = plain["task"] == 0
-    assert np.count_nonzero(plain["kind"][seed0] == catalog.KIND_CREEP) > 10
-    with catalog.Reader(tmp_path / "zero.h5") as cat:     # the spin-up (record 2) ended with a block creeping
+    assert np.count_nonzero(plain["kind"][seed0] == schema.KIND_CREEP) > 10
+    with reader.Reader(tmp_path / "zero.h5") as cat:     # the spin-up (record 2) ended with a block creeping
         spun = cat.layout.read_state(2, cat.layout.head(2))
     assert spun.creep is not None and spun.creep[-NCSTATE + CS_NCREEP] > 0
     for k in range(2):
         mine = zero["task"] == k
-        for name in catalog.EVENT_FIELDS:
+        for name in schema.EVENT_FIELDS:
             if name != "task":
                 np.testing.assert_array_equal(zero[name][mine], plain[name][seed0], err_msg=f"task {k} {name}")
 
@@ -252,13 +255,13 @@ def test_a_record_laid_out_for_another_kernel_is_not_continued(tmp_path, monkeyp
     from ensemble.tasks import task_list
     cfg = loads("[model]\nN = 5\nb = 15.0\n[run]\nevents = 4\ntransient = 0\n")
     path = str(tmp_path / "c.h5")
-    catalog.Rank0Writer(path, MPI.COMM_SELF, cfg, task_list(cfg), integrator_text(cfg.integrator)).close()
-    catalog.read(path)                                   # a reader does not ask
-    monkeypatch.setattr(catalog, "carries_creep", lambda model: False)
-    catalog.read(path)
-    writer = catalog.Rank0Writer(path, MPI.COMM_SELF)
+    writers.Rank0Writer(path, MPI.COMM_SELF, cfg, task_list(cfg), integrator_text(cfg.integrator)).close()
+    reader.read(path)                                   # a reader does not ask
+    monkeypatch.setattr(layout, "carries_creep", lambda model: False)    # what a resume asks
+    reader.read(path)
+    writer = writers.Rank0Writer(path, MPI.COMM_SELF)
     try:
-        with pytest.raises(catalog.CatalogError, match="task 0: its checkpoint slots were laid out with a creep "
+        with pytest.raises(CatalogError, match="task 0: its checkpoint slots were laid out with a creep "
                                                        "state, and this version keeps none"):
             writer.record(0)
     finally:

@@ -7,7 +7,8 @@ import numba
 import numpy as np
 import pytest
 
-from ensemble import catalog, cli
+from ensemble import cli
+from ensemble.store import reader, schema, writers
 from ensemble.config import loads
 
 from .conftest import run_cli, write_config
@@ -27,7 +28,7 @@ def small_run(tmp_path_factory):
 
 def test_catalog_schema_and_content(small_run):
     d, cfg = small_run
-    events, tasks, attrs = catalog.read(d / "cfg.h5")
+    events, tasks, attrs = reader.read(d / "cfg.h5")
     assert len(tasks["point"]) == 4 and list(tasks["events_written"]) == [30] * 4
     assert list(tasks["b"]) == [20.0, 20.0, 30.0, 30.0] and list(tasks["seed_index"]) == [0, 1, 0, 1]
     assert len(events["t"]) == 120
@@ -44,7 +45,7 @@ def test_catalog_schema_and_content(small_run):
     assert np.array_equal(events["boundary"], (events["first"] == 0) | (events["last"] == 59))
     assert np.all(events["duration"] > 0)
     with h5py.File(d / "cfg.h5") as h5:
-        assert set(h5["events"]) == set(catalog.EVENT_FIELDS)
+        assert set(h5["events"]) == set(schema.EVENT_FIELDS)
         assert h5["events"]["boundary"].dtype == np.bool_
 
 
@@ -52,10 +53,10 @@ def test_same_seed_same_catalog_other_seed_differs(small_run, tmp_path):
     d, cfg = small_run
     assert run_cli("run", cfg, "-o", tmp_path / "again.h5").returncode == 0
     assert run_cli("run", cfg, "-o", tmp_path / "other.h5", "--set", "run.seed=5").returncode == 0
-    a, _, _ = catalog.read(d / "cfg.h5")
-    b, _, _ = catalog.read(tmp_path / "again.h5")
-    c, _, _ = catalog.read(tmp_path / "other.h5")
-    for name in catalog.EVENT_FIELDS:
+    a, _, _ = reader.read(d / "cfg.h5")
+    b, _, _ = reader.read(tmp_path / "again.h5")
+    c, _, _ = reader.read(tmp_path / "other.h5")
+    for name in schema.EVENT_FIELDS:
         np.testing.assert_array_equal(a[name], b[name])
     assert not np.array_equal(a["slip"], c["slip"])
 
@@ -90,7 +91,7 @@ def expected_stack():
     """The mpi and hdf5 lines validate, the run log and the catalog give in this environment."""
     from mpi4py import MPI
     library = " ".join(MPI.Get_library_version().splitlines()[0].split())
-    mpi = "with" if catalog.has_parallel_hdf5() else "without"
+    mpi = "with" if writers.has_parallel_hdf5() else "without"
     return [f"mpi: {library} (MPI {'.'.join(map(str, MPI.Get_version()))}, mpi4py {mpi4py.__version__})",
             f"hdf5: {h5py.version.hdf5_version} {mpi} MPI (h5py {h5py.__version__})"]
 
@@ -99,7 +100,7 @@ def test_validate_names_the_mpi_the_hdf5_and_the_writer(small_run):
     d, cfg = small_run
     res = run_cli("validate", cfg)
     assert res.returncode == 0, res.stderr
-    more = ("parallel HDF5 (mpio), independent writes" if catalog.has_parallel_hdf5() else
+    more = ("parallel HDF5 (mpio), independent writes" if writers.has_parallel_hdf5() else
             "serial HDF5 on rank 0, rows sent by message (h5py has no MPI)")
     assert res.stdout.strip().splitlines()[-3:] == [
         *("# " + line for line in expected_stack()), f"# writer: auto -> 1 rank: serial HDF5; more ranks: {more}"]
@@ -108,7 +109,7 @@ def test_validate_names_the_mpi_the_hdf5_and_the_writer(small_run):
 def test_validate_without_parallel_hdf5(small_run, monkeypatch, capsys):
     """As on the wheel stack: 'auto' says why more ranks use rank0, 'parallel' fails naming the key."""
     d, cfg = small_run
-    monkeypatch.setattr(catalog, "has_parallel_hdf5", lambda: False)
+    monkeypatch.setattr(writers, "has_parallel_hdf5", lambda: False)
     assert cli.main(["validate", str(cfg)]) == 0
     lines = capsys.readouterr().out.strip().splitlines()
     assert lines[-2].startswith("# hdf5: ") and lines[-2].endswith(f" without MPI (h5py {h5py.__version__})")
@@ -123,7 +124,7 @@ def test_validate_without_parallel_hdf5(small_run, monkeypatch, capsys):
 def test_run_refuses_the_parallel_writer_without_parallel_hdf5(tmp_path):
     """The run itself refuses, as a config error (exit 2, one line), before creating anything."""
     cfg = write_config(tmp_path / "c.toml")
-    code = ("import sys; from ensemble import catalog, cli; catalog.has_parallel_hdf5 = lambda: False; "
+    code = ("import sys; from ensemble import cli; from ensemble.store import writers; writers.has_parallel_hdf5 = lambda: False; "
             f"sys.exit(cli.main(['run', {str(cfg)!r}, '--set', 'output.writer=\"parallel\"']))")
     res = run_bounded([sys.executable, "-c", code], 600, cwd=ROOT, env=child_env())
     assert res.returncode == 2, res.stderr
@@ -138,7 +139,7 @@ def test_run_log_and_catalog_name_the_stack(small_run):
     start = log.index(f"writing {d / 'cfg.h5.partial'} with 1 rank(s): serial HDF5")
     assert log[start - 2:start] == expected_stack()
     assert sum(line.startswith(("mpi: ", "hdf5: ")) for line in log) == 2
-    _, _, attrs = catalog.read_tasks(d / "cfg.h5")
+    _, _, attrs = reader.read_tasks(d / "cfg.h5")
     python = ".".join(map(str, sys.version_info[:3]))
     assert attrs["software"].splitlines() == [
         *expected_stack(), f"python {python}, numpy {np.__version__}, numba {numba.__version__}",

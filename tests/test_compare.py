@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from analysis import compare as cmp
-from ensemble import catalog
+from ensemble.store import reader, schema
 
 from .conftest import run_cli, write_config
 from .processes import child_env, run_bounded
@@ -132,7 +132,7 @@ def test_compare_numbers_are_the_catalogs(two_laws, tmp_path):
     assert [p["law"] for p in numbers["points"]] == ["carlson-langer", "aging"]
     assert numbers["points"][0]["label"] == "carlson-langer: alpha = 2.5, sigma = 0.01"
     for path, point in zip(paths, numbers["points"]):
-        events, tasks, _ = catalog.read(path)
+        events, tasks, _ = reader.read(path)
         parts = [brute_force({k: v[events["task"] == k_] for k, v in events.items()}, 5, 3)
                  for k_ in range(len(tasks["point"]))]
         T = np.concatenate([p[2] for p in parts]) * float(tasks["nu"][0])
@@ -239,8 +239,8 @@ def test_two_laws_with_the_same_keys_are_two_points(two_laws, tmp_path):
     assert res.returncode == 0, res.stderr
     kinds = {}
     for name, path in (("aging", aging), ("slip", tmp_path / "slip.h5")):
-        events, _, _ = catalog.read(path)
-        kinds[name] = int(np.count_nonzero(events["kind"] == catalog.KIND_EVENT))
+        events, _, _ = reader.read(path)
+        kinds[name] = int(np.count_nonzero(events["kind"] == schema.KIND_EVENT))
     out = tmp_path / "both.summary.h5"
     res = analysis("reduce", aging, tmp_path / "slip.h5", "-o", out, "--bootstrap", "5")
     assert res.returncode == 0, res.stderr

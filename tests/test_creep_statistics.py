@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from analysis import export, plot, report, summary
-from ensemble import catalog
+from ensemble.store import reader, schema
 
 from .conftest import ROOT, run_cli, write_config
 from .processes import run_bounded
@@ -42,7 +42,7 @@ def reduced(tmp_path_factory):
     for name, extra in (("sum", ()), ("narrow", (f"--creep-mu-bins={NARROW_MU}",))):
         res = analysis("reduce", d / "cat.h5", "-o", d / f"{name}.h5", "--bootstrap", "200", *extra)
         assert res.returncode == 0, res.stderr
-    events, tasks, _ = catalog.read(d / "cat.h5")
+    events, tasks, _ = reader.read(d / "cat.h5")
     return d, events, tasks
 
 
@@ -55,7 +55,7 @@ def test_aseismic_fraction_and_shares_are_the_catalogs(reduced):
     (ending 2) over episodes, as numpy gives them from the rows; the per-task sums add up to the point."""
     d, ev, tasks = reduced
     s = summary.read(d / "sum.h5")
-    creep, inertial = ev["kind"] == catalog.KIND_CREEP, ev["kind"] == catalog.KIND_EVENT
+    creep, inertial = ev["kind"] == schema.KIND_CREEP, ev["kind"] == schema.KIND_EVENT
     assert np.count_nonzero(creep & np.isin(ev["task"], np.flatnonzero(tasks["b"] == CREEPING))) > 100
     for b in (CREEPING, STIFF):
         i, mine = point_of(s, b), np.isin(ev["task"], np.flatnonzero(tasks["b"] == b))
@@ -66,7 +66,7 @@ def test_aseismic_fraction_and_shares_are_the_catalogs(reduced):
         assert number["aseismic_fraction"][0] == pytest.approx(creep_slip / (creep_slip + event_slip), rel=1e-12)
         assert number["creep_share"][0] == pytest.approx(n_creep / (n_creep + n_events), rel=1e-12)
         if n_creep:
-            taken = np.count_nonzero(mine & creep & (ev["ending"] == catalog.ENDING_TAKEN_OVER))
+            taken = np.count_nonzero(mine & creep & (ev["ending"] == schema.ENDING_TAKEN_OVER))
             assert number["taken_over_share"][0] == pytest.approx(taken / n_creep, rel=1e-12)
     # per task: the stretches of /per_task/creep sum to the task's rows
     per_task = s["per_task/creep"].sum(axis=1)
@@ -74,7 +74,7 @@ def test_aseismic_fraction_and_shares_are_the_catalogs(reduced):
         k = s["tasks/catalog_task"][g]
         rows = ev["task"] == k
         np.testing.assert_array_equal(per_task[g, :2], [np.count_nonzero(rows & creep), np.count_nonzero(
-            rows & creep & (ev["ending"] == catalog.ENDING_TAKEN_OVER))])
+            rows & creep & (ev["ending"] == schema.ENDING_TAKEN_OVER))])
         np.testing.assert_allclose(per_task[g, 2:], [ev["slip"][rows & creep].sum(), ev["slip"][rows & inertial].sum()],
                                    rtol=1e-12)
     print(f"\naseismic fraction at b = {CREEPING:g}, N = 50:",
@@ -85,7 +85,7 @@ def test_densities_integrate_to_the_share_of_episodes_in_their_bins(reduced):
     """sum(density * width) over the bins = episodes inside the bins / all episodes, for the size
     (default and narrow bins, half-open [lo, hi)) and the duration in units of 1/nu."""
     d, ev, tasks = reduced
-    mine = (ev["kind"] == catalog.KIND_CREEP) & np.isin(ev["task"], np.flatnonzero(tasks["b"] == CREEPING))
+    mine = (ev["kind"] == schema.KIND_CREEP) & np.isin(ev["task"], np.flatnonzero(tasks["b"] == CREEPING))
     nu = tasks["nu"][0]
     values = {"creep_mu": ev["mu"][mine], "creep_duration": np.log10(ev["duration"][mine] * nu)}
     shares = []

@@ -19,7 +19,8 @@ import numpy as np
 import pytest
 
 from analysis import export, summary
-from ensemble import catalog
+from ensemble.store import reader, schema, writers
+from ensemble.store.errors import CatalogError
 from ensemble.config import loads
 from ensemble.tasks import task_list
 
@@ -57,7 +58,7 @@ def files(tmp_path_factory):
     d = tmp_path_factory.mktemp("export")
     cat = d / "cat.h5"
     write_catalog(cat, CONFIG.format(N=N_CHAIN, sweep=SWEEP, seeds=2, seed=0), WRITTEN, seed=5)
-    writer = catalog.Rank0Writer(str(cat), MPI.COMM_SELF)
+    writer = writers.Rank0Writer(str(cat), MPI.COMM_SELF)
     for task, error in ERRORS.items():
         writer.fail(task, error)
     writer.close()
@@ -100,10 +101,10 @@ def assert_same(got, want, names=None):
 # -- the structured-array API against the files ------------------------------------------------
 
 def test_api_events_and_tasks_are_the_catalogs(files):
-    events, tasks, _ = catalog.read(files / "cat.h5")
+    events, tasks, _ = reader.read(files / "cat.h5")
     ev = export.events(files / "cat.h5")
-    assert list(ev.dtype.names) == list(catalog.EVENT_FIELDS)
-    for name, dtype in catalog.EVENT_FIELDS.items():
+    assert list(ev.dtype.names) == list(schema.EVENT_FIELDS)
+    for name, dtype in schema.EVENT_FIELDS.items():
         assert ev[name].dtype == dtype
         np.testing.assert_array_equal(ev[name], events[name], err_msg=name)
     tk = export.tasks(files / "cat.h5")
@@ -113,7 +114,7 @@ def test_api_events_and_tasks_are_the_catalogs(files):
                  "wall_time", "events_per_second", "seed_entropy", "spawn_key"):
         np.testing.assert_array_equal(tk[name], tasks[name], err_msg=name)
     assert list(tk["error"]) == [ERRORS.get(k, "").replace("\n", " ") for k in range(len(WRITTEN))]  # one line
-    assert list(np.flatnonzero(tk["status"] == catalog.FAILED)) == list(ERRORS)
+    assert list(np.flatnonzero(tk["status"] == schema.FAILED)) == list(ERRORS)
     cfg = loads(CONFIG.format(N=N_CHAIN, sweep=SWEEP, seeds=2, seed=0))
     assert set(tk["integrator_method"]) == {cfg.integrator.method}
     for key in ("dt", "rtol", "atol", "max_step", "max_duration"):
@@ -124,14 +125,14 @@ def test_api_events_and_tasks_are_the_catalogs(files):
 def test_api_streams_the_catalog_in_verified_chunks(files, tmp_path):
     """iter_events gives chunks of at most `chunk` rows, tasks in order; a corrupt row fails the
     export with the catalog's message, and nothing is written."""
-    events, _, _ = catalog.read(files / "cat.h5")
+    events, _, _ = reader.read(files / "cat.h5")
     parts = list(export.iter_events(files / "cat.h5", chunk=7))
     assert max(len(p) for p in parts) == 7 and len(parts) >= sum(WRITTEN) // 7
-    assert_same(np.concatenate(parts), events, list(catalog.EVENT_FIELDS))
+    assert_same(np.concatenate(parts), events, list(schema.EVENT_FIELDS))
     bad = shutil.copy(files / "cat.h5", tmp_path / "bad.h5")
     with h5py.File(bad, "r+") as h5:       # in range, so only the task's checksum can tell
         h5["events/duration"][3 * 400 + 150] += 1.0
-    with pytest.raises(catalog.CatalogError, match="task 3: its 400 events fail their checksum"):
+    with pytest.raises(CatalogError, match="task 3: its 400 events fail their checksum"):
         export.write(bad, tmp_path / "out", chunk=7, partial=True)
     assert os.listdir(tmp_path / "out") == []
     res = analysis("export", bad, "-o", tmp_path / "out", "--partial")
@@ -208,10 +209,10 @@ def test_every_column_has_a_unit_and_a_meaning(files):
 # -- CSV -----------------------------------------------------------------------------------------
 
 def test_catalog_csv_round_trips_exactly(files):
-    events, tasks, _ = catalog.read(files / "cat.h5")
+    events, tasks, _ = reader.read(files / "cat.h5")
     ev = genfromtxt(files / "cat_csv" / "events.csv")
-    assert list(ev.dtype.names) == list(catalog.EVENT_FIELDS)
-    assert_same(ev, events, list(catalog.EVENT_FIELDS))
+    assert list(ev.dtype.names) == list(schema.EVENT_FIELDS)
+    assert_same(ev, events, list(schema.EVENT_FIELDS))
     tk = genfromtxt(files / "cat_csv" / "tasks.csv")
     for name in ("point", "seed_index", "N", "l", "nu", "a", "b", "c", "events_written", "events_done",
                  "status", "rank", "wall_time", "events_per_second", "seed_entropy", "spawn_key"):
@@ -302,8 +303,8 @@ def test_export_of_an_unfinished_run_needs_partial_as_reduce_does(files, tmp_pat
 
 def test_tables_of_an_unfinished_run_say_so(files):
     """With --partial, every table's header states the run unfinished: tasks, events of expected."""
-    _, tasks, _ = catalog.read(files / "cat.h5")
-    assert np.count_nonzero((tasks["status"] != catalog.FINISHED) | (tasks["events_written"] < 400)) == 5
+    _, tasks, _ = reader.read(files / "cat.h5")
+    assert np.count_nonzero((tasks["status"] != schema.FINISHED) | (tasks["events_written"] < 400)) == 5
     line = (f"# PARTIAL export of an unfinished run (5 of 8 tasks unfinished): {sum(WRITTEN)} of {8 * 400} events "
             f"({100 * sum(WRITTEN) / (8 * 400):.1f}%)")
     for table in ("events", "tasks"):
@@ -346,7 +347,7 @@ def test_export_of_a_wrong_file_is_one_line(files, tmp_path, name, words):
 
 
 def test_api_given_the_other_kind_says_so(files):
-    with pytest.raises(catalog.CatalogError, match="not an event catalog .give the catalog it was reduced from"):
+    with pytest.raises(CatalogError, match="not an event catalog .give the catalog it was reduced from"):
         export.events(files / "cat.summary.h5")
     with pytest.raises(summary.SummaryError, match="not a reduction summary .reduce it first"):
         export.numbers(files / "cat.h5")
@@ -382,7 +383,7 @@ def test_pandas_reads_the_csv_as_the_api_returns_it(files):
 
 # -- descriptions ------------------------------------------------------------------------------------
 
-UNBRANCHED = [name for name in catalog.DATASETS if not name.startswith("spinup/")]   # run.branch = false
+UNBRANCHED = [name for name in schema.DATASETS if not name.startswith("spinup/")]   # run.branch = false
 
 
 def descriptions(path):
@@ -400,15 +401,15 @@ def assert_described(path, table):
     assert not missing, f"datasets without a description: {missing}"
     assert all("\n" not in text for text in found.values())
     for name, text in found.items():
-        assert text == catalog.description(table[name]), name
+        assert text == schema.description(table[name]), name
 
 
 def test_every_dataset_of_a_catalog_and_a_summary_is_described(files):
-    assert_described(files / "cat.h5", catalog.DATASETS)
+    assert_described(files / "cat.h5", schema.DATASETS)
     # no line for a dataset gone (/spinup exists with run.branch only: tests/test_branch.py)
     assert set(descriptions(files / "cat.h5")) == set(UNBRANCHED)
     assert_described(files / "cat.summary.h5", summary.DATASETS)
-    assert {name.split("/", 1)[1] for name in catalog.DATASETS if name.startswith("tasks/")} <= set(
+    assert {name.split("/", 1)[1] for name in schema.DATASETS if name.startswith("tasks/")} <= set(
         name.split("/", 1)[1] for name in descriptions(files / "cat.summary.h5") if name.startswith("tasks/"))
 
 
@@ -419,7 +420,7 @@ def test_a_catalog_without_descriptions_still_reads_and_exports(files, tmp_path)
         for name in UNBRANCHED:
             del h5[name].attrs["description"]
     assert set(descriptions(old).values()) == {None}
-    events, tasks, _ = catalog.read(old)
+    events, tasks, _ = reader.read(old)
     assert len(events["t"]) == sum(WRITTEN)
     export.write(old, tmp_path / "out", partial=True)
     assert (tmp_path / "out" / "events.csv").read_text().split("\n", 2)[2] == (
@@ -429,12 +430,12 @@ def test_a_catalog_without_descriptions_still_reads_and_exports(files, tmp_path)
 CREATE = """
 import sys
 from mpi4py import MPI
-from ensemble import catalog
+from ensemble.store import writers
 from ensemble.config import loads
 from ensemble.runner import integrator_text
 from ensemble.tasks import task_list
 cfg = loads(sys.argv[2])
-writer = catalog.ParallelWriter(sys.argv[1], MPI.COMM_WORLD, cfg, task_list(cfg), integrator_text(cfg.integrator))
+writer = writers.ParallelWriter(sys.argv[1], MPI.COMM_WORLD, cfg, task_list(cfg), integrator_text(cfg.integrator))
 writer.close()
 """
 
@@ -450,7 +451,7 @@ def test_the_parallel_writer_describes_every_dataset(tmp_path):
     res = subprocess.run(["mpiexec", "-n", "2", sys.executable, "-c", CREATE, str(path), text],
                          capture_output=True, text=True, env=env(), cwd=ROOT, timeout=120)
     assert res.returncode == 0, res.stderr
-    assert_described(path, catalog.DATASETS)
+    assert_described(path, schema.DATASETS)
     assert set(descriptions(path)) == set(UNBRANCHED)
-    _, tasks, _ = catalog.read_tasks(path)
+    _, tasks, _ = reader.read_tasks(path)
     assert len(tasks["point"]) == len(task_list(loads(text)))

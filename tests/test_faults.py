@@ -17,8 +17,11 @@ import h5py
 import numpy as np
 import pytest
 
-from ensemble import catalog, lock
-from ensemble.integrity import commit_crc
+from ensemble import lock
+from ensemble.store import reader, schema
+from ensemble.store.errors import CatalogError
+from ensemble.store.files import partial_path
+from ensemble.store.integrity import commit_crc
 
 from .conftest import committed, write_config
 from .inject import CRASH_CODE
@@ -38,10 +41,10 @@ def cli(*args, timeout=TIMEOUT):
 
 
 def same_events(path_a, path_b):
-    a, ta, _ = catalog.read(path_a)
-    b, tb, _ = catalog.read(path_b)
+    a, ta, _ = reader.read(path_a)
+    b, tb, _ = reader.read(path_b)
     assert len(a["t"]) == len(b["t"]) > 0
-    for name in catalog.EVENT_FIELDS:
+    for name in schema.EVENT_FIELDS:
         np.testing.assert_array_equal(a[name], b[name], err_msg=name)
     np.testing.assert_array_equal(ta["events_written"], tb["events_written"])
 
@@ -74,7 +77,7 @@ def test_crash_at_every_write_of_a_batch_resumes_to_the_uninterrupted_catalog(sm
         out = d / f"crash{k}.h5"
         res = injected(f"inject.crash_at_write({k})", "run", cfg, "-o", out)
         assert res.returncode == CRASH_CODE, res.stderr
-        events, tasks, _ = catalog.read(catalog.partial_path(out))       # consistent after the crash
+        events, tasks, _ = reader.read(partial_path(out))       # consistent after the crash
         assert len(events["t"]) == tasks["events_written"].sum() < 120
         res = cli("run", cfg, "-o", out, "--resume")
         assert res.returncode == 0, (k, res.stderr)
@@ -100,7 +103,7 @@ def interrupted(small, tmp_path):
     out = tmp_path / "x.h5"
     res = injected("inject.crash_at_write(60)", "run", cfg, "-o", out)
     assert res.returncode == CRASH_CODE, res.stderr
-    _, tasks, _ = catalog.read(catalog.partial_path(out))
+    _, tasks, _ = reader.read(partial_path(out))
     assert tasks["events_written"][0] > 0
     return cfg, out
 
@@ -109,7 +112,7 @@ def interrupted(small, tmp_path):
     ("state", "checkpoint slot"), ("event", "fail their checksum"), ("commit", "commit row")])
 def test_a_one_byte_flip_fails_resume_and_read_naming_the_task(interrupted, where, message):
     cfg, out = interrupted
-    partial = catalog.partial_path(out)
+    partial = partial_path(out)
     with h5py.File(partial, "r") as h5:
         row = h5["checkpoint/commit"][0]
         slot = int(np.argmax(row[:, 0]))          # the slot in use: highest sequence number
@@ -119,24 +122,24 @@ def test_a_one_byte_flip_fails_resume_and_read_naming_the_task(interrupted, wher
     elif where == "event":
         _flip_byte(partial, "events/mu", 7)
     else:
-        _flip_byte(partial, "checkpoint/commit", slot * catalog.NCOMMIT + catalog.C_DONE)
+        _flip_byte(partial, "checkpoint/commit", slot * schema.NCOMMIT + schema.C_DONE)
     res = cli("run", cfg, "-o", out, "--resume")
     assert res.returncode != 0 and "task 0" in res.stderr and message in res.stderr, res.stderr
     assert len(res.stderr.strip().splitlines()) == 1
     if where != "state":        # readers do not read checkpoints
-        with pytest.raises(catalog.CatalogError, match=f"task 0.*{message}"):
-            catalog.read(partial)
+        with pytest.raises(CatalogError, match=f"task 0.*{message}"):
+            reader.read(partial)
 
 
 def test_an_out_of_range_commit_row_with_a_valid_checksum_is_refused(interrupted):
     """A negative event count (once an endless loop) with a matching CRC: the range check catches it."""
     cfg, out = interrupted
-    partial = catalog.partial_path(out)
+    partial = partial_path(out)
     with h5py.File(partial, "r+") as h5:
         rows = h5["checkpoint/commit"][0]
         slot = int(np.argmax(rows[:, 0]))
-        fields = [int(x) for x in rows[slot][:catalog.C_ROW_CRC]]
-        fields[catalog.C_DONE] = -5
+        fields = [int(x) for x in rows[slot][:schema.C_ROW_CRC]]
+        fields[schema.C_DONE] = -5
         h5["checkpoint/commit"][0, slot] = fields + [commit_crc(0, slot, fields)]
     res = cli("run", cfg, "-o", out, "--resume")
     assert res.returncode == 1 and "task 0" in res.stderr and "out of range" in res.stderr
@@ -173,7 +176,7 @@ def test_a_second_run_on_a_live_output_is_refused_and_the_first_one_is_intact(lo
         code, log = stop(first)
     assert code == 75, log
     assert not os.path.exists(lock.lock_path(out))          # released on the way out
-    events, tasks, _ = catalog.read(catalog.partial_path(out))
+    events, tasks, _ = reader.read(partial_path(out))
     assert len(events["t"]) == tasks["events_written"].sum() > 0
 
 
@@ -213,7 +216,7 @@ def test_a_lock_from_another_host_with_a_fresh_heartbeat_is_refused_with_how_to_
         fh.write(f"host: node-elsewhere\npid: 4242\nstarted: x\nheartbeat: {time.time() + 3600:.1f}\n")
     res = cli("run", cfg, "-o", out)
     assert res.returncode == 2 and "node-elsewhere" in res.stderr and f"rm {path}" in res.stderr
-    assert not os.path.exists(catalog.partial_path(out))
+    assert not os.path.exists(partial_path(out))
     os.remove(path)
     assert cli("run", cfg, "-o", out).returncode == 0
 
@@ -232,7 +235,7 @@ def test_output_paths_are_checked_before_any_work(small, tmp_path):
     for target in (tmp_path / "adir", tmp_path / "missing" / "x.h5"):
         res = cli("run", cfg, "-o", target, "--force")
         assert res.returncode == 2 and str(target.parent if "missing" in str(target) else target) in res.stderr
-        assert "progress" not in res.stdout and not os.path.exists(catalog.partial_path(target))
+        assert "progress" not in res.stdout and not os.path.exists(partial_path(target))
     assert list((tmp_path / "adir").iterdir()) == []
 
 
@@ -253,7 +256,7 @@ def test_resume_continues_from_the_stored_config_without_retyping_overrides(long
     # SIGTERM at the first batch of events: it is committed, the rest of the run is not done
     res = injected("inject.signal_at_write(15)", "run", long_cfg, "-o", out, *sets)
     assert res.returncode == 75, res.stdout + res.stderr
-    _, tasks, _ = catalog.read(catalog.partial_path(out))
+    _, tasks, _ = reader.read(partial_path(out))
     assert 0 < tasks["events_written"].sum() < 400
     res = cli("resume", out)
     assert res.returncode == 0, res.stderr
@@ -279,20 +282,20 @@ def test_a_failing_task_is_recorded_and_rerun_with_another_integrator(small, tmp
     res = cli("run", cfg, "-o", out)
     assert res.returncode == 1 and "task 1" in res.stderr and "stability" in res.stderr
     assert "resume" in res.stdout and not out.exists()
-    _, tasks, _ = catalog.read(catalog.partial_path(out))
-    assert list(tasks["status"]) == [catalog.FINISHED, catalog.FAILED] and "stability" in tasks["error"][1]
+    _, tasks, _ = reader.read(partial_path(out))
+    assert list(tasks["status"]) == [schema.FINISHED, schema.FAILED] and "stability" in tasks["error"][1]
     status = cli("status", out)
     assert status.returncode == 0 and "failed: tasks 1" in status.stdout
     assert cli("resume", out).returncode == 1           # nothing changed: still failed, said again
     res = cli("resume", out, "--set", "integrator.dt=2e-4")
     assert res.returncode == 0, res.stderr
-    events, tasks, _ = catalog.read(out)
-    assert list(tasks["status"]) == [catalog.FINISHED] * 2 and list(tasks["events_written"]) == [60, 60]
+    events, tasks, _ = reader.read(out)
+    assert list(tasks["status"]) == [schema.FINISHED] * 2 and list(tasks["events_written"]) == [60, 60]
     assert "dt = 0.001" in tasks["integrator"][0] and "dt = 0.0002" in tasks["integrator"][1]
     ref = tmp_path / "ref.h5"
     assert cli("run", cfg, "-o", ref, "--set", "integrator.dt=2e-4").returncode == 0
-    ref_events, _, _ = catalog.read(ref)
-    for name in catalog.EVENT_FIELDS:       # the rerun task equals a run at dt = 2e-4 from the start
+    ref_events, _, _ = reader.read(ref)
+    for name in schema.EVENT_FIELDS:       # the rerun task equals a run at dt = 2e-4 from the start
         np.testing.assert_array_equal(events[name][events["task"] == 1], ref_events[name][ref_events["task"] == 1])
 
 
@@ -317,7 +320,7 @@ def test_a_full_disk_stops_the_run_with_one_line_and_nothing_lost(small, small_d
     assert len(res.stderr.strip().splitlines()) == 1 and not any(small_disk.iterdir())
     # in the middle (a file system without fallocate, whose space another process takes while the run
     # goes on: nothing reserved, the check before creation passed): one line, a readable catalog
-    res = injected("from ensemble import catalog, space; catalog._reserve_space = lambda path: None; "
+    res = injected("from ensemble import space; from ensemble.store import files; files.reserve_space = lambda path: None; "
                    "space.check_fits = lambda path, nbytes: None",
                    "run", cfg, "-o", small_disk / "b.h5", *big)
     assert res.returncode == 1 and "No space left on device" in res.stderr, res.stderr
@@ -377,16 +380,16 @@ def test_a_signal_during_one_very_long_event_is_served_within_a_kernel_call(tmp_
                  "the work loop", proc)
         code, log = stop(proc)
     assert code == 75, log
-    _, tasks, _ = catalog.read(catalog.partial_path(out))
+    _, tasks, _ = reader.read(partial_path(out))
     assert tasks["events_written"][0] == 0 and tasks["events_done"][0] == 0   # the event was in progress
 
 
 def test_status_of_the_partial_name_and_of_a_damaged_catalog(interrupted, tmp_path):
     cfg, out = interrupted
-    res = cli("status", catalog.partial_path(out))          # the .partial's own name: not "complete"
+    res = cli("status", partial_path(out))          # the .partial's own name: not "complete"
     assert res.returncode == 0 and "interrupted" in res.stdout.splitlines()[0]
     damaged = tmp_path / "damaged.h5"
-    damaged.write_bytes(open(catalog.partial_path(out), "rb").read()[:4096])
+    damaged.write_bytes(open(partial_path(out), "rb").read()[:4096])
     res = cli("status", damaged)
     assert res.returncode == 1 and "damaged.h5" in res.stderr
     assert len(res.stderr.strip().splitlines()) == 1

@@ -14,7 +14,7 @@ physics with c is checked against references that keep c (test_physics.py, test_
 import numpy as np
 import pytest
 
-from ensemble.catalog import Checkpoint
+from ensemble.store.checkpoint import Checkpoint
 from ensemble.config import Config, Integrator, Model, Run
 from ensemble.events import relative_energy_residual
 from ensemble.model.workspace import D_ENERGY_SCALE, D_RESIDUAL, D_SLIP, D_VMAX

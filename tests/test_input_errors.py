@@ -13,7 +13,9 @@ import h5py
 import pytest
 
 from analysis import summary
-from ensemble import catalog, filekind
+from ensemble import filekind
+from ensemble.store import reader
+from ensemble.store.errors import CatalogError
 from ensemble.config import SECTIONS, ConfigError, load, loads
 
 from .conftest import write_config
@@ -276,14 +278,14 @@ def test_reduce_refuses_rows_no_run_writes(files, tmp_path, values, words):
 
 def test_reduce_does_not_trust_the_events_written_mirror(files, tmp_path):
     """/tasks/events_written is a mirror: the checksummed commit rows say what a task holds, and a mirror
-    that matches none of them is a damaged catalog (ensemble/tables.py), never a count to use."""
-    _, tasks, _ = catalog.read_tasks(files / "cat.h5")
+    that matches none of them is a damaged catalog (ensemble/store/tables.py), never a count to use."""
+    _, tasks, _ = reader.read_tasks(files / "cat.h5")
     assert tasks["events_written"][1] == 40
     bad = shutil.copy(files / "cat.h5", tmp_path / "bad.h5")
     with h5py.File(bad, "r+") as h5:
         h5["tasks/events_written"][1] = 41
-    with pytest.raises(catalog.CatalogError, match=r"task 1: /tasks/events_written 41 matches none of its commit rows"):
-        catalog.read_tasks(bad)
+    with pytest.raises(CatalogError, match=r"task 1: /tasks/events_written 41 matches none of its commit rows"):
+        reader.read_tasks(bad)
 
 
 def test_reduce_force_replaces_only_a_summary(files, tmp_path):

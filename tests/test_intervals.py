@@ -60,12 +60,12 @@ def test_every_statistic_is_the_same_whatever_the_chunks(tmp_path):
     """A task streamed in chunks of 7 rows gives every statistic's tables as in one chunk: what a statistic
     carries from chunk to chunk (the previous event's time, the pending recurrences) is carried."""
     from analysis import reduce
-    from ensemble import catalog
+    from ensemble.store import reader, schema
     cat = gunzip(CATALOG, tmp_path / "catalog.h5")
     opt = reduce.Options(reduce.parse_bins("0:7:70"), reduce.parse_bins("0:2000:80"))
-    with catalog.Reader(str(cat)) as r:
+    with reader.Reader(str(cat)) as r:
         for k in range(len(r.tasks["N"])):
-            args = (r.count(k, catalog.KIND_EVENT), float(r.tasks["nu"][k]), int(r.tasks["N"][k]), opt,
+            args = (r.count(k, schema.KIND_EVENT), float(r.tasks["nu"][k]), int(r.tasks["N"][k]), opt,
                     int(r.tasks["events_written"][k]))
             whole = reduce.reduce_task(r.task_events(k, 1 << 16), *args)
             pieces = reduce.reduce_task(r.task_events(k, 7), *args)

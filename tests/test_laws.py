@@ -18,7 +18,7 @@ import h5py
 import numpy as np
 import pytest
 
-from ensemble import catalog
+from ensemble.store import reader
 from ensemble.config import Integrator, Model, loads
 from ensemble.events import advance_to_onset, check, run_event
 from ensemble.integrators import kernel_params
@@ -431,7 +431,7 @@ def test_catalog_independent_of_ranks(cl_run, writer):
                        "--set", f'output.writer="{writer}"'], 300, env=child_env())
     assert res.returncode == 0, res.stderr
     assert_same_events(d / "serial.h5", out)
-    _, tasks, _ = catalog.read(out)
+    _, tasks, _ = reader.read(out)
     assert len(tasks["rank"]) == 2 and set(tasks["rank"]) <= {0, 1}
 
 
@@ -475,7 +475,7 @@ def test_an_override_of_another_law_is_an_error_naming_it(cl_run, tmp_path, comm
 def test_catalog_records_the_law(cl_run):
     """/tasks/law and its conventions, the law's keys per task, NaN for the other law's keys."""
     d, cfg = cl_run
-    events, tasks, attrs = catalog.read(d / "serial.h5")
+    events, tasks, attrs = reader.read(d / "serial.h5")
     assert list(tasks["law"]) == [CL, CL]
     assert list(tasks["alpha"]) == [2.5, 2.5] and list(tasks["sigma"]) == [0.01, 0.01]
     for name in ("a", "b", "c"):
@@ -509,7 +509,7 @@ def test_status_reduce_and_report_on_a_carlson_langer_catalog(cl_run, tmp_path):
     assert res.returncode == 0, res.stderr
     print(res.stdout)
     assert "alpha = 2.5, sigma = 0.01" in res.stdout
-    events, _, _ = catalog.read(d / "serial.h5")
+    events, _, _ = reader.read(d / "serial.h5")
     row = {line.split()[0]: line.split()[1] for line in res.stdout.splitlines()
            if line.strip().startswith(("events", "frac(mu>=mu_c)"))}
     assert int(row["events"]) == 6000
@@ -527,7 +527,7 @@ def test_default_law_is_aging_and_unchanged(tmp_path):
     for cfg in (default, explicit):
         res = run_cli("run", cfg, "-o", cfg.with_suffix(".h5"))
         assert res.returncode == 0, res.stderr
-    _, tasks, attrs = catalog.read(default.with_suffix(".h5"))
+    _, tasks, attrs = reader.read(default.with_suffix(".h5"))
     assert list(tasks["law"]) == ["aging"] and 'law = "aging"' in attrs["config"]
     stored = loads(attrs["config"]).model
     assert (stored.law, stored.a, stored.b, stored.c, stored.alpha, stored.sigma) == ("aging", 0.0, 20.0, 1000.0,

@@ -11,7 +11,8 @@ import sys
 import numpy as np
 import pytest
 
-from ensemble import catalog
+from ensemble.store import reader, schema
+from ensemble.store.files import partial_path
 
 from .conftest import committed, run_cli, write_config
 from .processes import ROOT, Started, child_env, descendants, run_bounded, wait_for
@@ -64,7 +65,7 @@ def test_catalog_independent_of_ranks_and_writer(two_tasks, ranks, writer):
     res = mpirun(ranks, "run", cfg, "-o", out, "--set", f'output.writer="{writer}"')
     assert res.returncode == 0, res.stderr
     assert_same_events(d / "serial.h5", out)
-    _, tasks, attrs = catalog.read(out)
+    _, tasks, attrs = reader.read(out)
     assert set(tasks["rank"]) <= set(range(ranks)) and np.all(tasks["rank"] >= 0)
     assert np.all(tasks["events_per_second"] > 0)
     # each records the writer that made it (assert_same_events compares events and task rows only)
@@ -147,7 +148,7 @@ def test_resume_after_signal_equals_uninterrupted(four_tasks, sig, which, writer
     code, log = start_and_interrupt(cfg, out, (sig, which), writer)
     assert code == 75, log
     assert "interrupted" in log and not out.exists()
-    _, tasks, _ = catalog.read(catalog.partial_path(out))
+    _, tasks, _ = reader.read(partial_path(out))
     assert 0 < tasks["events_written"].sum() < 4 * 400      # really cut in the middle
     status = run_cli("status", out)
     assert status.returncode == 0 and "interrupted" in status.stdout and "resume" in status.stdout
@@ -159,7 +160,7 @@ def test_resume_after_kill9_loses_and_duplicates_nothing(four_tasks):
     out = d / "killed.h5"
     code, log = start_and_interrupt(cfg, out, "kill")
     assert code != 0 and not out.exists()
-    events, tasks, _ = catalog.read(catalog.partial_path(out))   # readable after kill -9
+    events, tasks, _ = reader.read(partial_path(out))   # readable after kill -9
     assert len(events["t"]) == tasks["events_written"].sum() < 4 * 400
     assert os.path.exists(str(out) + ".lock")          # left behind by the dead run ...
     res = resume_equals_uninterrupted(d, cfg, out)
@@ -186,7 +187,7 @@ def test_a_genuine_error_on_one_rank_aborts_the_job(tmp_path):
                       TIMEOUT, env=child_env())    # task 0 alone would run for minutes more: a hang fails
     assert res.returncode != 0
     assert "rank 1" in res.stderr and "injected failure" in res.stderr
-    catalog.read(catalog.partial_path(tmp_path / "x.h5"))   # what was committed stays readable
+    reader.read(partial_path(tmp_path / "x.h5"))   # what was committed stays readable
 
 
 def test_a_failing_task_does_not_stop_the_others_under_mpi(tmp_path):
@@ -198,11 +199,11 @@ def test_a_failing_task_does_not_stop_the_others_under_mpi(tmp_path):
     res = mpirun(2, "run", cfg, "-o", out, timeout=TIMEOUT)
     assert res.returncode == 1, res.stderr
     assert "task 1" in res.stderr and "stability" in res.stderr
-    _, tasks, _ = catalog.read(catalog.partial_path(out))
-    assert list(tasks["status"]) == [catalog.FINISHED, catalog.FAILED, catalog.FINISHED]
+    _, tasks, _ = reader.read(partial_path(out))
+    assert list(tasks["status"]) == [schema.FINISHED, schema.FAILED, schema.FINISHED]
     res = mpirun(2, "resume", out, "--set", "integrator.dt=2e-4", timeout=TIMEOUT)
     assert res.returncode == 0, res.stderr
-    _, tasks, _ = catalog.read(out)
+    _, tasks, _ = reader.read(out)
     assert list(tasks["events_written"]) == [100] * 3
 
 

@@ -137,14 +137,14 @@ def test_a_single_block_runs_its_stick_slip_cycle(tmp_path):
     displacement nu T since the event before (nothing else can take up the load)."""
     import sys
 
-    from ensemble import catalog
+    from ensemble.store import reader
 
     from .processes import child_env, run_bounded
     cfg = tmp_path / "one.toml"
     cfg.write_text("[model]\nN = 1\nb = 20.0\n[run]\nevents = 50\ntransient = 10\n")
     res = run_bounded([sys.executable, "-m", "ensemble", "run", cfg, "-o", tmp_path / "one.h5"], 300, env=child_env())
     assert res.returncode == 0, res.stderr
-    ev, tasks, _ = catalog.read(tmp_path / "one.h5")
+    ev, tasks, _ = reader.read(tmp_path / "one.h5")
     assert len(ev["t"]) == 50 and np.all(ev["n_slipped"] == 1) and np.all(ev["boundary"])
     interval = np.diff(ev["t"]) * 1e-8
     np.testing.assert_allclose(ev["slip"][1:], interval, rtol=1e-5)

@@ -1,6 +1,6 @@
 """Every number `python -m analysis reduce` writes, against a plain brute-force recomputation.
 
-Synthetic catalogs are written with the project's own writer (catalog.Rank0Writer on one
+Synthetic catalogs are written with the project's own writer (ensemble/store/writers.py's Rank0Writer on one
 process), so they are real, verified catalogs; their events are drawn to sit on the edges the
 reduction must get right: magnitudes exactly at mu_c, at the b-value cut, on bin edges and on
 the top edge, recurrence times on T nu bin edges, successive large events exactly `window` and
@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 from analysis import stats
-from ensemble import catalog
+from ensemble.store import reader, schema
 from ensemble.config import loads
 from ensemble.tasks import task_list
 
@@ -109,7 +109,7 @@ def write_catalog(path, config_text, written, seed):
     rng = np.random.default_rng(seed)
     parts = [synthetic_events(rng, t.index, written[t.index], gridded=t.index % 2 == 0) for t in tasks]
     write_events(path, config_text, parts)
-    return {c: np.concatenate([p[c] for p in parts]) for c in catalog.EVENT_FIELDS}
+    return {c: np.concatenate([p[c] for p in parts]) for c in schema.EVENT_FIELDS}
 
 
 CONFIG = """
@@ -170,8 +170,8 @@ def references(catalogs):
     out = {}
     for case, (name, level, blocks) in CASES.items():
         path, events = made[name]
-        got, tasks, _ = catalog.read(path)
-        for c in catalog.EVENT_FIELDS:     # the writer stored what was generated
+        got, tasks, _ = reader.read(path)
+        for c in schema.EVENT_FIELDS:     # the writer stored what was generated
             np.testing.assert_array_equal(got[c], events[c], err_msg=c)
         opt = options(level, blocks)
         out[case] = (path, tasks, opt, ref.expected_summary([(path, events, tasks)], opt))
@@ -325,7 +325,7 @@ def merged_reference(catalogs, names, level=0.9, blocks=5):
     inputs = []
     for name in names:
         path, events = made[name]
-        inputs.append((path, events, catalog.read_tasks(path)[1]))
+        inputs.append((path, events, reader.read_tasks(path)[1]))
     opt = options(level, blocks)
     return [p for p, _, _ in inputs], opt, ref.expected_summary(inputs, opt)
 
@@ -431,7 +431,7 @@ def test_unfinished_runs_need_partial_and_say_so(catalogs):
     # with --partial: both reduced as far as written; the statement names them
     paths = [made["seeds"][0], named]
     opt = options(0.9, 5)
-    exp = ref.expected_summary([(p, *catalog.read(p)[:2]) for p in paths], opt)
+    exp = ref.expected_summary([(p, *reader.read(p)[:2]) for p in paths], opt)
     written, expected = sum(SEEDS_WRITTEN) + 2 * 400, 12 * 400 + 2 * 400
     assert exp["partial"] == (written, expected, [str(p) for p in paths])
     out = d / "partial.summary.h5"

@@ -9,7 +9,8 @@ import numpy as np
 
 from analysis import reduce
 from analysis.statistics import seismicity
-from ensemble import catalog
+from ensemble.model.workspace import KIND_EVENT
+from ensemble.store import reader, schema
 
 from .processes import ROOT, child_env, run_bounded
 from .test_summary_identity import CATALOG, gunzip
@@ -60,16 +61,16 @@ def test_pairs_and_exposures_are_those_of_the_events_whatever_the_chunks(tmp_pat
     cat = gunzip(CATALOG, tmp_path / "catalog.h5")
     opt = options()
     checked = 0
-    with catalog.Reader(str(cat)) as r:
+    with reader.Reader(str(cat)) as r:
         for task in range(len(r.tasks["N"])):
             nu, n_blocks = float(r.tasks["nu"][task]), int(r.tasks["N"][task])
-            written = r.count(task, catalog.KIND_EVENT)
+            written = r.count(task, KIND_EVENT)
             ev = {name: [] for name in ("t", "epicenter", "mu", "kind")}
             for part in r.task_events(task, 1 << 16):
                 for name in ev:
                     ev[name].append(part[name])
             ev = {name: np.concatenate(v) for name, v in ev.items()}
-            inertial = ev["kind"] == catalog.KIND_EVENT
+            inertial = ev["kind"] == KIND_EVENT
             want_pairs, want_exposure = brute_force(ev["t"][inertial], ev["epicenter"][inertial],
                                                     ev["mu"][inertial], nu, n_blocks, opt)
             whole = None
@@ -90,10 +91,10 @@ def test_pairs_and_exposures_are_those_of_the_events_whatever_the_chunks(tmp_pat
 def hand_built(t, epicenter, mu, chunk):
     """The chunks of one task of inertial events (every column a statistic reads)."""
     n = len(t)
-    part = {name: np.zeros(n, dtype=dtype) for name, dtype in catalog.EVENT_FIELDS.items()}
+    part = {name: np.zeros(n, dtype=dtype) for name, dtype in schema.EVENT_FIELDS.items()}
     part.update(t=np.asarray(t, float), epicenter=np.asarray(epicenter, np.int64), mu=np.asarray(mu, float),
                 slip=10.0 ** np.asarray(mu, float), n_slipped=np.ones(n, np.int64))
-    part["kind"][:] = catalog.KIND_EVENT
+    part["kind"][:] = KIND_EVENT
     return [{name: col[a:a + chunk] for name, col in part.items()} for a in range(0, n, chunk)]
 
 

@@ -22,7 +22,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from ensemble import catalog
+from ensemble.store import reader
 
 from .conftest import run_cli, write_config
 from .reference import displacements_for, reference_sequence
@@ -91,7 +91,7 @@ def catalogs(tmp_path_factory):
                            run={"seeds": SEEDS, "events": EVENTS, "transient": 0}, integrator=integrator)
         res = run_cli("run", cfg, "-o", d / f"{method}.h5", timeout=300)
         assert res.returncode == 0, res.stderr
-        out[method] = catalog.read(d / f"{method}.h5")
+        out[method] = reader.read(d / f"{method}.h5")
     return out
 
 

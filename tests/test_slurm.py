@@ -18,7 +18,7 @@ import time
 import pytest
 
 from analysis import summary
-from ensemble import catalog
+from ensemble.store import reader
 from ensemble.config import load, loads
 from ensemble import environment
 from ensemble.slurm import (KINDS, PLACEHOLDER, PLACEHOLDERS, TEMPLATES, JobOptions, SlurmError,
@@ -439,7 +439,7 @@ def test_single_run_job_equals_serial_run(cluster, tmp_path, launcher):
     # rank compiles the kernels first, and one that is done seconds earlier on a loaded machine
     # may take all four ~2 s tasks.
     assert "with 2 rank(s)" in logs(job), logs(job)
-    _, tasks, _ = catalog.read(job / "tiny.h5")
+    _, tasks, _ = reader.read(job / "tiny.h5")
     assert set(tasks["rank"]) <= {0, 1}
     assert reduce["JobState"] == "COMPLETED", logs(job)
     for name in ("tiny.summary.h5", "tiny-magnitude.png", "tiny-recurrence.png", "tiny.report.txt"):
@@ -507,7 +507,7 @@ def test_array_sweep_then_reduction_only_after_every_element_succeeded(cluster, 
     assert reduce["JobState"] == "COMPLETED", logs(good)
     assert slurm_time(reduce["StartTime"]) >= max(slurm_time(e["EndTime"]) for e in elements)
     for i, b in enumerate([20.0, 30.0]):
-        events, tasks, attrs = catalog.read(good / "points" / f"point-{i:04d}.h5")
+        events, tasks, attrs = reader.read(good / "points" / f"point-{i:04d}.h5")
         assert list(tasks["b"]) == [b, b] and len(events["t"]) == 400
         assert loads(attrs["config"]).run.seed == element_seed(0, i)
     # one summary of the sweep from the elements' catalogs, its figures and report

@@ -12,7 +12,7 @@ import sys
 import numpy as np
 import pytest
 
-from ensemble import catalog
+from ensemble.store import reader
 
 from .processes import child_env, run_bounded
 
@@ -105,7 +105,7 @@ def test_a_law_in_one_new_module_validates_runs_and_is_recorded(copy_with_a_thir
     assert res.returncode == 2 and "model.alpha does not belong to model.law = 'coulomb'" in res.stderr
     res = ensemble(root, env, "run", "cfg.toml", "-o", "c.h5")
     assert res.returncode == 0, res.stderr
-    events, tasks, _ = catalog.read(root / "c.h5")
+    events, tasks, _ = reader.read(root / "c.h5")
     assert list(tasks["law"]) == ["coulomb", "coulomb"]
     assert np.all(np.isnan(tasks["b"])) and list(tasks["drop"]) == [0.05, 0.05]   # the new law's column
     assert len(events["t"]) == 800

@@ -2,7 +2,7 @@
 densities, their share of the rows, the share taken over by an inertial event, and the aseismic slip fraction."""
 import numpy as np
 
-from ensemble import catalog
+from ensemble.store import schema
 
 from . import Curve, Number, Statistic, Table
 
@@ -18,7 +18,7 @@ def feed(acc, rows):
     acc.count("creep_mu", block, part["mu"][creep], rows.opt.creep_mu_edges)
     acc.count("creep_duration", block, log_duration, rows.opt.creep_duration_edges)
     acc.add("creep", "n_creep", block, 1)
-    acc.add("creep", "n_creep_taken_over", block, part["ending"][creep] == catalog.ENDING_TAKEN_OVER)
+    acc.add("creep", "n_creep_taken_over", block, part["ending"][creep] == schema.ENDING_TAKEN_OVER)
     acc.add("creep", "sum_slip_creep", block, part["slip"][creep])
 
 

@@ -294,7 +294,7 @@ class Workspace:
     @staticmethod
     def creep_size(n, episode_columns=NEPISODE):
         """Length of `creep_state` for n blocks (of an episode table of `episode_columns`: an older
-        catalog's checkpoints kept fewer, catalog.py)."""
+        catalog's checkpoints kept fewer, store/schema.py: EPISODE_COLUMNS)."""
         return n * CR_KEEP + 2 * n * episode_columns + NCSTATE
 
     def creep_state(self):

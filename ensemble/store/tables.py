@@ -11,7 +11,7 @@ protects the rest, so that no damaged table can make a reader or a resume silent
   the stored config, where this version can read it, and compared (`config_problems`), so a config and
   its tables can never disagree. Catalogs of format bk-catalog-3, written before these checksums, are
   read with the comparison and the consistency rules only. (Whether /checkpoint/creep is what this
-  version's kernel needs is asked only by a resume: catalog.py.)
+  version's kernel needs is asked only by a resume: layout.py.)
 - **A task's record** (`RECORD`): /tasks/status, error, integrator and the provenance columns, written
   when a task finishes, fails or is taken up again. Each write of them ends with /tasks/record_crc[k],
   the CRC of the task's record bound to its index. A reader refuses a record that fails it; a resume
@@ -25,9 +25,7 @@ protects the rest, so that no damaged table can make a reader or a resume silent
 import numpy as np
 
 from .integrity import crc
-
-OPEN, FINISHED, FAILED = 0, 1, 2      # /tasks/status
-STATUS_NAMES = {OPEN: "open", FINISHED: "finished", FAILED: "failed"}
+from .schema import FAILED, FINISHED, STATUS_NAMES
 
 # root attributes written once at creation (tables_crc itself excluded)
 FIXED_ATTRS = ("config", "version", "format", "events_per_task", "transient", "spinup", "software")
@@ -58,7 +56,7 @@ def record_crc(task, values):
 
 
 def expected_parameters(tasks, spinups, law_keys):
-    """The parameter tables a run's task list implies: {column: array} (as catalog.create writes them)."""
+    """The parameter tables a run's task list implies: {column: array} (as create.create_layout writes them)."""
     out = {"point": np.array([t.point for t in tasks], dtype=np.int64),
            "seed_index": np.array([t.seed_index for t in tasks], dtype=np.int64),
            "N": np.array([t.model.N for t in tasks], dtype=np.int64),

@@ -1,0 +1,103 @@
+"""The project's import graph: no circle among its modules, and the catalog's modules small.
+
+Every import counts, a function's own included (one placed there to dodge a circle is still one).
+The graph is read from the sources (ast), nothing is imported, so the test takes well under a second.
+"""
+import ast
+import functools
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGES = ("ensemble", "analysis")
+STORE_LINES = 400       # lines at most of a module of ensemble/store/ (one job each)
+
+
+def modules(root=ROOT):
+    """{dotted name: path} of every module of the packages (a package is its __init__.py)."""
+    out = {}
+    for package in PACKAGES:
+        for path in sorted((root / package).rglob("*.py")):
+            parts = path.relative_to(root).with_suffix("").parts
+            out[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
+    return out
+
+
+def imports(name, path, known):
+    """The project's modules that module `name` (at `path`) imports, anywhere in it."""
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text(), str(path))):
+        if isinstance(node, ast.Import):
+            targets = [alias.name for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")[:len(package.split(".")) - (node.level - 1)]
+                base = ".".join(base + ([node.module] if node.module else []))
+            else:
+                base = node.module
+            # `from pkg import sub` imports the module pkg.sub; `from mod import name` the module mod
+            targets = [f"{base}.{alias.name}" if f"{base}.{alias.name}" in known else base for alias in node.names]
+        else:
+            continue
+        for target in targets:
+            while target and target not in known:     # `import a.b.c` where only a.b is ours, or a name
+                target = target.rpartition(".")[0]
+            if target and target != name:
+                found.add(target)
+    return found
+
+
+@functools.cache
+def graph(root=ROOT):
+    """{module: the project's modules it imports} (read once per session)."""
+    known = modules(root)
+    return {name: imports(name, path, known) for name, path in known.items()}
+
+
+def cycles(edges):
+    """The strongly connected components of more than one module (Tarjan), each sorted."""
+    index, low, stack, on, out = {}, {}, [], set(), []
+
+    def visit(v):
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in sorted(edges.get(v, ())):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            component = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                component.append(w)
+                if w == v:
+                    break
+            if len(component) > 1:
+                out.append(sorted(component))
+
+    for v in sorted(edges):
+        if v not in index:
+            visit(v)
+    return out
+
+
+def test_no_module_imports_itself_round_a_circle():
+    found = cycles(graph())
+    assert found == [], "import circles: " + "; ".join(" <-> ".join(c) for c in found)
+
+
+def test_the_graph_sees_imports_inside_functions_and_relative_ones():
+    edges = graph()
+    assert "ensemble.model.creep" in edges["ensemble.store.checkpoint"]     # (inside carries_creep)
+    assert "ensemble.store.schema" in edges["ensemble.store.layout"]         # from .schema import ...
+    assert cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
+
+
+def test_the_store_modules_are_small():
+    sizes = {path.name: len(path.read_text().splitlines()) for path in (ROOT / "ensemble" / "store").glob("*.py")}
+    assert {"schema.py", "layout.py", "reader.py", "writers.py"} <= set(sizes)
+    assert {name: n for name, n in sizes.items() if n > STORE_LINES} == {}
