@@ -6,6 +6,7 @@ import sys
 
 import h5py
 import numpy as np
+import pytest
 
 from analysis import reduce
 from analysis.statistics import seismicity
@@ -123,6 +124,27 @@ def test_a_hand_built_chain_gives_its_known_counts_and_exposures():
     assert doughnut == np.inf           # no event in the ring [2, 5) just before: a doughnut's opposite
 
 
+def sites(epicenter, n_blocks, distance_edges):
+    """(mainshocks, distance bins): the blocks of the chain in each distance bin [lo, hi) of each epicenter,
+    counted one by one."""
+    d = np.abs(np.arange(n_blocks)[None, :] - np.asarray(epicenter)[:, None])
+    k = np.searchsorted(distance_edges, d, side="right") - 1
+    return np.array([[np.count_nonzero(row == j) for j in range(len(distance_edges) - 1)] for row in k], float)
+
+
+@pytest.mark.parametrize("edges", ["0:40:20", "0:7:3", "-2:9.5:5", "1.5:3.5:4"])
+def test_the_exposure_counts_the_blocks_in_each_distance_bin(edges):
+    """The exposure kernel's blocks per distance bin (counted from the bin's edges) are the blocks of the chain
+    counted one by one, near both ends and in its middle, for integer and fractional edges."""
+    distance_edges, n_blocks = reduce.parse_bins(edges), 23
+    time_edges = np.array([0.0, 1.0])
+    epicenter = np.arange(n_blocks)
+    out = np.zeros((n_blocks, len(distance_edges) - 1))
+    seismicity.expose(np.zeros(n_blocks), epicenter, epicenter, 0.0, np.inf, n_blocks, time_edges, distance_edges,
+                      out)
+    np.testing.assert_array_equal(out, sites(epicenter, n_blocks, distance_edges))
+
+
 def test_cut_windows_leave_the_rates_unbiased():
     """Uniform random events (a Poisson process in time, every block alike) in a task only as long as a
     window: the rate of every cell is the background's, within its noise, although most windows are cut."""
@@ -139,7 +161,7 @@ def test_cut_windows_leave_the_rates_unbiased():
     assert np.all(np.abs(rate / background - 1) < 0.03), rate / background
     # counted as if every window were whole, the rates would be 3/4 of the background's (a window covers
     # 1500 of its 2000 T nu on average)
-    whole = 2000 * seismicity.sites(epicenter[mu >= opt.mu_c], n_blocks, opt.seis_distance_edges).sum(axis=0)
+    whole = 2000 * sites(epicenter[mu >= opt.mu_c], n_blocks, opt.seis_distance_edges).sum(axis=0)
     assert np.all(pairs[0].sum(axis=0) / whole < 0.8 * background)
 
 

@@ -22,6 +22,8 @@ seis_short, seis_long: put them on the bins' edges): near = distance < seis_near
 distance < seis_ring; just before = [-seis_short, 0), just after = [0, seis_short), some time before =
 [-seis_long, -seis_short). A rate of a region is its counts over its exposures, summed over its cells.
 """
+import functools
+
 import numba as nb
 import numpy as np
 
@@ -69,37 +71,39 @@ def _add(dt, d, s, time_edges, distance_edges, hi, n_distance, out):
         out[s, j * n_distance + k] += 1
 
 
-def sites(epicenter, n_blocks, distance_edges):
-    """(mainshocks, distance bins): the blocks 0 .. n_blocks - 1 at a distance in each bin of each epicenter."""
-    d = np.abs(np.arange(n_blocks)[None, :] - np.asarray(epicenter)[:, None])
-    k = np.searchsorted(distance_edges, d, side="right") - 1
-    inside = (k >= 0) & (k < len(distance_edges) - 1)
-    out = np.zeros((len(d), len(distance_edges) - 1))
-    rows = np.broadcast_to(np.arange(len(d))[:, None], d.shape)
-    np.add.at(out, (rows[inside], k[inside]), 1)
-    return out
-
-
-def coverage(T, start, end, time_edges):
-    """(mainshocks, time bins): the T nu of each bin of each mainshock's window (onset T) within [start, end]."""
-    a = T[:, None] + time_edges[None, :-1]
-    b = T[:, None] + time_edges[None, 1:]
-    return np.maximum(np.minimum(b, end) - np.maximum(a, start), 0.0)
-
-
-BATCH = 1024   # mainshocks whose exposures are added at once (their (mainshocks, N) and (mainshocks, cells) arrays)
+@nb.njit(cache=True)
+def expose(T, x, s, start, end, n_blocks, time_edges, distance_edges, out):
+    """Add to out (stretches, time bins * distance bins) the exposure of each mainshock (onset T, epicenter x,
+    stretch s), one after the other: the T nu of each time bin of its window within [start, end] times the
+    blocks 0 .. n_blocks - 1 at a distance in each distance bin of x (|j - x| < D counts the integers j in
+    (x - D, x + D), clipped to the chain)."""
+    n_time, n_distance = time_edges.shape[0] - 1, distance_edges.shape[0] - 1
+    space = np.empty(n_distance)
+    for m in range(T.shape[0]):
+        below = 0.0
+        for k in range(n_distance + 1):
+            D = distance_edges[k]
+            within = 0.0
+            if D > 0:
+                lo = max(np.floor(x[m] - D) + 1, 0.0)
+                hi = min(np.ceil(x[m] + D) - 1, n_blocks - 1.0)
+                within = max(hi - lo + 1, 0.0)
+            if k > 0:
+                space[k - 1] = within - below
+            below = within
+        for j in range(n_time):
+            a, b = T[m] + time_edges[j], T[m] + time_edges[j + 1]
+            cover = max(min(b, end) - max(a, start), 0.0)
+            for k in range(n_distance):
+                out[s[m], j * n_distance + k] += cover * space[k]
 
 
 def _expose(acc, carry, take, end, opt):
     """Add the exposures of the pending mainshocks `take` (a mask, in time order) with the span ending at `end`,
-    one after the other (np.add.at adds in order: the sums are the same whatever the chunks and batches)."""
-    which = np.flatnonzero(take)
-    for a in range(0, len(which), BATCH):
-        pick = which[a:a + BATCH]
-        cov = coverage(carry["pending_T"][pick], carry["start"], end, opt.seis_time_edges)
-        space = sites(carry["pending_x"][pick], carry["n_blocks"], opt.seis_distance_edges)
-        exposure = (cov[:, :, None] * space[:, None, :]).reshape(len(cov), -1)
-        np.add.at(acc["seis_exposure"], carry["pending_s"][pick], exposure)
+    one after the other (the sums are the same whatever the chunks)."""
+    expose(carry["pending_T"][take], carry["pending_x"][take], carry["pending_s"][take].astype(np.int64),
+           carry["start"], end, carry["n_blocks"], opt.seis_time_edges, opt.seis_distance_edges,
+           acc["seis_exposure"])
 
 
 def feed(acc, rows):
@@ -152,23 +156,33 @@ def _cells(edges, lo, hi):
     return (edges[:-1] >= lo - tol) & (edges[1:] <= hi + tol)
 
 
-def rate(u, opt, time, distance):
-    """Events per mainshock per block per T nu in the cells of time [lo, hi) x distance [lo, hi)."""
-    nt, nd = len(opt.seis_time_edges) - 1, len(opt.seis_distance_edges) - 1
-    pick = np.ix_(_cells(opt.seis_time_edges, *time), _cells(opt.seis_distance_edges, *distance))
-    counts = u["seis_pairs"].reshape(nt, nd)[pick].sum()
-    exposure = u["seis_exposure"].reshape(nt, nd)[pick].sum()
+@functools.lru_cache(maxsize=8)
+def _regions(time_edges, distance_edges, near, ring, short, long):
+    """{(time region, distance region): the flat indices of its cells} (edges as tuples: a cache key)."""
+    time_edges, distance_edges = np.array(time_edges), np.array(distance_edges)
+    times = {"before": (-short, 0.0), "after": (0.0, short), "earlier": (-long, -short)}
+    distances = {"near": (0.0, near), "ring": (near, ring)}
+    nd = len(distance_edges) - 1
+    return {(t, d): (np.flatnonzero(_cells(time_edges, *times[t]))[:, None] * nd
+                     + np.flatnonzero(_cells(distance_edges, *distances[d]))[None, :]).ravel()
+            for t in times for d in distances}
+
+
+def rate(u, cells):
+    """Events per mainshock per block per T nu in the cells (flat indices) of a region."""
+    counts = u["seis_pairs"][cells].sum()
+    exposure = u["seis_exposure"][cells].sum()
     return counts / exposure if exposure > 0 else np.nan
 
 
 def estimate(u, opt):
-    near, ring = (0.0, opt.seis_near), (opt.seis_near, opt.seis_ring)
-    before, after, earlier = (-opt.seis_short, 0.0), (0.0, opt.seis_short), (-opt.seis_long, -opt.seis_short)
+    cells = _regions(tuple(opt.seis_time_edges), tuple(opt.seis_distance_edges), opt.seis_near, opt.seis_ring,
+                     opt.seis_short, opt.seis_long)
     with np.errstate(invalid="ignore", divide="ignore"):
         return [u.column(NAME, "n_gaps") / u.column(NAME, "block_span"),
-                rate(u, opt, before, near), rate(u, opt, after, near),
-                rate(u, opt, earlier, near) / rate(u, opt, earlier, ring),
-                rate(u, opt, before, near) / rate(u, opt, before, ring)]
+                rate(u, cells["before", "near"]), rate(u, cells["after", "near"]),
+                rate(u, cells["earlier", "near"]) / rate(u, cells["earlier", "ring"]),
+                rate(u, cells["before", "near"]) / rate(u, cells["before", "ring"])]
 
 
 def rate_map(units, opt, rng):
