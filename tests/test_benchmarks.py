@@ -1,10 +1,12 @@
 """The benchmark scripts at tiny sizes: their helpers against known answers, their outputs sane."""
 import json
+import subprocess
 
 import numpy as np
 import pytest
 
-from benchmarks import cost_scaling, hard_cases, paired, statistics, step_budget, step_trace, work_precision
+from benchmarks import (cost_scaling, hard_cases, paired, reduce_speed, statistics, step_budget, step_trace,
+                        work_precision)
 from benchmarks.baselines import BASELINES
 from benchmarks.common import cost_at_error, ks_distance, parse_setting, wasserstein1
 from ensemble.config import Model
@@ -263,6 +265,19 @@ def test_paired_tiny(tmp_path):
     assert (tmp_path / "paired_N40_b20.txt").read_text().count("\n") >= 3
     with pytest.raises(SystemExit, match="atol"):
         paired.main(["--runs", "ark4:rtol=1e-4,atol=1e-9", "--out", str(tmp_path)])
+
+
+def test_reduce_speed_tiny(tmp_path):
+    from .test_summary_identity import CATALOG, gunzip
+    cat = gunzip(CATALOG, tmp_path / "catalog.h5")
+    data = reduce_speed.main([str(cat), "--before", "HEAD", "--rounds", "1", "--cpu", "-1", "--out", str(tmp_path)])
+    (now, _), (before, _) = data["cost"]["now"][0], data["cost"]["before"][0]
+    assert now > 0 and before > 0 and data["cpu_ratios"] == [now / before]
+    assert "cpu ratio now / before" in (tmp_path / "reduce_speed.txt").read_text()
+    assert str(tmp_path) not in subprocess.run(["git", "worktree", "list"], capture_output=True, text=True,
+                                               cwd=reduce_speed.ROOT).stdout   # its checkout of HEAD removed
+    with pytest.raises(SystemExit, match="not a revision"):
+        reduce_speed.main([str(cat), "--before", "no-such-revision", "--out", str(tmp_path)])
 
 
 def test_phase_of_a_block():
