@@ -198,12 +198,14 @@ def point_statistics(per_task, task_ids, opt, rng, layout=LAYOUT):
     names = list(layout.tables)
     units = {name: pack(name) for name in names}
     # every unit's tables side by side in one row: one resample draws them all alike
-    ends = np.cumsum([units[name].shape[1] for name in names])
+    ends = np.cumsum([0] + [units[name].shape[1] for name in names])
     flat = np.concatenate([units[name] for name in names], axis=1)
     edges = bin_edges(opt)
+    where = [(name, slice(a, b)) for name, a, b in zip(names, ends[:-1], ends[1:])]
+    widths = {c.table: np.diff(edges[layout.tables[c.table].bins]) for c in layout.curves}
 
     def split(row):
-        return layout.sum_of(dict(zip(names, np.split(row, ends[:-1]))))
+        return layout.sum_of({name: row[cut] for name, cut in where})
 
     def numbers(row):
         u = split(row)
@@ -211,7 +213,7 @@ def point_statistics(per_task, task_ids, opt, rng, layout=LAYOUT):
 
     def curves(row):
         u = split(row)
-        return np.concatenate([stats.density(u[c.table], edges[layout.tables[c.table].bins], u.column(*c.total))
+        return np.concatenate([stats.density(u[c.table], None, u.column(*c.total), widths[c.table])
                                for c in layout.curves])
 
     total = flat.sum(axis=0)

@@ -11,9 +11,10 @@ import numpy as np
 LOG10_E = math.log10(math.e)
 
 
-def density(counts, edges, total):
-    """Probability density from bin counts; `total` counts the events in and out of range."""
-    widths = np.diff(edges)
+def density(counts, edges, total, widths=None):
+    """Probability density from bin counts; `total` counts the events in and out of range (widths: the
+    bins' widths, np.diff(edges), when the caller has them)."""
+    widths = np.diff(edges) if widths is None else widths
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(total > 0, counts / (np.maximum(total, 1) * widths), np.nan)
 

@@ -117,6 +117,7 @@ class Layout:
         self.numbers = [n for s in statistics for n in s.numbers]
         self.curves = [c for s in statistics for c in s.curves]
         self.bins = list(dict.fromkeys(name for t in self.tables.values() if t.bins for name in bin_names(t)))
+        self._column = {(table, name): i for table, names in self.columns.items() for i, name in enumerate(names)}
 
     def width(self, table, edges):
         """Entries per unit of `table`: its bins (of a 2-d histogram, their product), or its columns."""
@@ -124,7 +125,7 @@ class Layout:
         return int(np.prod([len(edges[name]) - 1 for name in bin_names(t)])) if t.bins else len(self.columns[table])
 
     def column(self, table, name):
-        return self.columns[table].index(name)
+        return self._column[table, name]
 
     def sum_of(self, arrays):
         """Tables of summed units (1-d arrays) with columns by name."""
@@ -161,7 +162,11 @@ class Tables(dict):
         """Histogram `values` into `table` (bins `edges`) at stretches `block`; out of range: not counted."""
         idx = np.searchsorted(edges, values, side="right") - 1
         ok = (idx >= 0) & (idx < len(edges) - 1)
-        np.add.at(self[table], (block[ok], idx[ok]), 1)
+        out = self[table]
+        if out.dtype.kind == "i":   # counts: a sum in any order is exact
+            out += np.bincount(block[ok] * out.shape[1] + idx[ok], minlength=out.size).reshape(out.shape)
+        else:
+            np.add.at(out, (block[ok], idx[ok]), 1)
 
 
 @dataclass

@@ -36,14 +36,13 @@ _EDGE = 1e-9    # a region's bound matches a bin edge within this share of the b
 
 
 @nb.njit(cache=True)
-def count_pairs(T, epicenter, main, stretch, n_old, time_edges, distance_edges, out):
+def count_pairs(T, epicenter, main, stretch, n_old, time_edges, distance_bin, out):
     """Count into out (stretches, time bins * distance bins) every pair (mainshock m, event i != m) of
     the events T (T nu, in time order), epicenter, main (mu >= mu_c), stretch (of each event) with
-    dt = T[i] - T[m] in [time_edges[0], time_edges[-1]) and |epicenter[i] - epicenter[m]| in the
-    distance bins, of which at least one of m, i is new (index >= n_old: the events before are the
-    carried ones, whose pairs among themselves were counted before)."""
+    dt = T[i] - T[m] in [time_edges[0], time_edges[-1]) and its distance d = |epicenter[i] - epicenter[m]|
+    in a distance bin (distance_bin[d], -1: none), of which at least one of m, i is new (index >= n_old: the
+    events before are the carried ones, whose pairs among themselves were counted before)."""
     lo, hi = time_edges[0], time_edges[-1]
-    n_distance = distance_edges.shape[0] - 1
     n = T.shape[0]
     for m in range(n):
         if not main[m]:
@@ -51,24 +50,33 @@ def count_pairs(T, epicenter, main, stretch, n_old, time_edges, distance_edges, 
         if m >= n_old:   # the events before m: old or new, one of the pair is new
             i = m - 1
             while i >= 0 and T[i] - T[m] >= lo:
-                _add(T[i] - T[m], abs(epicenter[i] - epicenter[m]), stretch[m], time_edges, distance_edges,
-                     hi, n_distance, out)
+                _add(T[i] - T[m], distance_bin[abs(epicenter[i] - epicenter[m])], stretch[m], time_edges, out)
                 i -= 1
         i = max(m + 1, n_old)
         while i < n and T[i] - T[m] < hi:
-            _add(T[i] - T[m], abs(epicenter[i] - epicenter[m]), stretch[m], time_edges, distance_edges,
-                 hi, n_distance, out)
+            _add(T[i] - T[m], distance_bin[abs(epicenter[i] - epicenter[m])], stretch[m], time_edges, out)
             i += 1
 
 
 @nb.njit(cache=True)
-def _add(dt, d, s, time_edges, distance_edges, hi, n_distance, out):
-    if dt < time_edges[0] or dt >= hi:
+def _add(dt, k, s, time_edges, out):
+    n_time = time_edges.shape[0] - 1
+    if k < 0 or dt < time_edges[0] or dt >= time_edges[n_time]:
         return
-    j = np.searchsorted(time_edges, dt, side="right") - 1
-    k = np.searchsorted(distance_edges, d, side="right") - 1
-    if 0 <= k < n_distance:
-        out[s, j * n_distance + k] += 1
+    # the time bin j with time_edges[j] <= dt < time_edges[j + 1]: guessed as if the bins were even, then
+    # moved to the edges themselves (the same bin as a search of the edges, for any edges)
+    j = min(max(int((dt - time_edges[0]) / (time_edges[n_time] - time_edges[0]) * n_time), 0), n_time - 1)
+    while time_edges[j] > dt:
+        j -= 1
+    while time_edges[j + 1] <= dt:
+        j += 1
+    out[s, j * (out.shape[1] // n_time) + k] += 1
+
+
+def distance_bins(n_blocks, distance_edges):
+    """The distance bin of each distance 0 .. n_blocks - 1 (blocks; -1: in none)."""
+    k = np.searchsorted(distance_edges, np.arange(n_blocks), side="right") - 1
+    return np.where(k < len(distance_edges) - 1, k, -1).astype(np.int64)
 
 
 @nb.njit(cache=True)
@@ -132,8 +140,8 @@ def feed(acc, rows):
     allx = np.concatenate([carry["x"], x])
     allm = np.concatenate([carry["main"], main])
     alls = np.concatenate([carry["s"], rows.block])
-    count_pairs(allT, allx, allm, alls.astype(np.int64), n_old, edges, opt.seis_distance_edges,
-                acc["seis_pairs"])
+    count_pairs(allT, allx, allm, alls.astype(np.int64), n_old, edges,
+                distance_bins(max(rows.n_blocks, int(allx.max()) + 1), opt.seis_distance_edges), acc["seis_pairs"])
     keep = allT >= allT[-1] - max(abs(edges[0]), abs(edges[-1]))
     carry.update(T=allT[keep], x=allx[keep], main=allm[keep], s=alls[keep])
     # the exposures: of every mainshock whose window has been seen to its end, in time order
