@@ -6,7 +6,10 @@ makes merging across tasks and ranks exact and resampling cheap.
 """
 import math
 
+import numba as nb
 import numpy as np
+
+import ensemble.model  # noqa: F401  (first: numba caches the kernels in the package's cache, ensemble/kernel_cache.py)
 
 LOG10_E = math.log10(math.e)
 
@@ -27,17 +30,23 @@ SMOOTHING = np.array([1, 4, 6, 4, 1]) / 16   # the histogram is smoothed with th
 PEAK_Z = 3.0    # a peak's prominence must exceed this many noise standard deviations
 
 
+def _edge_padded(counts):
+    """The counts as floats with the edge bins repeated twice beyond each edge."""
+    c = np.asarray(counts, dtype=float)
+    return np.concatenate([c[:1], c[:1], c, c[-1:], c[-1:]])
+
+
 def smooth(counts):
     """The [1, 4, 6, 4, 1] / 16 smoothed histogram (the edge bins repeated beyond the edges)."""
-    return np.convolve(np.pad(np.asarray(counts, dtype=float), 2, mode="edge"), SMOOTHING, mode="valid")
+    return np.convolve(_edge_padded(counts), SMOOTHING, mode="valid")
 
 
 def poisson_noise(counts):
     """Standard deviation of each smoothed bin if the counts were independent Poisson variables."""
-    padded = np.pad(np.asarray(counts, dtype=float), 2, mode="edge")
-    return np.sqrt(np.convolve(padded, SMOOTHING ** 2, mode="valid"))
+    return np.sqrt(np.convolve(_edge_padded(counts), SMOOTHING ** 2, mode="valid"))
 
 
+@nb.njit(cache=True)
 def prominence(s, i):
     """(prominence, base bin) of the local maximum i of s, as scipy.signal.peak_prominences defines it:
     on each side the lowest value before a higher one (or the end); the higher of the two is the base."""
@@ -53,6 +62,19 @@ def prominence(s, i):
     return (s[i] - level, base) if base >= 0 else (s[i], i)
 
 
+@nb.njit(cache=True)
+def local_maxima(s):
+    """(bins, prominences, base bins) of the local maxima of s (the right end of a plateau) inside its ends."""
+    bins, heights, bases = [], [], []
+    for i in range(1, len(s) - 1):
+        if s[i] >= s[i - 1] and s[i] > s[i + 1]:
+            height, base = prominence(s, i)
+            bins.append(i)
+            heights.append(height)
+            bases.append(base)
+    return np.array(bins, dtype=np.int64), np.array(heights, dtype=np.float64), np.array(bases, dtype=np.int64)
+
+
 def find_peaks(counts, edges, noise, z=PEAK_Z):
     """Positions (bin centres) of the significant peaks of a histogram, highest first.
 
@@ -65,12 +87,7 @@ def find_peaks(counts, edges, noise, z=PEAK_Z):
     """
     s = np.concatenate([[0.0], smooth(counts), [0.0]])
     sd = np.concatenate([[0.0], np.asarray(noise, dtype=float), [0.0]])
-    found = []
-    for i in range(1, len(s) - 1):
-        if s[i] >= s[i - 1] and s[i] > s[i + 1]:
-            height, base = prominence(s, i)
-            if height > z * math.hypot(sd[i], sd[base]):
-                found.append(i)
+    found = [int(i) for i, height, base in zip(*local_maxima(s)) if height > z * math.hypot(sd[i], sd[base])]
     found.sort(key=lambda i: (-s[i], i))
     return centers(edges)[np.array(found, dtype=np.int64) - 1]
 
