@@ -29,7 +29,10 @@ import pkgutil
 from dataclasses import dataclass, field
 from typing import Callable, Optional
 
+import numba as nb
 import numpy as np
+
+import ensemble.model  # noqa: F401  (first: numba caches the kernels in the package's cache, ensemble/kernel_cache.py)
 
 
 @dataclass(frozen=True)
@@ -155,8 +158,14 @@ class Tables(dict):
         return self[table][..., self.layout.column(table, name)]
 
     def add(self, table, name, block, values):
-        """Add `values` to column `name` of `table` at stretches `block` (unbuffered, repeated indices add)."""
-        np.add.at(self[table][:, self.layout.column(table, name)], block, values)
+        """Add `values` to column `name` of `table` at stretches `block` (unbuffered, repeated indices add, one
+        after the other in their order: the sums do not depend on how a task is cut into chunks)."""
+        out = self[table]
+        block = np.asarray(block, dtype=np.int64)
+        if len(block) and (block.min() < 0 or block.max() >= len(out)):
+            raise IndexError(f"table {table}: stretch out of range 0..{len(out) - 1}")
+        values = np.ascontiguousarray(np.broadcast_to(np.asarray(values, dtype=out.dtype), block.shape))
+        _add_at(out, self.layout.column(table, name), block, values)
 
     def count(self, table, block, values, edges):
         """Histogram `values` into `table` (bins `edges`) at stretches `block`; out of range: not counted."""
@@ -167,6 +176,12 @@ class Tables(dict):
             out += np.bincount(block[ok] * out.shape[1] + idx[ok], minlength=out.size).reshape(out.shape)
         else:
             np.add.at(out, (block[ok], idx[ok]), 1)
+
+
+@nb.njit(cache=True)
+def _add_at(out, column, block, values):
+    for i in range(block.shape[0]):
+        out[block[i], column] += values[i]
 
 
 @dataclass
