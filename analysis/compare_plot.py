@@ -8,7 +8,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .plot import _band  # noqa: E402
+from .drawing import band  # noqa: E402
 from .stats import centers  # noqa: E402
 
 TNU_BINS = np.linspace(0.0, 5.0, 101)      # T / median(T)
@@ -37,7 +37,7 @@ def figures(points, opt, out_dir, mu_edges):
     for p, color in zip(points, colors):
         e = p["size_edges"]
         x = np.sqrt(e[:-1] * (e[1:] - 1.0))          # geometric middle of the integers of the bin
-        _band(ax, x, p["size_density"], p["size_lo"], p["size_hi"], _with_events(p), color, log=True, style=".-")
+        band(ax, x, p["size_density"], p["size_lo"], p["size_hi"], _with_events(p), color, log=True, style=".-")
         tau = p["numbers"][3]
         if np.isfinite(tau):
             n = np.arange(opt.n_min, opt.n_large, dtype=float)
@@ -54,7 +54,7 @@ def figures(points, opt, out_dir, mu_edges):
 
     fig, ax = plt.subplots(figsize=(9.6, 4.4))
     for p, color in zip(points, colors):
-        _band(ax, centers(mu_edges), p["mu_density"], p["mu_lo"], p["mu_hi"], _with_events(p), color, log=True)
+        band(ax, centers(mu_edges), p["mu_density"], p["mu_lo"], p["mu_hi"], _with_events(p), color, log=True)
     lowest = min(p["mu_density"][p["mu_density"] > 0].min() for p in points)
     ax.set_ylim(bottom=lowest / 3)      # a lower bound of 0 would stretch the axis to 1e-300
     ax.set(yscale="log", xlabel="mu = log10(total slip) (each law's own scale)", ylabel="R(mu)",

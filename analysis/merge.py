@@ -27,7 +27,7 @@ from ensemble.store import reader, schema
 from ensemble.store.errors import CatalogError
 from ensemble.config import loads
 
-from .reduce import PARAMS, reduce_tasks
+from .reduce import LAYOUT, PARAMS, reduce_tasks
 
 
 class MergeError(ValueError):
@@ -165,12 +165,13 @@ def _partial_statement(paths, tables, per_tasks, unfinished):
             + ", ".join(which))
 
 
-def reduce_share(inputs, rows, opt):
-    """The tables (reduce.reduce_task) of the given rows of inputs.tasks (one rank's share), keyed by row."""
+def reduce_share(inputs, rows, opt, layout=LAYOUT):
+    """The tables (reduce.reduce_task) of the given rows of inputs.tasks (one rank's share), keyed by row;
+    layout: the statistics reduced (the summary's, or a set's: statistics.of)."""
     out = {}
     for c, path in enumerate(inputs.paths):
         mine = [g for g in rows if inputs.tasks["catalog"][g] == c]
         if mine:
-            local = reduce_tasks(path, [int(inputs.tasks["catalog_task"][g]) for g in mine], opt)
+            local = reduce_tasks(path, [int(inputs.tasks["catalog_task"][g]) for g in mine], opt, layout)
             out.update({g: local[int(inputs.tasks["catalog_task"][g])] for g in mine})
     return out

@@ -64,6 +64,8 @@ class Options:
     seis_ring: float = SEIS_RING      # blocks: the ring around it is seis_near <= distance < seis_ring
     seis_short: float = SEIS_SHORT    # T nu: "just before" is [-seis_short, 0), "just after" [0, seis_short)
     seis_long: float = SEIS_LONG      # T nu: "some time before" is [-seis_long, -seis_short)
+    n_large: int = 50                 # blocks: a large event by its rupture length, n_slipped >= n_large (compare)
+    n_min: int = 1                    # blocks: the smallest n_slipped of the rupture lengths' power law (compare)
 
 
 # every statistic of analysis/statistics/, laid out: its tables, numbers and curves in the registry's order
@@ -72,9 +74,28 @@ LAYOUT = Layout()
 CURVES = {c.name: LAYOUT.tables[c.table].bins for c in LAYOUT.curves}
 
 
-def bin_edges(opt):
-    """{bins name: edges} of the options (the summary's /bins/<name>): option <name>_edges."""
-    return {name: getattr(opt, f"{name}_edges") for name in LAYOUT.bins}
+def bin_edges(opt, n_blocks=None, layout=LAYOUT):
+    """{bins name: edges} of the options (the summary's /bins/<name>): option <name>_edges; bins of the
+    chain's own (Table.chain_edges) from its N, `n_blocks`."""
+    return {name: layout.chain_bins[name](n_blocks) if name in layout.chain_bins else getattr(opt, f"{name}_edges")
+            for name in layout.bins}
+
+
+# the criteria of a large event whose recurrences a statistic may need ("recurrences:<criterion>";
+# "recurrences" alone: mu): (the events' column, its threshold from the options), large where column >= threshold
+LARGE = {
+    "mu": ("mu", lambda opt: opt.mu_c),
+    "n_slipped": ("n_slipped", lambda opt: opt.n_large),
+}
+
+
+def _criteria(layout):
+    """The criteria whose recurrences the layout's statistics need, in order."""
+    need = [n.partition(":")[2] or "mu" for s in layout.statistics for n in s.needs if n.startswith("recurrences")]
+    unknown = sorted(set(need) - set(LARGE))
+    if unknown:
+        raise ValueError(f"recurrences of an unknown criterion {unknown}: LARGE has {sorted(LARGE)}")
+    return list(dict.fromkeys(need))
 
 
 MAX_BINS = 10 ** 6   # bins of a histogram: beyond a million, (tasks, stretches, bins) counts outgrow memory
@@ -103,10 +124,10 @@ def reduce_task(chunks, written, nu, n_blocks_chain, opt, rows=None, layout=LAYO
     attribute `rows` the rows read). Every statistic is fed each chunk once. The chunks are consumed to
     their end (the catalog checks a task's checksum there)."""
     k = opt.blocks
-    out = layout.empty(k, bin_edges(opt))
+    out = layout.empty(k, bin_edges(opt, n_blocks_chain, layout))
     out.rows = 0
-    recurrences = any("recurrences" in s.needs for s in layout.statistics)
-    scanner = RecurrenceScanner(n_blocks_chain, opt.mu_c, opt.window) if written and recurrences else None
+    scanners = {c: RecurrenceScanner(n_blocks_chain, float(LARGE[c][1](opt)), opt.window)
+                for c in _criteria(layout)} if written else {}
     lo = row = 0
     t_before = np.nan
     for part in chunks:
@@ -114,22 +135,26 @@ def reduce_task(chunks, written, nu, n_blocks_chain, opt, rows=None, layout=LAYO
         creep = part["kind"] == schema.KIND_CREEP
         creep_block = _creep_stretches(inertial, creep, lo, row, written, rows, k) if creep.any() else None
         row += len(inertial)
-        ev = block = rec = None
+        ev = block = None
+        scans = {}
         if inertial.any():
             ev = part if inertial.all() else {name: column[inertial] for name, column in part.items()}
             hi = lo + len(ev["t"])
             block = (np.arange(lo, hi) * k) // written
-            if scanner is not None:
-                src, T, interior = scanner.feed(ev["t"], ev["epicenter"], ev["mu"], ev["boundary"])
-                rec = ((src * k) // written, T * nu, interior)
+            for criterion, scanner in scanners.items():
+                values = np.asarray(ev[LARGE[criterion][0]], dtype=float)
+                src, T, interior = scanner.feed(ev["t"], ev["epicenter"], values, ev["boundary"])
+                scans[criterion] = ((src * k) // written, T * nu, interior)
             lo = hi
-        seen = Rows(part, inertial, ev, block, creep, creep_block, rec, t_before, nu, opt, n_blocks_chain,
-                    ev is not None and lo == written)
+        seen = Rows(part, inertial, ev, block, creep, creep_block, scans.get("mu"), t_before, nu, opt, n_blocks_chain,
+                    ev is not None and lo == written, scans)
         for statistic in layout.statistics:
             statistic.feed(out, seen)
         if ev is not None:
             t_before = ev["t"][-1]
     out.carry.clear()    # the statistics' carry of this task ends with it
+    for name in layout.samples:   # a stretch's sample: one array of its values in the order fed
+        out[name] = [np.concatenate(parts) if parts else np.zeros(0) for parts in out[name]]
     return out
 
 
@@ -143,7 +168,7 @@ def _creep_stretches(inertial, creep, before, row, written, rows, k):
     return ((row + np.flatnonzero(creep)) * k) // max(rows or 0, row + len(creep))
 
 
-def reduce_tasks(path, task_indices, opt):
+def reduce_tasks(path, task_indices, opt, layout=LAYOUT):
     """TaskHistograms for the given tasks of a catalog (one rank's share)."""
     out = {}
     # the catalog checks the ranges of the rows as they stream (an epicenter outside the chain
@@ -154,7 +179,7 @@ def reduce_tasks(path, task_indices, opt):
             # every row read once: reduce_task keeps the creep episodes out of R(mu) and the recurrences
             rows = int(tasks["events_written"][k])
             out[k] = reduce_task(cat.task_events(k, opt.chunk), cat.count(k, schema.KIND_EVENT),
-                                 float(tasks["nu"][k]), int(tasks["N"][k]), opt, rows)
+                                 float(tasks["nu"][k]), int(tasks["N"][k]), opt, rows, layout)
             out[k].rows = rows
     return out
 
@@ -179,47 +204,69 @@ def unreliable(units, method):
 
 def _units(per_task, task_ids):
     """Resampling units of a point: its tasks if it has at least MIN_UNITS, else the stretches
-    of all its tasks (task by task, in task order)."""
+    of all its tasks (task by task, in task order). pack(name): the units of an additive table stacked
+    (units, width); of a sample, a list of one array per unit (a task's stretches one after the other)."""
     stack = [per_task[k] for k in task_ids]
     if len(stack) >= MIN_UNITS:
-        pack = lambda name: np.stack([h[name].sum(axis=0) for h in stack])  # noqa: E731
+        def pack(name):
+            if isinstance(stack[0][name], list):
+                return [np.concatenate(h[name]) for h in stack]
+            return np.stack([h[name].sum(axis=0) for h in stack])
         return pack, "seeds"
-    pack = lambda name: np.concatenate([h[name] for h in stack])  # noqa: E731
+
+    def pack(name):
+        if isinstance(stack[0][name], list):
+            return [stretch for h in stack for stretch in h[name]]
+        return np.concatenate([h[name] for h in stack])
     return pack, "blocks"
 
 
 UNIT_ARRAYS = tuple(LAYOUT.tables)
 
 
-def point_statistics(per_task, task_ids, opt, rng, layout=LAYOUT):
+def point_statistics(per_task, task_ids, opt, rng, layout=LAYOUT, n_blocks=None):
     """Merged densities and summary numbers of one parameter point, with bootstrap intervals, and each
-    statistic's extras (the recurrence peaks)."""
+    statistic's extras (the recurrence peaks). n_blocks: the chain's N (for bins of the chain's own).
+
+    A resample draws units with replacement, rng.integers(0, units, (bootstrap, units)); its additive tables
+    are the sums of the drawn units', its samples the drawn units' values concatenated in the order drawn.
+    Returns curves (est, lo, hi, the curves one after the other) and curve {name: (est, lo, hi)}, numbers
+    (numbers, 3), method, units, sums (the summed tables of all units, samples concatenated), and the extras."""
     pack, method = _units(per_task, task_ids)
-    names = list(layout.tables)
-    units = {name: pack(name) for name in names}
-    # every unit's tables side by side in one row: one resample draws them all alike
+    names = [name for name in layout.tables if name not in layout.samples]
+    units = {name: pack(name) for name in layout.tables}
+    m = len(units[names[0]]) if names else len(units[layout.samples[0]])
+    # every unit's additive tables side by side in one row: one resample draws them all alike
     ends = np.cumsum([0] + [units[name].shape[1] for name in names])
-    flat = np.concatenate([units[name] for name in names], axis=1)
-    edges = bin_edges(opt)
+    flat = np.concatenate([units[name] for name in names], axis=1) if names else np.zeros((m, 0))
+    edges = bin_edges(opt, n_blocks, layout)
     where = [(name, slice(a, b)) for name, a, b in zip(names, ends[:-1], ends[1:])]
-    widths = {c.table: np.diff(edges[layout.tables[c.table].bins]) for c in layout.curves}
+    widths = {c.table: np.diff(edges[layout.tables[c.table].bins]) for c in layout.curves if c.values is None}
 
-    def split(row):
-        return layout.sum_of({name: row[cut] for name, cut in where})
+    def split(row, picks):
+        u = {name: row[cut] for name, cut in where}
+        u.update({name: np.concatenate([units[name][i] for i in picks]) for name in layout.samples})
+        return layout.sum_of(u)
 
-    def numbers(row):
-        u = split(row)
+    def numbers(u):
         return np.array([x for s in layout.statistics if s.numbers for x in s.estimate(u, opt)], dtype=float)
 
-    def curves(row):
-        u = split(row)
-        return np.concatenate([stats.density(u[c.table], None, u.column(*c.total), widths[c.table])
-                               for c in layout.curves])
+    def curves(u):
+        return [c.values(u, opt, edges) if c.values is not None else
+                stats.density(u[c.table], None, u.column(*c.total), widths[c.table])
+                for c in layout.curves]
 
-    total = flat.sum(axis=0)
-    samples = stats.bootstrap(flat, lambda row: np.concatenate([curves(row), numbers(row)]),
-                              opt.bootstrap, rng) if len(flat) >= 2 else None
-    est = np.concatenate([curves(total), numbers(total)])
+    def estimate(row, picks):
+        u = split(row, picks)
+        return np.concatenate([*curves(u), numbers(u)])
+
+    samples = None
+    if m >= 2:   # as stats.bootstrap, with the picks for the samples
+        picks = rng.integers(0, m, size=(opt.bootstrap, m))
+        samples = np.array([estimate(flat[p].sum(axis=0), p) for p in picks])
+    sums = split(flat.sum(axis=0), range(m))
+    each = curves(sums)
+    est = np.concatenate([*each, numbers(sums)])
     if samples is None:
         lo = hi = np.full_like(est, np.nan)
     else:
@@ -227,7 +274,11 @@ def point_statistics(per_task, task_ids, opt, rng, layout=LAYOUT):
     n_curve = len(est) - len(layout.numbers)
     out = {"curves": (est[:n_curve], lo[:n_curve], hi[:n_curve]),
            "numbers": np.stack([est[n_curve:], lo[n_curve:], hi[n_curve:]], axis=1),
-           "method": method, "units": len(flat)}
+           "method": method, "units": m, "sums": sums, "curve": {}}
+    start = 0
+    for c, values in zip(layout.curves, each):
+        out["curve"][c.name] = tuple(x[start:start + len(values)] for x in out["curves"])
+        start += len(values)
     for statistic in layout.statistics:
         if statistic.extra is not None:
             out.update(statistic.extra(units, opt, rng))

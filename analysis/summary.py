@@ -80,6 +80,9 @@ _INTERVAL = "(points, 3): estimate, lo, hi (lo, hi: the bootstrap interval at `l
 _CURVE = "(points, {} bins)"   # the curve's variable
 SEIS_ATTRS = ("seis_near", "seis_ring", "seis_short", "seis_long")   # the regions of the seismicity's numbers
 LAYOUT = reduce.LAYOUT   # the statistics (analysis/statistics/): their tables, curves and numbers
+if LAYOUT.samples or LAYOUT.chain_bins:   # ragged per unit, or of a width per point: no /per_task dataset holds them
+    raise ImportError(f"analysis/statistics: the summary stores no sample table nor bins of the chain's own "
+                      f"({LAYOUT.samples + list(LAYOUT.chain_bins)}): give their statistic a set of its own (sets)")
 CURVES = {   # name -> (its bins, its variable, whose variable, the density's unit), in the curves' order
     c.name: (LAYOUT.tables[c.table].bins, c.variable, c.whose, c.unit) for c in LAYOUT.curves}
 NUMBER_MEANINGS = {n.name: (n.unit, n.meaning) for n in LAYOUT.numbers}   # in the order of reduce.NUMBERS

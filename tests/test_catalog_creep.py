@@ -121,16 +121,19 @@ def test_reduce_counts_the_inertial_events_alone(creeping):
 
 
 def test_compare_counts_the_inertial_events_alone(creeping):
-    """`analysis compare`'s units (sizes, magnitudes, recurrences) read the kind-0 rows alone."""
-    from analysis import compare
+    """`analysis compare`'s tables (sizes, magnitudes, recurrences: the engine's, reduced with its set of
+    statistics) read the kind-0 rows alone."""
+    from analysis import compare, reduce
     d, _ = creeping
     events, tasks, _ = reader.read(d / "full.h5")
-    opt = compare.Options(blocks=5, window=10, n_large=40, n_min=1)
-    for k in tasks_of(tasks, CREEPING):
-        sizes, mu_counts, _ = compare.task_units(str(d / "full.h5"), int(k), opt)
+    opt = compare.engine_options(compare.Options(blocks=5, window=10, n_large=40, n_min=1))
+    ids = [int(k) for k in tasks_of(tasks, CREEPING)]
+    per_task = reduce.reduce_tasks(str(d / "full.h5"), ids, opt, compare.LAYOUT)
+    for k in ids:
         inertial = (events["task"] == k) & (events["kind"] == schema.KIND_EVENT)
-        np.testing.assert_array_equal(sizes.sum(axis=0), np.bincount(events["n_slipped"][inertial], minlength=51))
-        assert mu_counts.sum() == np.count_nonzero(inertial)
+        np.testing.assert_array_equal(per_task[k]["n_slipped"].sum(axis=0),
+                                      np.bincount(events["n_slipped"][inertial], minlength=51))
+        assert per_task[k]["mu"].sum() == np.count_nonzero(inertial)
 
 
 @pytest.mark.parametrize("paused", [False, True], ids=["creeping", "creeping-and-paused"])

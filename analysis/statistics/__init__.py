@@ -9,6 +9,13 @@ A statistic (a module of this package that defines STATISTIC) declares
   Additive, so that merging tasks and ranks and resampling units are exact: every estimate is a
   function of a sum over units. `bins` may name two sets of bins, (rows, columns): a 2-d histogram
   stored flattened, row by row; `weights` makes a histogram table hold float sums instead of counts.
+  `chain_edges` makes the bins the chain's own, a function of its N (the blocks slipped, 0..N): each point
+  then has its bins and no option sets them.
+- its samples: a table with `sample` set holds the values themselves (float), a list per unit in the order
+  fed, for estimators that are no function of sums (a median, a mode of values scaled by it). A resample
+  concatenates the lists of the units it draws, in the order drawn, so that its estimate is that of the
+  resampled values exactly, as with the additive tables. Samples are not stored in the summary: a
+  statistic with one belongs to a set of its own (`sets`, below).
 - `feed(acc, rows)`: add one chunk of a task's rows to the tables (rows: `Rows`, below). What a statistic
   must carry from one chunk of a task to the next (events waiting for their partners) it keeps in
   `acc.carry[<its name>]`, a dict the engine gives each task and drops at its end; `rows.last` tells the
@@ -16,7 +23,12 @@ A statistic (a module of this package that defines STATISTIC) declares
 - its numbers (name, unit, meaning) and `estimate(u, opt)`: their values from summed tables `u`
   (u.table(name) the array, u.column(table, column) one column), in the order declared.
 - its curves: densities of a histogram table (`table`), normalised by a count column (`total`), over
-  the table's bins.
+  the table's bins; or, with `values`, any curve of the summed tables (`values(u, opt, edges)`).
+- its recurrences (`needs`): "recurrences" for those of the large events mu >= mu_c, "recurrences:<criterion>"
+  for another criterion of a large event (reduce.LARGE: "n_slipped", n_slipped >= n_large); `rows.scans`
+  holds them by criterion.
+- its sets (`sets`): the commands that reduce with it, "reduce" (the summary) and "compare" (the friction-law
+  comparison, analysis/compare.py); `Layout(of("compare"))` lays out a set.
 - optionally `extra(units, opt, rng)`: {name: array} per point beyond numbers and curves, computed after
   the bootstrap of the numbers and curves (the recurrence peaks).
 
@@ -44,6 +56,8 @@ class Table:
     bins: object = ""      # a bins name, or (rows, columns) of a 2-d histogram (flattened row by row)
     columns: tuple = ()
     weights: bool = False  # a histogram of float sums (weights), not of counts
+    sample: bool = False   # the values themselves, a list per unit (concatenated on resample)
+    chain_edges: Optional[Callable] = None   # the bins' edges from the chain's N (per point), not an option
 
 
 @dataclass(frozen=True)
@@ -64,6 +78,7 @@ class Curve:
     variable: str
     whose: str
     unit: str
+    values: Optional[Callable] = None   # (summed tables, opt, edges) -> the curve, instead of the density
 
 
 @dataclass(frozen=True)
@@ -78,6 +93,7 @@ class Statistic:
     estimate: Callable = None
     extra: Optional[Callable] = None
     extra_datasets: dict = field(default_factory=dict)   # /points/<name>: (unit, shape, meaning) of extra's
+    sets: tuple = ("reduce",)       # the commands that reduce with it ("reduce": the summary; "compare")
 
 
 def _discover():
@@ -96,15 +112,20 @@ def _discover():
 STATISTICS = _discover()
 
 
+def of(name):
+    """The statistics of set `name` ("reduce", "compare"), in order."""
+    return tuple(s for s in STATISTICS if name in s.sets)
+
+
 class Layout:
     """Where every table and column lives: the tables in the statistics' order, columns of shared tables
     concatenated (first declaration first), and the numbers and curves in order."""
 
-    def __init__(self, statistics=STATISTICS):
-        self.statistics = statistics
+    def __init__(self, statistics=None):
+        self.statistics = of("reduce") if statistics is None else statistics
         self.tables = {}           # name -> Table (bins) or merged column table
         self.columns = {}          # table -> [column names]
-        for s in statistics:
+        for s in self.statistics:
             for t in s.tables:
                 if t.bins:
                     if t.name in self.tables:
@@ -117,14 +138,18 @@ class Layout:
                     if clash:
                         raise ValueError(f"table {t.name}: columns {sorted(clash)} declared twice")
                     self.columns[t.name] += list(t.columns)
-        self.numbers = [n for s in statistics for n in s.numbers]
-        self.curves = [c for s in statistics for c in s.curves]
+        self.numbers = [n for s in self.statistics for n in s.numbers]
+        self.curves = [c for s in self.statistics for c in s.curves]
         self.bins = list(dict.fromkeys(name for t in self.tables.values() if t.bins for name in bin_names(t)))
         self._column = {(table, name): i for table, names in self.columns.items() for i, name in enumerate(names)}
+        self.chain_bins = {t.bins: t.chain_edges for t in self.tables.values() if t.chain_edges is not None}
+        self.samples = [name for name, t in self.tables.items() if t.sample]
 
     def width(self, table, edges):
         """Entries per unit of `table`: its bins (of a 2-d histogram, their product), or its columns."""
         t = self.tables[table]
+        if t.sample:
+            return 0
         return int(np.prod([len(edges[name]) - 1 for name in bin_names(t)])) if t.bins else len(self.columns[table])
 
     def column(self, table, name):
@@ -135,9 +160,10 @@ class Layout:
         return Tables(self, arrays)
 
     def empty(self, blocks, edges):
-        """Zeroed tables of one task: {table: (blocks, width)} (histograms int64, columns float64)."""
-        return Tables(self, {name: np.zeros((blocks, self.width(name, edges)),
-                                            np.int64 if t.bins and not t.weights else np.float64)
+        """Zeroed tables of one task: {table: (blocks, width)} (histograms int64, columns float64; a sample:
+        a list per stretch of the arrays fed to it)."""
+        return Tables(self, {name: [[] for _ in range(blocks)] if t.sample else
+                             np.zeros((blocks, self.width(name, edges)), np.int64 if t.bins and not t.weights else np.float64)
                              for name, t in self.tables.items()})
 
 
@@ -177,6 +203,11 @@ class Tables(dict):
         else:
             np.add.at(out, (block[ok], idx[ok]), 1)
 
+    def append(self, table, block, values):
+        """Append `values` to sample `table`, each to the list of its stretch (`block`), in order."""
+        for b in np.unique(block):
+            self[table][b].append(np.asarray(values, dtype=float)[block == b])
+
 
 @nb.njit(cache=True)
 def _add_at(out, column, block, values):
@@ -193,7 +224,8 @@ class Rows:
     creep_block their stretches; recurrences: (stretch of the starting event, T nu, interior) of the
     recurrences closed in this chunk, or None when no statistic asks for them; t_before: the time of the
     task's last inertial event before this chunk (NaN before its first); nu, opt; n_blocks: N, the blocks of
-    the chain; last: whether this chunk holds the task's last inertial event (none come after it).
+    the chain; last: whether this chunk holds the task's last inertial event (none come after it); scans: the
+    recurrences by criterion of a large event (reduce.LARGE), those the statistics need.
     """
     part: dict
     inertial: np.ndarray
@@ -207,3 +239,4 @@ class Rows:
     opt: object
     n_blocks: int = 0
     last: bool = False
+    scans: dict = field(default_factory=dict)   # criterion -> recurrences as `recurrences` ("mu": the same)

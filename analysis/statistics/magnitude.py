@@ -27,4 +27,4 @@ STATISTIC = Statistic(
              Number("n_large", "count", "large events (mu >= mu_c)"),
              Number("fraction_large", "1", "fraction of the events with mu >= mu_c")),
     curves=(Curve("mu", "mu", ("numbers", "n_events"), "mu", "all events", "1/mu"),),
-    feed=feed, estimate=estimate)
+    feed=feed, estimate=estimate, sets=("reduce", "compare"))

@@ -1,0 +1,98 @@
+"""The words of the summaries' figures: a summary's name, the legend labels of their points (the parameters
+that differ between them), and the figure's title (events per point, mu_c, window, what the bands resample,
+and a line for each partial reduction)."""
+import os
+
+from . import summary as summary_file
+from .reduce import PARAMS
+from .report import count_text, level_text, partial_text, size_text
+
+def summary_name(path):
+    """A summary's name in labels and titles: its file name without .summary.h5 (or .h5)."""
+    base = os.path.basename(str(path))
+    return base.removesuffix(".h5").removesuffix(".summary")
+
+
+def legend_labels(summaries, names=None):
+    """(keys, labels) for the points of all `summaries`, in order (summary by summary).
+
+    keys: the parameters that differ between the plotted points (in PARAMS order; ["b"] if
+    none do); a label gives their values, e.g. "N = 1600, b = 40" (6 significant digits, or
+    all where that is needed to tell two points apart). A point whose parameters appear in
+    several summaries gets the summary's name appended, "b = 20 (run2)" (names: one per
+    summary, default "summary 1", "summary 2", ...).
+    """
+    names = list(names) if names is not None else [f"summary {j + 1}" for j in range(len(summaries))]
+    owner, rows = [], []
+    for j, s in enumerate(summaries):
+        for i in range(len(s["points/N"])):
+            owner.append(j)
+            # None for a key of another friction law (NaN in the summary, which equals nothing)
+            rows.append(tuple(None if v != v else v for v in (s[f"points/{k}"][i].item() for k in PARAMS))
+                        + (str(summary_file.point_laws(s)[i]),))
+    keys = [k for n, k in enumerate(PARAMS) if len({r[n] for r in rows}) > 1] or ["b"]
+    laws = len({r[-1] for r in rows}) > 1      # points of several laws: "slip: b = 20"
+    for exact in (False, True):
+        labels = [(f"{r[-1]}: " if laws else "")
+                  + ", ".join(f"{k} = {repr(r[PARAMS.index(k)]) if exact else format(r[PARAMS.index(k)], 'g')}"
+                              for k in keys if r[PARAMS.index(k)] is not None) for r in rows]
+        if all(labels[a] != labels[b] or rows[a] == rows[b]
+               for a in range(len(rows)) for b in range(a)):
+            break
+    repeated = {r for r in rows if rows.count(r) > 1}
+    labels = [f"{label} ({names[j]})" if r in repeated else label
+              for label, r, j in zip(labels, rows, owner)]
+    return keys, labels
+
+
+def points_of(summaries):
+    """[(summary, point index)] of every plotted point."""
+    return [(s, i) for s in summaries for i in range(len(s["points/N"]))]
+
+
+def _values(values, fmt="{}"):
+    """Distinct values, " / " between them."""
+    return " / ".join(dict.fromkeys(fmt.format(v) for v in values))
+
+
+def _units(s):
+    """What a summary's bands resample: "20 stretches", "4 seeds" (or a range of counts)."""
+    words = {"blocks": "stretches", "seeds": "seeds"}
+    return " / ".join(dict.fromkeys(
+        f"{min(n)}-{max(n)} {words[m]}" if min(n) != max(n) else f"{n[0]} {words[m]}"
+        for m in dict.fromkeys(s["points/method"])
+        for n in [[int(u) for u, k in zip(s["points/units"], s["points/method"]) if k == m]]))
+
+
+def _creep_sizes(summaries):
+    """The creep episodes per point, over the points that have any: "15380-16492 creep episodes per point"."""
+    counts = [c for s in summaries if summary_file.has_creep(s)
+              for c, creeps in zip(s["points/numbers/n_creep"][:, 0], summary_file.creeping(s)) if creeps]
+    if not counts:
+        return "no creep episodes"      # (the creep figure then stops with its one-line error)
+    lo, hi = min(counts), max(counts)
+    return f"{count_text(lo)}{'' if lo == hi else f'-{count_text(hi)}'} creep episodes per point"
+
+
+def title_text(summaries, names, title=None, kind=None):
+    """The figure's title: `title` (then the description below) or by default the description
+    alone: events per point, mu_c, window and the bands (never the file names; for the creep
+    figure the creep episodes per point and the bands); then one line for each partial reduction
+    (events reduced of expected), whatever the title."""
+    levels = " / ".join(dict.fromkeys(level_text(s["attrs"]["level"]) for s in summaries))
+    bands = f"bands: {levels} bootstrap over {_values(_units(s) for s in summaries)}"
+    if kind == "seismicity":   # a map has no band: its numbers (analysis report) have the intervals
+        bands = (f"\nmaps without intervals; the numbers' {levels} intervals (analysis report) over "
+                 f"{_values(_units(s) for s in summaries)}")
+    if kind == "creep":
+        description = f"{_creep_sizes(summaries)}; {bands}"
+    else:
+        description = (f"{_values(size_text(s) for s in summaries)}, "
+                       f"mu_c = {_values((s['attrs']['mu_c'] for s in summaries), '{:g}')}, "
+                       f"window = {_values((s['attrs']['window'] for s in summaries), '{:g}')} blocks; {bands}")
+    partials = []
+    for s, name in zip(summaries, names):
+        partial = partial_text(s).split(";")[0]
+        if partial:
+            partials.append(partial if len(summaries) == 1 else f"{name}: {partial}")
+    return "\n".join(([description] + partials) if title is None else ([title] + partials + [description]))
