@@ -91,6 +91,7 @@ QUICK = {
     "test_imports.py": ["test_no_module_imports_itself_round_a_circle",
                         "test_the_graph_sees_imports_inside_functions_and_relative_ones",
                         "test_the_store_modules_are_small"],
+    "test_mutation_targets.py": ["test_every_mutant_applies_once_and_names_existing_tests"],
     "test_quick_tier.py": ["test_every_test_named_in_the_quick_tier_exists",
                            "test_every_test_file_is_in_the_quick_tier_or_says_why_not"],
 }

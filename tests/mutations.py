@@ -173,7 +173,8 @@ MUTATIONS = (
              "R(mu) normalised as a probability per bin instead of a density"),
     # -- several catalogs -------------------------------------------------------------------
     Mutation("merge-units-in-catalog-order", "analysis/merge.py",
-             "points.append((dict(zip(PARAMS, key)), rows))", "points.append((dict(zip(PARAMS, key)), sorted(rows)))",
+             'points.append(({**dict(zip(PARAMS, key)), "law": law}, rows))',
+             'points.append(({**dict(zip(PARAMS, key)), "law": law}, sorted(rows)))',
              ("tests/test_reduction.py", "tests/test_analysis.py"),
              "a pooled point's intervals change with the order in which its catalogs are given"),
     Mutation("merge-bootstrap-by-point-index", "analysis/cli.py",
