@@ -1,32 +1,26 @@
 """TOML config -> validated frozen dataclasses (the one source of parameter truth).
 
-Every key has a default, a one-line meaning and a valid range below. Unknown
-keys and out-of-range values raise ConfigError naming the key; every float must
-be finite (TOML has inf and nan, and 1e400 reads as inf), and parameter points
-whose numbers the kernels' arithmetic cannot hold are refused (_OVERFLOW_RULES).
+Every key has a default and a one-line meaning below, or where it is declared (a friction law's
+keys in model/laws/, the [integrator] keys in integrators.KEYS), and a valid range
+(config_rules.py). Unknown keys and out-of-range values raise ConfigError naming the key; every
+float must be finite (TOML has inf and nan, and 1e400 reads as inf), and parameter points whose
+numbers the kernels' arithmetic cannot hold are refused (config_rules.OVERFLOW_RULES).
 """
 import dataclasses
-import itertools
 import math
 import tomllib
-from contextlib import contextmanager
 from dataclasses import dataclass, field, fields
 
 from . import filekind
+from .config_rules import ConfigError, check_overflow, coerce, from_set, point_values
+from .integrators import INTEGRATORS
+from .integrators import KEYS as INTEGRATOR_KEYS
 from .model import laws
 from .sections import SECTION_NAMES
 
-
-class ConfigError(ValueError):
-    """A config file or override that cannot be used; the message names the key."""
-
-
-def _positive(x):
-    return x > 0
-
-
-def _nonneg(x):
-    return x >= 0
+__all__ = ["Config", "ConfigError", "DECORRELATION_PER_BLOCK", "Integrator", "LAW_KEYS", "Model", "Output", "Run",
+           "SECTIONS", "TRANSIENT_PER_BLOCK", "from_dict", "load", "loads", "parse_override", "replace",
+           "section_lines"]
 
 
 @dataclass(frozen=True)
@@ -94,19 +88,13 @@ class Run:
         return self.decorrelation if self.branch else self.transient
 
 
-# integrator.rtol's default: the fastest ark4 tolerance whose magnitudes and recurrence times are
-# indistinguishable from rtol 1e-7's at 1e5 events per point (b = 20 and 50, N = 800); 1e-3's
-# recurrence times at b = 50 are not (benchmarks/statistics.py --catalogs, docs/benchmarks.md).
-@dataclass(frozen=True)
-class Integrator:
-    method: str = "ark4"           # event integrator (ensemble.integrators.INTEGRATORS); a config file without it
-                                   # takes its law's (Law.method: exp4 for the aging law, ark4 for the others)
-    dt: float = 1e-3               # time step of "rk4"; first step of the adaptive methods
-    rtol: float = 1e-4             # adaptive methods (ark3, ark4, ark5): relative tolerance of the local error per step
-    atol: float = 1e-12            # adaptive methods: absolute tolerance (slip, velocity)
-    max_step: float = 0.5          # adaptive methods: largest step
-    max_duration: float = 1e5      # an event lasting longer than this is an error
-    creep_tol: float = 1e-6        # creep phase (b below a block's stiffness): local error of the state psi per creep step
+# [integrator]: the keys declared in integrators.KEYS (default, unit, range, meaning, the methods that
+# read each); a config file without integrator.method takes its law's (Law.method, from_dict)
+Integrator = dataclasses.make_dataclass(
+    "Integrator", [(name, type(key.default), field(default=key.default)) for name, key in INTEGRATOR_KEYS.items()],
+    frozen=True)
+Integrator.__doc__ = "The event integrator and its settings (integrators.KEYS)."
+Integrator.__module__ = __name__
 
 
 @dataclass(frozen=True)
@@ -117,45 +105,6 @@ class Output:
     progress_seconds: float = 30.0  # rank 0 prints a progress line this often
     writer: str = "auto"         # "parallel" (mpio), "rank0" (messages to rank 0), "auto"
 
-
-# sizes beyond what any run can do: refused at once instead of allocating, or promising an ETA of
-# 1e14 minutes (1e12 events are decades of core time at the ~1000 events/s of N = 800)
-MAX_BLOCKS = 10 ** 6
-MAX_COUNT = 10 ** 12
-MAX_BATCH = 10 ** 7
-MAX_NU = 10.0
-
-_RULES = {
-    # a rank holds about 500 bytes per block: 1e6 blocks are 0.5 GB (the paper: 800 and 1600)
-    ("model", "N"): (lambda x: 1 <= x <= MAX_BLOCKS, f"an integer in [1, {MAX_BLOCKS}] (a rank holds about 500 "
-                                                      f"bytes per block)"),
-    ("model", "l"): (_positive, "> 0"),
-    # the plate must be slow against slip, whose velocities are of order 1 in these units (the paper:
-    # 1e-8); faster loading is not this model, and from about 1e8 on the kernels' floats fail
-    ("model", "nu"): (lambda x: 0 < x <= MAX_NU, f"in (0, {MAX_NU:g}] (loading slow against slip; the paper: 1e-8)"),
-    **{("model", name): (key.check, key.rule) for law in laws.LAWS.values() for name, key in law.keys.items()},
-    ("run", "seeds"): (lambda x: 1 <= x <= MAX_COUNT, f"an integer in [1, {MAX_COUNT:.0e}]"),
-    ("run", "events"): (lambda x: 1 <= x <= MAX_COUNT, f"an integer in [1, {MAX_COUNT:.0e}]"),
-    ("run", "transient"): (lambda x: 0 <= x <= MAX_COUNT, f"an integer in [0, {MAX_COUNT:.0e}]"),
-    ("run", "seed"): (_nonneg, "an integer >= 0"),
-    ("run", "init_stress"): (_positive, "> 0"),
-    ("run", "perturbation"): (_nonneg, ">= 0"),
-    ("run", "decorrelation"): (lambda x: 0 <= x <= MAX_COUNT, f"an integer in [0, {MAX_COUNT:.0e}]"),
-    ("integrator", "dt"): (lambda x: 0 < x <= 1, "in (0, 1]"),
-    ("integrator", "max_duration"): (_positive, "> 0"),
-    ("integrator", "rtol"): (lambda x: 0 < x < 1, "in (0, 1)"),
-    ("integrator", "atol"): (_positive, "> 0"),
-    ("integrator", "max_step"): (_positive, "> 0"),
-    ("integrator", "creep_tol"): (lambda x: 0 < x < 1, "in (0, 1)"),
-    # a task buffers a batch in memory, 80 bytes per event
-    ("output", "batch"): (lambda x: 1 <= x <= MAX_BATCH, f"an integer in [1, {MAX_BATCH:.0e}] (80 bytes per event "
-                                                          f"in memory)"),
-    ("output", "flush_seconds"): (_positive, "> 0"),
-    ("output", "progress_seconds"): (_positive, "> 0"),
-    ("output", "writer"): (lambda x: x in ("auto", "parallel", "rank0"), "one of auto, parallel, rank0"),
-    ("run", "poll_seconds"): (_positive, "> 0"),
-    ("output", "path"): (lambda x: len(x) > 0, "a non-empty string"),
-}
 
 # (the names in sections.py, where filekind.py reads them too)
 SECTIONS = dict(zip(SECTION_NAMES, (Model, Run, Integrator, Output), strict=True))
@@ -172,7 +121,7 @@ class Config:
     def __post_init__(self):
         """Resolve run.transient and run.decorrelation left out: TRANSIENT_PER_BLOCK and
         DECORRELATION_PER_BLOCK events per block of the largest N."""
-        largest = max(int(n) for n in _values(self, "model.N")[1])
+        largest = max(int(n) for n in point_values(self, "model.N")[1])
         if self.run.transient is None:
             object.__setattr__(self, "run", dataclasses.replace(self.run, transient=TRANSIENT_PER_BLOCK * largest))
         if self.run.decorrelation is None:
@@ -211,62 +160,18 @@ def _toml_value(v):
     return str(v)
 
 
-def _coerce(section, key, value, typ, where=None):
-    """Check the type and range of one value (ints are accepted where floats are expected).
-
-    where: the name the message gives the value (default section.key; sweep.KEY for a swept one).
-    """
-    where = where or f"{section}.{key}"
-    if typ is bool:
-        if not isinstance(value, bool):
-            raise ConfigError(f"{where} must be true or false, got {value!r}")
-    elif typ is float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ConfigError(f"{where} must be a number, got {value!r}")
-        try:
-            value = float(value)
-        except OverflowError:   # a TOML integer beyond float range
-            value = math.inf
-        if not math.isfinite(value):
-            # "> 0" and ">= 0" alone let inf through (and TOML reads 1e400 as inf)
-            raise ConfigError(f"{where} must be a finite number, got {value!r}")
-    elif typ is int:
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise ConfigError(f"{where} must be an integer, got {value!r}")
-        if not -2**63 <= value < 2**63:   # tomllib reads integers of any size; catalogs store int64
-            raise ConfigError(f"{where} must fit in 64 bits, got {value!r}")
-    elif typ is str:
-        if not isinstance(value, str):
-            raise ConfigError(f"{where} must be a string, got {value!r}")
-    rule = _RULES.get((section, key))
-    if rule is not None and not rule[0](value):
-        raise ConfigError(f"{where} must be {rule[1]}, got {value!r}")
-    return value
-
-
-@contextmanager
-def _from_set(overridden, section, key):
-    """An error about a value that came from --set says so."""
-    try:
-        yield
-    except ConfigError as err:
-        if (section, key) not in overridden:
-            raise
-        raise ConfigError(f"{err} (from --set {overridden[section, key]})") from None
-
-
 def _section(name, raw, overridden):
     cls = SECTIONS[name]
     if not isinstance(raw, dict):
         raise ConfigError(f"[{name}] must be a table")
     known = {f.name: f for f in fields(cls)}
-    values = {}
+    given = {}
     for key, value in raw.items():
-        with _from_set(overridden, name, key):
+        with from_set(overridden, name, key):
             if key not in known:
                 raise ConfigError(f"unknown key {name}.{key} (known: {', '.join(known)})")
-            values[key] = _coerce(name, key, value, known[key].type)
-    return cls(**values)
+            given[key] = coerce(name, key, value, known[key].type)
+    return cls(**given)
 
 
 def _sweep(raw, overridden):
@@ -275,66 +180,19 @@ def _sweep(raw, overridden):
     types = {f.name: f.type for f in fields(Model)}
     out = []
     for key, values in raw.items():
-        with _from_set(overridden, "sweep", key):
+        with from_set(overridden, "sweep", key):
             if key not in types or key == "law":
                 raise ConfigError(f"unknown key sweep.{key} (only [model] keys can be swept: "
                                   f"{', '.join(k for k in types if k != 'law')})")
             if not isinstance(values, list) or not values:
                 raise ConfigError(f"sweep.{key} must be a non-empty list of values, e.g. {key} = [20, 40] "
                                   f"(on the command line: --set 'sweep.{key}=[20, 40]'), got {values!r}")
-            coerced = tuple(_coerce("model", key, v, types[key], where=f"sweep.{key}") for v in values)
+            coerced = tuple(coerce("model", key, v, types[key], where=f"sweep.{key}") for v in values)
             repeated = [v for i, v in enumerate(coerced) if v in coerced[:i]]
             if repeated:   # the points would be one point run twice, then pooled by the reduction
                 raise ConfigError(f"sweep.{key} lists {repeated[0]!r} more than once")
             out.append((key, coerced))
     return tuple(out)
-
-
-def _values(cfg, name):
-    """Every value a key ("model.b", "run.init_stress") takes over the parameter points, and the
-    name to give it ("sweep.b" if swept)."""
-    section, key = name.split(".")
-    for swept, values in cfg.sweep:
-        if section == "model" and swept == key:
-            return f"sweep.{key}", values
-    return name, (getattr(getattr(cfg, section), key),)
-
-
-def _first_onset_bound(b, nu, init_stress):
-    """Latest time of the first onset from the initial state, as ensemble/model/onset.py finds it.
-
-    Every block starts at theta = 1 with its force up to init_stress below threshold;
-    onset_delay forms L = ln(b / nu) + init_stress / b + nu / b (at most), takes a root
-    y <= max(2 L, 1) and returns (y - nu / b) * b / nu.
-    """
-    ratio = b / nu
-    L = (math.log(ratio) if ratio > 0 else -math.inf) + init_stress / b + nu / b
-    return max(2 * L, 1.0) * ratio
-
-
-# Parameter points whose numbers the kernels' float arithmetic cannot hold. Each entry: the
-# keys it reads, the number (must come out finite) and what that number is. The kernel is the
-# wrong place to find out: with b / nu = 1e310 (b = 1e300, nu = 1e-10) a run looped forever
-# inside the kernel, deaf to SIGTERM, and with nu / b = 1e310 it corrupted memory ("double
-# free"). Each term that can overflow is largest at a corner of the sweep (smallest or largest
-# b, nu, l), so only the corners are checked.
-_OVERFLOW_RULES = (
-    (("model.l",), lambda l: l * l,   # noqa: E741 - the model's name
-     "l^2 (the stiffness between blocks, integrators.kernel_params)"),
-    (("model.b", "model.nu", "run.init_stress"), _first_onset_bound,
-     "the time of the first onset, up to 2 b/nu (ln(b/nu) + init_stress/b + nu/b) (model/onset.py)"),
-)
-
-
-def _check_overflow(cfg):
-    for keys, number, meaning in _OVERFLOW_RULES:
-        named = [_values(cfg, key) for key in keys]
-        if any(v is None for _, values in named for v in values):
-            continue    # a key of another friction law
-        for corner in itertools.product(*[(min(v), max(v)) for _, v in named]):
-            if not math.isfinite(number(*corner)):
-                given = ", ".join(f"{name} = {x!r}" for (name, _), x in zip(named, corner))
-                raise ConfigError(f"{given}: {meaning} overflows a float")
 
 
 def from_dict(raw, overridden=None):
@@ -359,7 +217,6 @@ def from_dict(raw, overridden=None):
     if cfg.integrator.method not in _integrator_names():
         raise ConfigError(f"integrator.method must be one of {', '.join(_integrator_names())}, "
                           f"got {cfg.integrator.method!r}")
-    from .integrators import INTEGRATORS
     refusal = INTEGRATORS[cfg.integrator.method].refusal(laws.get(cfg.model.law))
     if refusal:
         raise ConfigError(refusal)
@@ -368,12 +225,11 @@ def from_dict(raw, overridden=None):
         # a tolerance for a phase this law never enters: a mistake about the model, not a no-op
         raise ConfigError(f"integrator.creep_tol = {cfg.integrator.creep_tol!r}: model.law = {law.name!r} has no creep "
                           f"phase (its blocks always start inertial events; docs/laws.md)")
-    _check_overflow(cfg)
+    check_overflow(cfg)
     return cfg
 
 
 def _integrator_names():
-    from .integrators import INTEGRATORS
     return sorted(INTEGRATORS)
 
 

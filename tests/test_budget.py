@@ -9,14 +9,18 @@ No tolerances: everything is compared bit for bit. The counts asserted are cover
 pauses did fall inside events): measured 12-16 of 16 events paused in, 4-6 resumed in a fresh
 workspace, against at least 8 and 3.
 """
+import ast
+import inspect
+
 import numpy as np
 import pytest
 
 from ensemble.store.checkpoint import Checkpoint
 from ensemble.config import Config, Integrator, Model, Run
 from ensemble.integrators import kernel_params
+from ensemble.model import event, workspace
 from ensemble.model.chain import simulate
-from ensemble.model.workspace import F0, NDIAG, OK, P, PAUSED, UNLIMITED, Workspace
+from ensemble.model.workspace import F0, NDIAG, OK, P, PAUSED, UNLIMITED, PausedEvent, Workspace
 from ensemble.runner import Trajectory
 from ensemble.tasks import task_list
 
@@ -138,3 +142,39 @@ def test_trajectory_checkpoint_during_a_paused_event():
         traj.advance(24 - traj.done, budget=300)
     np.testing.assert_array_equal(traj.clock, whole.clock)
     np.testing.assert_array_equal(traj.ws.W[:, [F0, P]], whole.ws.W[:, [F0, P]])
+
+
+# -- the paused event's record ------------------------------------------------------------------
+
+def _slots():
+    """{EV_ name: slot} of the event-state vector (workspace.py)."""
+    return {name: value for name, value in vars(workspace).items() if name.startswith("EV_")}
+
+
+def test_the_event_state_slots_are_one_each_and_contiguous():
+    """Each name of the event-state vector has a slot of its own, and the slots fill the vector. (The
+    vector never reaches a file: a checkpoint holds the between-events state, Workspace.between_events,
+    and a paused event is integrated again from its onset, so only this holds the slots in place.)"""
+    slots = _slots()
+    assert sorted(slots.values()) == list(range(workspace.NEVENT)), slots
+    assert {f"EV_{field.upper()}" for field in PausedEvent._fields} <= set(slots)
+
+
+def test_the_paused_event_is_saved_and_restored_by_name():
+    """_keep puts each field of the record into its slot (field x into EV_X) and _resume reads it back
+    from there, whatever the order of the record's fields: a record of distinct values comes back whole,
+    and each value sits in the slot of its name (run as Python: the same code numba compiles)."""
+    counts = {"na", "nt", "far", "steps", "block_steps", "rejected", "cuts", "traced"}
+    values = {f: (k + 2 if f in counts else k + 2.5) for k, f in enumerate(PausedEvent._fields)}
+    record = PausedEvent(**values)
+    vector = np.full(workspace.NEVENT, np.nan)
+    event._keep.py_func(vector, record)
+    slots = _slots()
+    assert {f: vector[slots[f"EV_{f.upper()}"]] for f in PausedEvent._fields} == values
+    back = event._resume.py_func(vector)
+    assert back == record
+    assert {f: type(getattr(back, f)) for f in counts} == {f: int for f in counts}
+    # the record is built by keyword wherever the kernel builds it, so no call depends on the fields' order
+    tree = ast.parse(inspect.getsource(event))
+    calls = [node for node in ast.walk(tree) if isinstance(node, ast.Call) and getattr(node.func, "id", "") == "PausedEvent"]
+    assert calls and all(not call.args and {k.arg for k in call.keywords} == set(PausedEvent._fields) for call in calls)

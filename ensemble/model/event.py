@@ -25,7 +25,8 @@ STOPPED), `touched` the blocks that slid.
 
 An event is begun (`begin_event`) and then integrated by `continue_event`, which returns
 after a given amount of work if the event has not finished by then, its loop variables kept
-in the event-state vector (workspace.EV_*), and carries on from there at the next call:
+in the event-state vector (one record, workspace.PausedEvent, each field in its slot EV_*,
+saved and restored by name), and carries on from there at the next call:
 every floating-point operation is the same as in one call, so the result is bit-identical.
 Work is counted in block-steps: the sliding blocks of every step tried (rejected steps and
 steps redone after a cut included), the quantity the cost of an event is proportional to.
@@ -50,7 +51,7 @@ from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D
                         EV_BLOCK_STEPS, EV_CUTS, EV_EPICENTER, EV_ERR_PREV, EV_FAR, EV_H_NEXT, EV_NA, EV_NT,
                         EV_PHASE, EV_REJECTED, EV_SLIP_TIME, EV_STEPS, EV_T_FAR, EV_TAU, EV_TRACED, EV_VMAX,
                         EV_WORK, EV_YREST, F0, HD0, CR_HB, CR_V, CR_VN, HD1, IN_EVENT, NONFINITE, OK, P, P0, PAUSED, SLIDING,
-                        STOPPED, TOO_LONG, TR, TS, UNLIMITED, UNSTABLE, UNTOUCHED, V, V0, Y, Y0, YS)
+                        STOPPED, TOO_LONG, TR, TS, UNLIMITED, UNSTABLE, UNTOUCHED, V, V0, Y, Y0, YS, PausedEvent)
 
 # Stability limit of classical RK4 on the negative real axis: the state equation
 # relaxes at rate 1/theta (= v in steady sliding), so dt / theta must stay below it.
@@ -156,7 +157,7 @@ def begin_event(arrays, t0, n, epicenter, v_start, p):
     W[epicenter, V] = v_start
     event[EV_PHASE] = IN_EVENT
     event[EV_EPICENTER] = epicenter
-    _keep(event, na, nt, yrest, t_far, far, 0.0, 0.0, 0.0, 0, 0, 0, 0, v_start, p.dt, 1.0, 0)
+    _keep(event, _at_onset(na=na, nt=nt, yrest=yrest, t_far=t_far, far=far, vmax=v_start, h_next=p.dt))
 
 
 @nb.njit(cache=True)
@@ -179,38 +180,48 @@ def begin_handover(arrays, t0, n, epicenter, p):
     t_far, far = _far_onset(W, arrays.flag, n, arrays.since, arrays.tree, t0, 0.0, p)
     event[EV_PHASE] = IN_EVENT
     event[EV_EPICENTER] = epicenter
-    _keep(event, na, nt, yrest, t_far, far, 0.0, 0.0, 0.0, 0, 0, 0, 0, vmax, p.dt, 1.0, 0)
+    _keep(event, _at_onset(na=na, nt=nt, yrest=yrest, t_far=t_far, far=far, vmax=vmax, h_next=p.dt))
 
 
 @nb.njit(cache=True, inline="always")
-def _keep(event, na, nt, yrest, t_far, far, tau, work, slip_time, steps, block_steps, rejected, cuts,
-          vmax, h_next, err_prev, traced):
-    """The loop variables of the event in progress into the event-state vector (workspace.EV_*)."""
-    event[EV_NA] = na
-    event[EV_NT] = nt
-    event[EV_YREST] = yrest
-    event[EV_T_FAR] = t_far
-    event[EV_FAR] = far
-    event[EV_TAU] = tau
-    event[EV_WORK] = work
-    event[EV_SLIP_TIME] = slip_time
-    event[EV_STEPS] = steps
-    event[EV_BLOCK_STEPS] = block_steps
-    event[EV_REJECTED] = rejected
-    event[EV_CUTS] = cuts
-    event[EV_VMAX] = vmax
-    event[EV_H_NEXT] = h_next
-    event[EV_ERR_PREV] = err_prev
-    event[EV_TRACED] = traced
+def _at_onset(na, nt, yrest, t_far, far, vmax, h_next):
+    """The loop variables (PausedEvent) of an event at its onset: the blocks started, nothing integrated yet."""
+    return PausedEvent(na=na, nt=nt, yrest=yrest, t_far=t_far, far=far, tau=0.0, work=0.0, slip_time=0.0, steps=0,
+                       block_steps=0, rejected=0, cuts=0, vmax=vmax, h_next=h_next, err_prev=1.0, traced=0)
+
+
+@nb.njit(cache=True, inline="always")
+def _keep(event, s):
+    """The loop variables of the event in progress (a PausedEvent) into the event-state vector, each
+    field into its slot (workspace: field x in EV_X)."""
+    event[EV_NA] = s.na
+    event[EV_NT] = s.nt
+    event[EV_YREST] = s.yrest
+    event[EV_T_FAR] = s.t_far
+    event[EV_FAR] = s.far
+    event[EV_TAU] = s.tau
+    event[EV_WORK] = s.work
+    event[EV_SLIP_TIME] = s.slip_time
+    event[EV_STEPS] = s.steps
+    event[EV_BLOCK_STEPS] = s.block_steps
+    event[EV_REJECTED] = s.rejected
+    event[EV_CUTS] = s.cuts
+    event[EV_VMAX] = s.vmax
+    event[EV_H_NEXT] = s.h_next
+    event[EV_ERR_PREV] = s.err_prev
+    event[EV_TRACED] = s.traced
 
 
 @nb.njit(cache=True, inline="always")
 def _resume(event):
-    """The loop variables of the event in progress from the event-state vector, as _keep takes them."""
-    return (int(event[EV_NA]), int(event[EV_NT]), event[EV_YREST], event[EV_T_FAR], int(event[EV_FAR]),
-            event[EV_TAU], event[EV_WORK], event[EV_SLIP_TIME], int(event[EV_STEPS]),
-            int(event[EV_BLOCK_STEPS]), int(event[EV_REJECTED]), int(event[EV_CUTS]), event[EV_VMAX],
-            event[EV_H_NEXT], event[EV_ERR_PREV], int(event[EV_TRACED]))
+    """The loop variables of the event in progress (a PausedEvent) from the event-state vector, each
+    field from its slot; counts and block indices back to integers."""
+    return PausedEvent(na=int(event[EV_NA]), nt=int(event[EV_NT]), yrest=event[EV_YREST], t_far=event[EV_T_FAR],
+                       far=int(event[EV_FAR]), tau=event[EV_TAU], work=event[EV_WORK],
+                       slip_time=event[EV_SLIP_TIME], steps=int(event[EV_STEPS]),
+                       block_steps=int(event[EV_BLOCK_STEPS]), rejected=int(event[EV_REJECTED]),
+                       cuts=int(event[EV_CUTS]), vmax=event[EV_VMAX], h_next=event[EV_H_NEXT],
+                       err_prev=event[EV_ERR_PREV], traced=int(event[EV_TRACED]))
 
 
 @nb.njit(cache=True)
@@ -225,8 +236,10 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
     """
     W, act, flag, event = arrays.W, arrays.act, arrays.flag, arrays.event
     stuck, since, tree = arrays.stuck, arrays.since, arrays.tree
-    (na, nt, yrest, t_far, far, tau, work, slip_time, steps, block_steps, rejected, cuts, vmax, h_next,
-     err_prev, traced) = _resume(event)
+    s = _resume(event)     # the loop variables, by name (a PausedEvent)
+    na, nt, yrest, t_far, far = s.na, s.nt, s.yrest, s.t_far, s.far
+    tau, work, slip_time, vmax, h_next, err_prev = s.tau, s.work, s.slip_time, s.vmax, s.h_next, s.err_prev
+    steps, block_steps, rejected, cuts, traced = s.steps, s.block_steps, s.rejected, s.cuts, s.traced
     status = OK
     v_limit = RK4_STABILITY / p.dt
     psi_limit = stiff_limit(p.law, v_limit)
@@ -238,8 +251,9 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
     at_last = (0.0, 0.0)
     while na > 0:
         if used >= budget:
-            _keep(event, na, nt, yrest, t_far, far, tau, work, slip_time, steps, block_steps, rejected,
-                  cuts, vmax, h_next, err_prev, traced)
+            _keep(event, PausedEvent(na=na, nt=nt, yrest=yrest, t_far=t_far, far=far, tau=tau, work=work,
+                                     slip_time=slip_time, steps=steps, block_steps=block_steps, rejected=rejected,
+                                     cuts=cuts, vmax=vmax, h_next=h_next, err_prev=err_prev, traced=traced))
             return PAUSED, used
         if steps >= p.max_steps or tau > p.max_duration:
             status = TOO_LONG
@@ -368,8 +382,9 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
     diag[D_REJECTED] = rejected
     diag[D_CUTS] = cuts
     # the final values too, so that the vector does not depend on where the event was paused
-    _keep(event, na, nt, yrest, t_far, far, tau, work, slip_time, steps, block_steps, rejected, cuts,
-          vmax, h_next, err_prev, traced)
+    _keep(event, PausedEvent(na=na, nt=nt, yrest=yrest, t_far=t_far, far=far, tau=tau, work=work,
+                             slip_time=slip_time, steps=steps, block_steps=block_steps, rejected=rejected, cuts=cuts,
+                             vmax=vmax, h_next=h_next, err_prev=err_prev, traced=traced))
     clear_log(W, event, arrays.undo)
     event[EV_PHASE] = BETWEEN
     return status, used

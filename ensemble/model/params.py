@@ -22,14 +22,13 @@ class KernelParams(_Fields):
     method        the integrator's record, of that method's own class (model/methods.py): the kernels are
                   compiled once per method, each with its stepper and tableau; its field
                   control_exponent is -1 / (q + 1), q the embedded order (0 for rk4)
-    dt            step of rk4; the first step of an event for the adaptive methods
-    rtol          adaptive methods: relative tolerance of the local error per step
-    atol          adaptive methods: absolute tolerance (slip, velocity)
-    max_step      adaptive methods: largest step (inf: no bound)
-    max_duration  an event lasting longer than this (local time since its onset) ends with TOO_LONG
+    dt, rtol, atol, max_step, max_duration, creep_tol
+                  the [integrator] keys of the same names, as declared (meaning, unit, the methods
+                  that read them) in ensemble.integrators.KEYS; here max_step and max_duration may
+                  be inf (no bound), and an event longer than max_duration (local time since its
+                  onset) ends with TOO_LONG
     max_steps     steps of one event, rejected ones included, after which it ends with TOO_LONG (a
                   backstop behind max_duration for steps too small to reach it)
-    creep_tol     the creep phase (creep.py): local error of the state psi per creep step
     """
     __slots__ = ()
 
