@@ -5,7 +5,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from benchmarks import (cost_scaling, hard_cases, paired, reduce_speed, statistics, step_budget, step_trace,
+from benchmarks import (cost_scaling, hard_cases, paired, revisions, statistics, step_budget, step_trace,
                         work_precision)
 from benchmarks.baselines import BASELINES
 from benchmarks.common import cost_at_error, ks_distance, parse_setting, wasserstein1
@@ -267,17 +267,19 @@ def test_paired_tiny(tmp_path):
         paired.main(["--runs", "ark4:rtol=1e-4,atol=1e-9", "--out", str(tmp_path)])
 
 
-def test_reduce_speed_tiny(tmp_path):
+def test_revisions_tiny(tmp_path):
     from .test_summary_identity import CATALOG, gunzip
     cat = gunzip(CATALOG, tmp_path / "catalog.h5")
-    data = reduce_speed.main([str(cat), "--before", "HEAD", "--rounds", "1", "--cpu", "-1", "--out", str(tmp_path)])
+    data = revisions.main(["--before", "HEAD", "--rounds", "1", "--cpu", "-1", "--name", "t", "--out", str(tmp_path),
+                           "--", "python", "-m", "analysis", "reduce", str(cat), "-o", str(tmp_path / "{side}.h5"), "--force"])
     (now, _), (before, _) = data["cost"]["now"][0], data["cost"]["before"][0]
     assert now > 0 and before > 0 and data["cpu_ratios"] == [now / before]
-    assert "cpu ratio now / before" in (tmp_path / "reduce_speed.txt").read_text()
+    assert (tmp_path / "before.h5").is_file() and (tmp_path / "now.h5").is_file()
+    assert "cpu ratio now / before" in (tmp_path / "revisions_t.txt").read_text()
     assert str(tmp_path) not in subprocess.run(["git", "worktree", "list"], capture_output=True, text=True,
-                                               cwd=reduce_speed.ROOT).stdout   # its checkout of HEAD removed
+                                               cwd=revisions.ROOT).stdout   # its checkout of HEAD removed
     with pytest.raises(SystemExit, match="not a revision"):
-        reduce_speed.main([str(cat), "--before", "no-such-revision", "--out", str(tmp_path)])
+        revisions.main(["--before", "no-such-revision", "--out", str(tmp_path), "--", "true"])
 
 
 def test_phase_of_a_block():
