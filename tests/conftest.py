@@ -91,6 +91,8 @@ QUICK = {
     "test_imports.py": ["test_no_module_imports_itself_round_a_circle",
                         "test_the_graph_sees_imports_inside_functions_and_relative_ones",
                         "test_the_store_modules_are_small"],
+    "test_compare_engine.py": ["test_the_engines_tables_of_the_comparison_are_the_events"],
+    "test_integrator_keys.py": ["test_the_config_section_is_the_declaration", "test_each_key_reaches_the_kernels_by_name"],
     "test_mutation_targets.py": ["test_every_mutant_applies_once_and_names_existing_tests"],
     "test_quick_tier.py": ["test_every_test_named_in_the_quick_tier_exists",
                            "test_every_test_file_is_in_the_quick_tier_or_says_why_not"],
