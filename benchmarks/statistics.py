@@ -59,7 +59,7 @@ from ensemble.store.schema import KIND_EVENT
 from ensemble.config import LAW_KEYS, Integrator, Model
 from ensemble.integrators import INTEGRATORS
 from ensemble.model import laws
-from ensemble.runner import SimulationError, event_rows
+from ensemble.run.trajectory import SimulationError, event_rows
 
 from .common import (Clock, ks_distance, minutes, parse_setting, pyplot, rough_events_per_second, save_figure,
                      trajectory, wasserstein1, write_outputs)
