@@ -4,8 +4,8 @@
     tasks.py        sweep x seeds -> tasks, each with its own random stream and initial state
     branching.py    run.branch: the spin-ups a run needs, and the state a branch starts from
     decision.py     rank 0's decision about the files before any work: new, resume, complete, refused
-    runner.py       run(ctx): the lock, the decision, the catalog, the work loop, the close and the rename
-    worker.py       one rank's work on a task or a spin-up: kernel calls sized in time, commits, failures
+    runner.py       run(ctx): the lock, the decision, the catalog opened, the work served, closed and renamed
+    worker.py       one rank's work: items from the shared counter; a task or a spin-up in kernel calls, commits
     trajectory.py   one task's chain between events: the wrapper from config to kernel, the event rows
     progress.py     rank 0's progress line, in the log and in the lock file
     parallel.py     the MPI plumbing: the shared task counter, event counts, stop requests (signals)

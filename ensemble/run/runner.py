@@ -1,4 +1,4 @@
-"""A run on every rank: decide, open the catalog, take work until none is left, close, rename.
+"""A run on every rank: decide, open the catalog, serve the work (worker.py) until none is left, close, rename.
 
 The same code runs serially (one rank, no mpirun) and under MPI. Each task is one trajectory on one
 rank (worker.py); its seed comes from its index, so results do not depend on the number of ranks or
@@ -10,14 +10,13 @@ import time
 
 from .. import environment
 from ..store import writers
-from ..store.checkpoint import Checkpoint
 from .decision import check_output, prepare
 from .lock import RunLock
 from .parallel import Coordinator
 from .progress import Progress
 from .tasks import task_list
 from .trajectory import Trajectory, integrator_text
-from .worker import TaskRunner
+from .worker import TaskRunner, work
 
 EXIT_INTERRUPTED = 75   # checkpointed after a signal; continue with --resume (EX_TEMPFAIL)
 EXIT_FAILED = 1         # some tasks failed (recorded in the catalog); the others finished
@@ -98,7 +97,7 @@ def _serve(ctx, tasks, spins, t_start):
     try:
         _compile_kernels(ctx, tasks[0])
         progress.restart_clock()
-        busy, idle = _work(ctx, tasks, spins, worker)
+        busy, idle = work(ctx, tasks, spins, worker)
     except BaseException as err:
         # with more ranks the caller aborts them all; a broken file is not touched again
         if ctx.n_ranks == 1 and not getattr(err, "broken", False):
@@ -153,54 +152,3 @@ def _compile_kernels(ctx, task):
         Trajectory(ctx.cfg, tiny).advance(0)
     if not cached:
         ctx.say(f"kernels ready in {time.perf_counter() - start:.0f} s")
-
-
-def _work(ctx, tasks, spins, worker):
-    """Take work until none is left (or a stop request): first the spin-ups (run.branch), then, once
-    all are done and their states known on every rank, the tasks. Returns (busy, idle) seconds.
-
-    One counter numbers the work: items [0, len(spins)) are the spin-ups, then the tasks.
-    """
-    coord = ctx.coord
-    busy = idle = 0.0
-    first = len(spins)
-    total = first + len(tasks)
-    stopped = coord.poll()
-    mine = {}
-    k = total
-    while not stopped:
-        k = coord.next_task()
-        if k >= first:
-            break
-        t0 = time.perf_counter()
-        mine[spins[k].point] = state = worker.spin_up(spins[k], tasks)
-        stopped = state is None
-        busy += time.perf_counter() - t0
-    if spins:
-        idle += _wait(ctx, first)
-        # one decision for all: a stop seen by some ranks only must not split the collective below
-        if any(ctx.comm.allgather(coord.poll())):
-            return busy, idle
-        for part in ctx.comm.allgather(mine):
-            for point, state in part.items():
-                (worker.spun if isinstance(state, Checkpoint) else worker.spin_failed)[point] = state
-        stopped = False
-    while not stopped and k < total:
-        t0 = time.perf_counter()
-        stopped = not worker.run(tasks[k - first])
-        busy += time.perf_counter() - t0
-        if not stopped:
-            k = coord.next_task()
-    return busy, idle + _wait(ctx, total)
-
-
-def _wait(ctx, count):
-    """Keep serving MPI (and rank 0's writer) until `count` items are done or a stop is requested;
-    returns the seconds waited."""
-    waited = time.perf_counter()
-    while not ctx.coord.poll() and ctx.coord.tasks_done() < count:
-        ctx.writer.poll()
-        ctx.progress.maybe_print()
-        time.sleep(0.05)
-    return time.perf_counter() - waited
-

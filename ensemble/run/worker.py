@@ -1,4 +1,5 @@
-"""One rank's work on one task or spin-up: kernel calls sized in time, a buffer, commits with checkpoints.
+"""One rank's work: take items from the shared counter (work), and integrate each task or spin-up
+(TaskRunner): kernel calls sized in time, a buffer, commits with checkpoints.
 
 A task that fails numerically (SimulationError) is recorded as failed in the catalog and the rank goes
 on with the next task. The loop (TaskRunner._integrate) sizes each kernel call to last about
@@ -10,6 +11,7 @@ import time
 
 import numpy as np
 
+from ..store.checkpoint import Checkpoint
 from ..store.errors import CatalogError
 from ..store.schema import FAILED, FINISHED
 from ..model.workspace import UNLIMITED
@@ -195,3 +197,54 @@ class TaskRunner:
             self.progress.maybe_print()
         flush()
         return recorded_here / max(record_time, 1e-9)
+
+
+def work(ctx, tasks, spins, worker):
+    """Take work until none is left (or a stop request): first the spin-ups (run.branch), then, once
+    all are done and their states known on every rank, the tasks. Returns (busy, idle) seconds.
+
+    One counter numbers the work: items [0, len(spins)) are the spin-ups, then the tasks.
+    """
+    coord = ctx.coord
+    busy = idle = 0.0
+    first = len(spins)
+    total = first + len(tasks)
+    stopped = coord.poll()
+    mine = {}
+    k = total
+    while not stopped:
+        k = coord.next_task()
+        if k >= first:
+            break
+        t0 = time.perf_counter()
+        mine[spins[k].point] = state = worker.spin_up(spins[k], tasks)
+        stopped = state is None
+        busy += time.perf_counter() - t0
+    if spins:
+        idle += _wait(ctx, first)
+        # one decision for all: a stop seen by some ranks only must not split the collective below
+        if any(ctx.comm.allgather(coord.poll())):
+            return busy, idle
+        for part in ctx.comm.allgather(mine):
+            for point, state in part.items():
+                (worker.spun if isinstance(state, Checkpoint) else worker.spin_failed)[point] = state
+        stopped = False
+    while not stopped and k < total:
+        t0 = time.perf_counter()
+        stopped = not worker.run(tasks[k - first])
+        busy += time.perf_counter() - t0
+        if not stopped:
+            k = coord.next_task()
+    return busy, idle + _wait(ctx, total)
+
+
+def _wait(ctx, count):
+    """Keep serving MPI (and rank 0's writer) until `count` items are done or a stop is requested;
+    returns the seconds waited."""
+    waited = time.perf_counter()
+    while not ctx.coord.poll() and ctx.coord.tasks_done() < count:
+        ctx.writer.poll()
+        ctx.progress.maybe_print()
+        time.sleep(0.05)
+    return time.perf_counter() - waited
+
