@@ -33,7 +33,7 @@ from .reduce import (CREEP_DURATION_BINS, CREEP_MU_BINS, LAYOUT, NUMBERS, SEIS_D
                      SEIS_RING, SEIS_SHORT, SEIS_TIME_BINS, Options, bin_edges, parse_bins)
 
 # errors that reduce's rank 0 finds before the work starts and every rank then raises alike
-# (ensemble.abort.on_root), with their exit codes; any other error on any rank aborts them all
+# (ensemble.run.abort.on_root), with their exit codes; any other error on any rank aborts them all
 # (merge.MergeError is a ValueError: exit 2)
 COLLECTIVE = {ValueError: 2, CatalogError: 1, summary.SummaryError: 1, OSError: 1}
 
@@ -184,7 +184,7 @@ def _compare(args):
 def _reduce(args):
     from mpi4py import MPI
 
-    from ensemble.abort import run_guarded
+    from ensemble.run.abort import run_guarded
     comm = MPI.COMM_WORLD
     return run_guarded(comm, lambda: _reduce_on(comm, args), COLLECTIVE)
 
@@ -272,7 +272,7 @@ def _check_counts(inputs, per_task):
 
 
 def _reduce_on(comm, args):
-    from ensemble.abort import abort_on_error, on_root
+    from ensemble.run.abort import abort_on_error, on_root
 
     from .reduce import MIN_UNITS, point_statistics, unreliable
     rank, size = comm.Get_rank(), comm.Get_size()

@@ -4,7 +4,7 @@ whether the input is complete.
 A trajectory is its random stream (seed_entropy, spawn_key) together with its parameters
 (N, l, nu, a, b, c). The runner records the stream of a task when the task finishes; for a task
 that has not finished it is the stream the runner uses, SeedSequence(run.seed of the catalog's
-config, spawn_key=(task index,)) (ensemble/tasks.py), and the summary stores it so.
+config, spawn_key=(task index,)) (ensemble/run/tasks.py), and the summary stores it so.
 
 - Points. Tasks with exactly equal parameters pool into one parameter point, whichever catalog
   they come from; points are numbered in the order of first appearance (catalogs in the order

@@ -23,7 +23,7 @@ import time
 import numpy as np
 
 from ensemble.model.workspace import D_BLOCK_STEPS, D_NSLIP, D_SLIP
-from ensemble.runner import SimulationError
+from ensemble.run.trajectory import SimulationError
 
 from .common import (Clock, minutes, parse_setting, pyplot, rough_events_per_second, save_figure, trajectory,
                      write_outputs)

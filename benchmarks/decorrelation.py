@@ -7,7 +7,7 @@
 Per point (N, b; every pair of --N x --b): task 0 of the point is spun up for --spinup events
 (the branch point); from that state start an unperturbed continuation (the reference) and, per
 perturbation size, --branches branches, each with its forces lowered as a branched run lowers them
-(ensemble.tasks.perturb with branch_rng of its own task). Branch j of a repeat uses the same
+(ensemble.run.tasks.perturb with branch_rng of its own task). Branch j of a repeat uses the same
 generator at every perturbation size, so that only the size differs. With --repeats R > 1 the
 reference's state after --events events is the next branch point (R branch points per point).
 Independent pairs: task 1 of the point, spun up alike, against the reference and every branch.
@@ -54,8 +54,8 @@ import numpy as np
 from ensemble.config import Config, Model, Run
 from ensemble.store.checkpoint import Checkpoint
 from ensemble.model.workspace import D_NSLIP
-from ensemble.runner import Trajectory
-from ensemble.tasks import branch_rng, perturb, task_list
+from ensemble.run.trajectory import Trajectory
+from ensemble.run.tasks import branch_rng, perturb, task_list
 
 from .common import Clock, minutes, parse_setting, pyplot, save_figure, write_outputs
 

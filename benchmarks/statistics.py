@@ -49,7 +49,7 @@ import sys
 
 from ensemble.config import Model
 from ensemble.model import laws
-from ensemble.runner import SimulationError, event_rows
+from ensemble.run.trajectory import SimulationError, event_rows
 from ensemble.store.errors import CatalogError
 
 from .common import Clock, minutes, parse_setting, rough_events_per_second, trajectory, write_outputs

@@ -41,8 +41,8 @@ from pathlib import Path
 import numpy as np
 
 from ensemble.config import load, replace
-from ensemble.runner import Trajectory
-from ensemble.tasks import task_list
+from ensemble.run.trajectory import Trajectory
+from ensemble.run.tasks import task_list
 
 from .common import Clock, pyplot, save_figure, write_outputs
 

@@ -10,12 +10,12 @@ import signal
 import sys
 
 from . import __version__
-from .abort import abort
+from .run.abort import abort
 from .store.errors import CatalogError
 from .store.files import partial_path
 from .store.reader import read_tasks
 from .config import ConfigError, load, loads, parse_override, replace
-from .lock import LockError
+from .run.lock import LockError
 
 
 
@@ -41,7 +41,7 @@ def _parser():
                           "goes on (repeatable)")
     st = sub.add_parser("status", help="summarise a catalog (finished, or being written)")
     st.add_argument("catalog", help="catalog path (PATH.partial is found automatically)")
-    from .slurm import add_arguments
+    from .slurm.command import add_arguments
     add_arguments(sub.add_parser("slurm", help="write (and submit) Slurm job scripts for a config"))
     return p
 
@@ -55,7 +55,7 @@ def _config(args):
 
 def _validate(args):
     from . import environment
-    from .tasks import describe, task_list
+    from .run.tasks import describe, task_list
     cfg = _config(args)
     # before any output: a writer this stack cannot provide fails here, before a job is submitted
     stack = environment.describe(cfg.output.writer)
@@ -67,7 +67,7 @@ def _validate(args):
 
 
 def _status(args):
-    from .status import summary
+    from .run.status import summary
     print(summary(args.catalog))
     return 0
 
@@ -123,8 +123,10 @@ def _late_signal(signum, frame):
 def _run(args):
     from mpi4py import MPI
 
-    from .parallel import INTERRUPT_SIGNALS
-    from .runner import Refused, run
+    from .run.context import RunContext
+    from .run.decision import Refused
+    from .run.parallel import INTERRUPT_SIGNALS
+    from .run.runner import run
     comm = MPI.COMM_WORLD
     rank = comm.Get_rank()
     for sig in INTERRUPT_SIGNALS:
@@ -139,10 +141,10 @@ def _run(args):
                         _log(f"{path} is complete; nothing to resume")
                     return 0
                 raise Refused(f"{partial_path(path)}: no interrupted run to resume")
-            return run(cfg, path, comm, resume=True, rerun=rerun, command=command, log=_log)
+            return run(RunContext(cfg, path, comm, log=_log, resume=True, rerun=rerun, command=command))
         cfg = _config(args)
-        return run(cfg, cfg.output.path, comm, resume=args.resume, force=args.force, command=command,
-                   log=_log, inputs=[args.config])
+        return run(RunContext(cfg, cfg.output.path, comm, log=_log, resume=args.resume, force=args.force,
+                              command=command, inputs=(args.config,)))
     except (ConfigError, LockError, Refused) as err:
         # raised on every rank alike (decisions are made on rank 0 and broadcast)
         if rank == 0:
@@ -164,7 +166,7 @@ def _run(args):
 
 
 def _slurm(args):
-    from .slurm import command
+    from .slurm.command import command
     return command(args)
 
 

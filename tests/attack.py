@@ -23,7 +23,7 @@ if str(ROOT) not in sys.path:
 import h5py  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ensemble import lock  # noqa: E402
+from ensemble.run import lock  # noqa: E402
 from ensemble.model.workspace import Workspace  # noqa: E402
 from ensemble.store import reader, schema  # noqa: E402
 from ensemble.store.errors import CatalogError  # noqa: E402
@@ -495,13 +495,13 @@ ATTACKS = {
            ("ensemble.store.create:create_layout", 1, "parallel"),
            ("ensemble.store.files:reserve_space", 0, "parallel"),
            ("ensemble.store.create:create_layout", 0, "rank0"),
-           ("ensemble.parallel:Coordinator.__init__", 1, "parallel"),
+           ("ensemble.run.parallel:Coordinator.__init__", 1, "parallel"),
            ("ensemble.store.writers:ParallelWriter.close", 1, "parallel"),
            ("ensemble.store.writers:Rank0Writer.close", 1, "rank0"),
-           ("ensemble.parallel:Coordinator.close", 0, "parallel"),
-           ("ensemble.runner:_compile_kernels", 1, "parallel"))},
+           ("ensemble.run.parallel:Coordinator.close", 0, "parallel"),
+           ("ensemble.run.runner:_compile_kernels", 1, "parallel"))},
     "mpi: a spin-up fails on the rank that takes it (run.branch)": one_rank_fails(
-        "ensemble.runner:TaskRunner.spin_up", -1, "parallel", branch=True),
+        "ensemble.run.worker:TaskRunner.spin_up", -1, "parallel", branch=True),
 }
 
 

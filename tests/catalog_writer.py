@@ -8,8 +8,8 @@ from ensemble.store import schema, writers
 from ensemble.store.checkpoint import Checkpoint, carries_creep
 from ensemble.config import loads
 from ensemble.model.workspace import Workspace
-from ensemble.runner import integrator_text
-from ensemble.tasks import task_list
+from ensemble.run.trajectory import integrator_text
+from ensemble.run.tasks import task_list
 
 
 def write_events(path, config_text, parts, streams=None):

@@ -54,16 +54,16 @@ def fail_on_rank(rank, after_calls=1):
     """Raise a RuntimeError (a bug, not a numerical failure) on one MPI rank once it has run a while."""
     from mpi4py import MPI
 
-    from ensemble import runner
+    from ensemble.run import worker
     calls = [0]
-    original = runner.event_rows
+    original = worker.event_rows
 
     def patched(*args):
         calls[0] += 1
         if MPI.COMM_WORLD.Get_rank() == rank and calls[0] > after_calls:
             raise RuntimeError("injected failure")
         return original(*args)
-    runner.event_rows = patched
+    worker.event_rows = patched
 
 
 def _signal_self(signum):
@@ -88,8 +88,8 @@ def signal_at_write(signum, what="write /events/task", nth=1):
 def signal_when_paused(signum):
     """Send this process `signum` when a kernel call first ends inside an event (the work budget
     spent) after the transient: the stop then checkpoints while an event is paused."""
-    from ensemble import runner
-    advance = runner.Trajectory.advance
+    from ensemble.run import trajectory
+    advance = trajectory.Trajectory.advance
     sent = [False]
 
     def patched(self, n, *args, **kwargs):
@@ -98,15 +98,15 @@ def signal_when_paused(signum):
             sent[0] = True
             _signal_self(signum)
         return out
-    runner.Trajectory.advance = patched
+    trajectory.Trajectory.advance = patched
 
 
 def signal_when_creeping(signum, paused=False):
     """Send this process `signum` when a kernel call first ends with blocks creeping (a creep episode in
     flight; paused: and an event paused too) after the transient: the stop then checkpoints the creep state."""
-    from ensemble import runner
+    from ensemble.run import trajectory
     from ensemble.model.workspace import CS_NCREEP
-    advance = runner.Trajectory.advance
+    advance = trajectory.Trajectory.advance
     sent = [False]
 
     def patched(self, n, *args, **kwargs):
@@ -116,28 +116,29 @@ def signal_when_creeping(signum, paused=False):
             sent[0] = True
             _signal_self(signum)
         return out
-    runner.Trajectory.advance = patched
+    trajectory.Trajectory.advance = patched
 
 
 def count_pauses(path, first_budget=None):
     """Write to `path`, at exit, how many kernel calls ended inside an event (the work budget spent).
 
-    first_budget replaces runner.FIRST_BUDGET, the budget of a task's first call, so that a run
+    first_budget replaces worker.FIRST_BUDGET, the budget of a task's first call, so that a run
     whose events are all cheaper than the default (250k block-steps) pauses as well.
     """
     import atexit
 
-    from ensemble import runner
+    from ensemble.run import trajectory
+    from ensemble.run import worker
     if first_budget is not None:
-        runner.FIRST_BUDGET = first_budget
-    advance = runner.Trajectory.advance
+        worker.FIRST_BUDGET = first_budget
+    advance = trajectory.Trajectory.advance
     paused = [0]
 
     def patched(self, n, *args, **kwargs):
         out = advance(self, n, *args, **kwargs)
         paused[0] += self.ws.paused
         return out
-    runner.Trajectory.advance = patched
+    trajectory.Trajectory.advance = patched
 
     def write():
         with open(path, "w") as fh:
@@ -148,8 +149,8 @@ def count_pauses(path, first_budget=None):
 def hold(ready, go, rank=0, seconds=300):
     """Hold the run at its first kernel call (on MPI rank `rank`; the lock is taken, the catalog
     open) until the file `go` exists, after creating `ready`; a RuntimeError after `seconds`."""
-    from ensemble import runner
-    advance = runner.Trajectory.advance
+    from ensemble.run import trajectory
+    advance = trajectory.Trajectory.advance
     held = [False]
 
     def patched(self, *args, **kwargs):
@@ -164,12 +165,12 @@ def hold(ready, go, rank=0, seconds=300):
                         raise RuntimeError(f"held for {seconds} s: {go} never appeared")
                     time.sleep(0.05)
         return advance(self, *args, **kwargs)
-    runner.Trajectory.advance = patched
+    trajectory.Trajectory.advance = patched
 
 
 def signal_after_rename(signum):
     """Send this process `signum` right after the run renames its finished catalog."""
-    from ensemble import runner
+    from ensemble.run import runner
     replace = os.replace
 
     def patched(src, dst):
@@ -180,8 +181,8 @@ def signal_after_rename(signum):
 
 def signal_in_spin_up(signum, point, after_events):
     """Send this process `signum` once the spin-up of `point` has run `after_events` events."""
-    from ensemble import runner
-    advance = runner.Trajectory.advance
+    from ensemble.run import trajectory
+    advance = trajectory.Trajectory.advance
     sent = [False]
 
     def patched(self, *args, **kwargs):
@@ -190,19 +191,19 @@ def signal_in_spin_up(signum, point, after_events):
             sent[0] = True
             _signal_self(signum)
         return out
-    runner.Trajectory.advance = patched
+    trajectory.Trajectory.advance = patched
 
 
 def fail_spin_up(point, after_events=1):
     """Make the spin-up of `point` fail numerically once it has run `after_events` events."""
-    from ensemble import runner
-    advance = runner.Trajectory.advance
+    from ensemble.run import trajectory
+    advance = trajectory.Trajectory.advance
 
     def patched(self, *args, **kwargs):
         if self.label == f"spin-up of point {point}" and self.done >= after_events:
-            raise runner.SimulationError(f"{self.label} event {self.done}: injected failure")
+            raise trajectory.SimulationError(f"{self.label} event {self.done}: injected failure")
         return advance(self, *args, **kwargs)
-    runner.Trajectory.advance = patched
+    trajectory.Trajectory.advance = patched
 
 
 def main(argv):

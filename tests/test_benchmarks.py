@@ -386,8 +386,8 @@ def test_decorrelation_forces_are_read_at_one_time():
     block's own time), as Trajectory.state gives them at the trajectory's clock."""
     from benchmarks.decorrelation import Follower
     from ensemble.config import Config, Run
-    from ensemble.runner import Trajectory
-    from ensemble.tasks import task_list
+    from ensemble.run.trajectory import Trajectory
+    from ensemble.run.tasks import task_list
     cfg = Config(model=Model(N=40, b=20.0), run=Run(seeds=1))
     task = task_list(cfg)[0]
     traj = Trajectory(cfg, task)
@@ -411,8 +411,8 @@ def test_decorrelation_unperturbed_branch_continues_the_trajectory():
     exactly; one with a perturbation starts its first event later (forces only lowered)."""
     from benchmarks.decorrelation import branched
     from ensemble.config import Config, Run
-    from ensemble.runner import Trajectory
-    from ensemble.tasks import branch_rng, task_list
+    from ensemble.run.trajectory import Trajectory
+    from ensemble.run.tasks import branch_rng, task_list
     cfg = Config(model=Model(N=40, b=20.0), run=Run(seeds=2))
     tasks = task_list(cfg)
     traj = Trajectory(cfg, tasks[0])

@@ -142,8 +142,8 @@ def test_resume_with_creep_in_flight_gives_the_uninterrupted_catalog(creeping, t
     its creep state, and the resumed catalog is the uninterrupted one, row for row."""
     d, cfg = creeping
     out = tmp_path / "cut.h5"
-    # kernel calls of 1000 block-steps (runner.MIN_BUDGET) from the first on: most events pause many times
-    setup = (f"from ensemble import runner; runner.FIRST_BUDGET = 1000; "
+    # kernel calls of 1000 block-steps (worker.MIN_BUDGET) from the first on: most events pause many times
+    setup = (f"from ensemble.run import worker; worker.FIRST_BUDGET = 1000; "
              f"inject.signal_when_creeping({int(signal.SIGTERM)}, paused={paused})")
     res = injected(setup, "run", cfg, "-o", out, "--set", "run.poll_seconds=1e-5")
     assert res.returncode == 75, res.stdout + res.stderr
@@ -194,8 +194,8 @@ def test_a_checkpoint_packs_its_creep_state_and_a_slot_of_another_size_is_refuse
     from mpi4py import MPI
 
     from ensemble.config import loads
-    from ensemble.runner import integrator_text
-    from ensemble.tasks import task_list
+    from ensemble.run.trajectory import integrator_text
+    from ensemble.run.tasks import task_list
     cfg = loads(f"[model]\nN = {n}\nb = 15.0\n[run]\nevents = 4\ntransient = 0\n")
     assert carries_creep(cfg.model) and not carries_creep(loads("[model]\nN = 5\n").model)
     writer = writers.Rank0Writer(str(tmp_path / "c.h5"), MPI.COMM_SELF, cfg, task_list(cfg),
@@ -218,8 +218,8 @@ def test_unperturbed_branches_carry_the_spun_up_creep_state(tmp_path):
     spin-up is made to end with a block creeping (the first such row count, found by running the chain
     here), so the branches need its creep state, not only its forces and states."""
     from ensemble.config import loads
-    from ensemble.runner import Trajectory
-    from ensemble.tasks import task_list
+    from ensemble.run.trajectory import Trajectory
+    from ensemble.run.tasks import task_list
     run = {"seeds": 2, "events": 100, "transient": 40, "branch": True, "decorrelation": 20, "perturbation": 0.0}
     cfg = write_config(tmp_path / "branch.toml", model={"N": 50, "b": CREEPING}, run=run,
                        integrator={"method": "ark4"})
@@ -254,8 +254,8 @@ def test_a_record_laid_out_for_another_kernel_is_not_continued(tmp_path, monkeyp
     from mpi4py import MPI
 
     from ensemble.config import loads
-    from ensemble.runner import integrator_text
-    from ensemble.tasks import task_list
+    from ensemble.run.trajectory import integrator_text
+    from ensemble.run.tasks import task_list
     cfg = loads("[model]\nN = 5\nb = 15.0\n[run]\nevents = 4\ntransient = 0\n")
     path = str(tmp_path / "c.h5")
     writers.Rank0Writer(path, MPI.COMM_SELF, cfg, task_list(cfg), integrator_text(cfg.integrator)).close()

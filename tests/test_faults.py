@@ -17,7 +17,7 @@ import h5py
 import numpy as np
 import pytest
 
-from ensemble import lock
+from ensemble.run import lock
 from ensemble.store import reader, schema
 from ensemble.store.errors import CatalogError
 from ensemble.store.files import partial_path

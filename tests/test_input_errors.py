@@ -394,7 +394,7 @@ class OneRank:
 
 
 def test_run_guarded_codes_and_messages(capsys):
-    from ensemble.abort import on_root, run_guarded
+    from ensemble.run.abort import on_root, run_guarded
     codes = {ConfigError: 2, summary.SummaryError: 1}
 
     def body(error):

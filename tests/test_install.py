@@ -19,7 +19,8 @@ import sys
 import pytest
 
 from ensemble import kernel_cache
-from ensemble.slurm import JobOptions, render
+from ensemble.slurm.options import JobOptions
+from ensemble.slurm.render import render
 
 from .conftest import write_config
 from .processes import ROOT, child_env, run_bounded

@@ -27,7 +27,7 @@ TIMEOUT = 300           # seconds for one run, the reference's compilation inclu
 # at the reference commit)
 INTEGRATORS = {"rk4": {"method": "rk4", "dt": 5e-4}, "ark4": {"method": "ark4", "rtol": 1e-5}}
 FIRST_BUDGET = 1_000    # block-steps: the paused run pauses from its first large event on
-POLL_SECONDS = 1e-5     # ... and every call after that stays at runner.MIN_BUDGET
+POLL_SECONDS = 1e-5     # ... and every call after that stays at worker.MIN_BUDGET
 
 
 @pytest.fixture(scope="module")

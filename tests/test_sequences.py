@@ -67,7 +67,7 @@ FIRST_SLIP_RTOL = {"rk4": 1e-9, "ark4": 1e-6}
 
 
 def initial_state(tasks, attrs, k):
-    """(u, theta) at t = 0 of task k from the catalog: the documented seeding, not ensemble.tasks."""
+    """(u, theta) at t = 0 of task k from the catalog: the documented seeding, not ensemble.run.tasks."""
     run = tomllib.loads(attrs["config"])["run"]
     rng = np.random.default_rng(np.random.SeedSequence(int(tasks["seed_entropy"][k]),
                                                        spawn_key=(int(tasks["spawn_key"][k]),)))

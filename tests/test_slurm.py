@@ -21,8 +21,10 @@ from analysis import summary
 from ensemble.store import reader
 from ensemble.config import load, loads
 from ensemble import environment
-from ensemble.slurm import (KINDS, PLACEHOLDER, PLACEHOLDERS, TEMPLATES, JobOptions, SlurmError,
-                            element_seed, fill, python_stack, render, time_seconds)
+from ensemble.slurm.kinds import KINDS, element_seed
+from ensemble.slurm.options import JobOptions, SlurmError, time_seconds
+from ensemble.slurm.render import PLACEHOLDER, PLACEHOLDERS, TEMPLATES, fill, render
+from ensemble.slurm.stack import python_stack
 
 from .conftest import write_config
 from .processes import child_env, poll_until, run_bounded

@@ -1,7 +1,7 @@
 """Numba kernels of the Burridge-Knopoff chain with rate- and state-dependent friction.
 
 Kernels are pure: arrays, scalars and the parameter record (params.py) in, arrays out. Nothing here knows about
-config objects, files, MPI or HDF5 (see ensemble.runner for the wrapper).
+config objects, files, MPI or HDF5 (see ensemble.run.trajectory for the wrapper).
 
 Numba's on-disk cache only notices changes to the file of the cached function
 itself, not to the kernels it calls from other files; a stale cache would run

@@ -2,15 +2,15 @@
 
 Each parameter point is spun up once (tasks.spinups: from its seed 0's initial state, run.transient
 events); its tasks then start from that state, each perturbed by its own stream (tasks.perturb,
-tasks.branch_rng). The runner (runner.py) runs the spin-ups first, then the tasks.
+tasks.branch_rng). The runner (runner.py, worker.py) runs the spin-ups first, then the tasks.
 """
 from dataclasses import dataclass
 
 import numpy as np
 
-from .store.checkpoint import Checkpoint
-from .store.schema import FAILED, OPEN
-from .model.workspace import CR_EP, CR_KEEP
+from ..store.checkpoint import Checkpoint
+from ..store.schema import FAILED, OPEN
+from ..model.workspace import CR_EP, CR_KEEP
 from .tasks import Task, branch_rng, perturb, point_tasks, spinups
 
 

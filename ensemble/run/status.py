@@ -11,10 +11,10 @@ import os
 import numpy as np
 
 from . import lock
-from .store import reader, schema
-from .store.errors import CatalogError
-from .store.files import partial_path
-from .config import loads
+from ..store import reader, schema
+from ..store.errors import CatalogError
+from ..store.files import partial_path
+from ..config import loads
 
 RESUME = "python -m ensemble resume"
 

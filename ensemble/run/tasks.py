@@ -5,8 +5,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .config import Model
-from .model import laws
+from ..config import Model
+from ..model import laws
 
 
 @dataclass(frozen=True)

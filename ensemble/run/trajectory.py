@@ -1,0 +1,102 @@
+"""One task's chain between events: the thin wrapper that turns a config into the kernel's arrays.
+
+The kernels (ensemble.model) see arrays and numbers only; a Trajectory holds a task's workspace, its
+clock and its event counter, builds the kernels' parameter record once (integrators.kernel_params) and
+calls chain.simulate. event_rows turns the kernel's output into the catalog's columns; integrator_text
+and parse_integrator are a task's [integrator] as the catalog stores it.
+"""
+import tomllib
+
+import numpy as np
+
+from ..config import ConfigError, from_dict, section_lines
+from ..integrators import kernel_params
+from ..model.chain import simulate
+from ..model.workspace import (D_DURATION, D_ENDING, D_FIRST, D_KIND, D_LAST, D_NSLIP, D_SLIP, NDIAG, OK, PAUSED,
+                               STATUS_TEXT, UNLIMITED, Workspace)
+from ..store.checkpoint import Checkpoint, carries_creep
+from ..store.errors import CatalogError
+from .tasks import initial_state
+
+
+class SimulationError(RuntimeError):
+    """A task that cannot go on; the message names the task and the event."""
+
+
+class Trajectory:
+    """One task's chain between events: its workspace, clock and event counter."""
+
+    def __init__(self, cfg, task, checkpoint=None, integrator=None, label=None, discarded=None):
+        self.cfg = cfg
+        self.task = task
+        self.label = f"task {task.index}" if label is None else label     # in error messages
+        self.discarded = cfg.run.discarded if discarded is None else discarded
+        self.integrator = cfg.integrator if integrator is None else integrator
+        self.ws = Workspace(task.model.N)
+        # a chain that can creep keeps its creep phase's state in its checkpoints (store/checkpoint.py)
+        self.creeps = carries_creep(task.model)
+        if checkpoint is None:
+            self.ws.load(*initial_state(cfg, task))
+            self.clock = np.zeros(2)
+            self.done = 0      # rows completed (events and creep episodes), transient included
+        else:
+            self.ws.load(checkpoint.force, checkpoint.psi, checkpoint.since, creep=checkpoint.creep)
+            self.clock = checkpoint.clock.copy()
+            self.done = checkpoint.done
+        self.params = kernel_params(task.model, self.integrator)
+
+    def checkpoint(self):
+        """The state after the last completed event (also while an event is paused; the creep state is
+        that of the same moment, Workspace.creep_state)."""
+        force, psi, since, clock = self.ws.between_events(self.clock)
+        return Checkpoint(force, psi, since, clock, self.done, self.ws.creep_state() if self.creeps else None)
+
+    def state(self):
+        """(force, psi) of every block now (between events), c-free frame."""
+        return self.ws.state(self.clock, self.params)
+
+    def advance(self, n, budget=UNLIMITED):
+        """Run n events; returns (onset times, epicenters, diagnostics rows).
+
+        With a work `budget` (chain.simulate) fewer events may be returned: the call stops
+        when the budget is spent, possibly in the middle of an event, which the next call continues.
+        """
+        t = np.empty(n)
+        epicenter = np.empty(n, dtype=np.int64)
+        diag = np.empty((n, NDIAG))
+        ws = self.ws
+        status, k = simulate(ws.arrays, self.clock, self.params, n, budget, t, epicenter, diag)
+        if status not in (OK, PAUSED):
+            where = self.done + k
+            phase = "transient " if where < self.discarded else ""
+            raise SimulationError(f"{self.label} {phase}event {where}: {STATUS_TEXT[status]} "
+                                  f"(method={self.integrator.method}, dt={self.integrator.dt}, "
+                                  f"rtol={self.integrator.rtol})")
+        self.done += k
+        return t[:k], epicenter[:k], diag[:k]
+
+
+def event_rows(task, t, epicenter, diag):
+    """Kernel output -> catalog columns (EVENT_FIELDS, ensemble/store/schema.py)."""
+    first = diag[:, D_FIRST].astype(np.int64)
+    last = diag[:, D_LAST].astype(np.int64)
+    return {
+        "task": np.full(len(t), task.index, dtype=np.int64), "t": t, "epicenter": epicenter,
+        "mu": np.log10(diag[:, D_SLIP]), "slip": diag[:, D_SLIP], "first": first, "last": last,
+        "n_slipped": diag[:, D_NSLIP].astype(np.int64),
+        "boundary": (first == 0) | (last == task.model.N - 1), "duration": diag[:, D_DURATION],
+        "kind": diag[:, D_KIND].astype(np.int8), "ending": diag[:, D_ENDING].astype(np.int8),
+    }
+
+
+def integrator_text(integrator):
+    """A task's [integrator] as TOML text (stored per task in the catalog)."""
+    return "\n".join(section_lines(integrator))
+
+
+def parse_integrator(text, where):
+    """The inverse of integrator_text, validated like a config."""
+    try:
+        return from_dict({"integrator": tomllib.loads(text)}).integrator
+    except (tomllib.TOMLDecodeError, ConfigError) as err:
+        raise CatalogError(f"{where}: stored integrator cannot be read ({err})") from None
