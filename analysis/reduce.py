@@ -263,7 +263,20 @@ def point_statistics(per_task, task_ids, opt, rng, layout=LAYOUT, n_blocks=None)
     samples = None
     if m >= 2:   # as stats.bootstrap, with the picks for the samples
         picks = rng.integers(0, m, size=(opt.bootstrap, m))
-        samples = np.array([estimate(flat[p].sum(axis=0), p) for p in picks])
+        need = layout.drawn(opt)
+        if need:   # a resample sums only the entries its numbers and curves read (the same sums, in the same order)
+            drawn = np.concatenate([np.arange(cut.start, cut.stop) if name not in need else cut.start + need[name]
+                                    for name, cut in where]) if where else np.zeros(0, np.int64)
+            sub = np.ascontiguousarray(flat[:, drawn])
+
+            def resample(p):
+                row = np.full(flat.shape[1], np.nan)
+                row[drawn] = sub[p].sum(axis=0)
+                return row
+        else:
+            def resample(p):
+                return flat[p].sum(axis=0)
+        samples = np.array([estimate(resample(p), p) for p in picks])
     sums = split(flat.sum(axis=0), range(m))
     each = curves(sums)
     est = np.concatenate([*each, numbers(sums)])

@@ -183,3 +183,27 @@ def test_report_plot_and_export_show_the_seismicity(tmp_path):
     text = (tmp_path / "tables" / "seismicity.csv").read_text()
     rows = [line for line in text.splitlines() if not line.startswith("#")]
     assert rows[0].startswith("point,") and len(rows) == 1 + 2 * 16 * 10
+
+
+def test_a_resample_sums_only_the_cells_the_numbers_read_and_gives_the_same_intervals(tmp_path):
+    """The bootstrap draws only the map's cells that the seismicity's numbers read (Statistic.drawn): every
+    number, curve and interval is the same as when every cell is drawn, to the last bit."""
+    import dataclasses
+
+    from analysis import merge
+    from analysis.statistics import Layout
+
+    cat = gunzip(CATALOG, tmp_path / "catalog.h5")
+    opt = options(blocks=5, bootstrap=200)
+    inputs = merge.read([str(cat)])
+    params, rows = inputs.points[0]
+    per_task = reduce.reduce_tasks(str(cat), [int(inputs.tasks["catalog_task"][g]) for g in rows], opt)
+    ids = sorted(per_task)
+    every = Layout(tuple(dataclasses.replace(s, drawn=None) for s in reduce.LAYOUT.statistics))
+    assert reduce.LAYOUT.drawn(opt) and not every.drawn(opt)
+    subset = reduce.point_statistics(per_task, ids, opt, merge.bootstrap_rng(0, params))
+    whole = reduce.point_statistics(per_task, ids, opt, merge.bootstrap_rng(0, params), layout=every)
+    assert np.isfinite(subset["numbers"][:, 1]).any()
+    np.testing.assert_array_equal(subset["numbers"], whole["numbers"])
+    for a, b in zip(subset["curves"], whole["curves"]):
+        np.testing.assert_array_equal(a, b)

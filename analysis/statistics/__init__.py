@@ -94,6 +94,9 @@ class Statistic:
     extra: Optional[Callable] = None
     extra_datasets: dict = field(default_factory=dict)   # /points/<name>: (unit, shape, meaning) of extra's
     sets: tuple = ("reduce",)       # the commands that reduce with it ("reduce": the summary; "compare")
+    # opt -> {histogram table: the entries its numbers read}: a resample sums only those (default: all; the
+    # others are NaN in the resample's tables, so reading one shows); the estimate of all units has every entry
+    drawn: Optional[Callable] = None
 
 
 def _discover():
@@ -144,6 +147,11 @@ class Layout:
         self._column = {(table, name): i for table, names in self.columns.items() for i, name in enumerate(names)}
         self.chain_bins = {t.bins: t.chain_edges for t in self.tables.values() if t.chain_edges is not None}
         self.samples = [name for name, t in self.tables.items() if t.sample]
+
+    def drawn(self, opt):
+        """{table: the entries a resample needs} of the tables whose statistic names them (Statistic.drawn)."""
+        return {table: np.asarray(idx, dtype=np.int64) for s in self.statistics if s.drawn is not None
+                for table, idx in s.drawn(opt).items()}
 
     def width(self, table, edges):
         """Entries per unit of `table`: its bins (of a 2-d histogram, their product), or its columns."""

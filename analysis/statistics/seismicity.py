@@ -193,6 +193,14 @@ def estimate(u, opt):
                 rate(u, cells["before", "near"]) / rate(u, cells["before", "ring"])]
 
 
+def drawn(opt):
+    """The cells of the map that the numbers read (a resample sums no other)."""
+    cells = np.unique(np.concatenate(list(_regions(tuple(opt.seis_time_edges), tuple(opt.seis_distance_edges),
+                                                   opt.seis_near, opt.seis_ring, opt.seis_short,
+                                                   opt.seis_long).values())))
+    return {"seis_pairs": cells, "seis_exposure": cells}
+
+
 def rate_map(units, opt, rng):
     """The map of a point: its summed counts over its summed exposures, (time bins, distance bins)."""
     nt, nd = len(opt.seis_time_edges) - 1, len(opt.seis_distance_edges) - 1
@@ -226,7 +234,7 @@ STATISTIC = Statistic(
                                              "active ring)", "quiescence ratio"),
              Number("doughnut_ratio", "1", "the same ratio just before the onset, in [-seis_short, 0)",
                     "doughnut ratio")),
-    feed=feed, estimate=estimate, extra=rate_map,
+    feed=feed, estimate=estimate, extra=rate_map, drawn=drawn,
     extra_datasets={"seismicity_rate": (RATE, "(points, seis_time bins, seis_distance bins)",
                                         "events per mainshock per block per unit T nu at (time from the mainshock's "
                                         "onset, distance from its epicenter); NaN where nothing was exposed")})
