@@ -62,3 +62,22 @@ print("ok")
 def test_a_key_added_to_the_declaration_is_accepted_checked_and_described():
     res = run_bounded([sys.executable, "-c", ADDED], 120, cwd=ROOT, env=child_env(PYTHONPATH=str(ROOT)))
     assert res.returncode == 0 and res.stdout.strip() == "ok", res.stdout + res.stderr
+
+
+def test_the_readme_states_every_key_with_its_declared_default():
+    """The README's config table names every [integrator] key, with the default KEYS declares (the method's
+    default is the law's, said in words)."""
+    import re
+    readme = (ROOT / "README.md").read_text()
+    stated = {}
+    for row in readme.splitlines():
+        cells = [c.strip() for c in row.strip().strip("|").split("|")]
+        keys = re.findall(r"`integrator\.(\w+)`", cells[0])
+        if not keys or len(cells) < 3:
+            continue
+        for key, default in zip(keys, cells[1].split(",")):
+            stated[key] = default.strip()
+    assert set(stated) == set(KEYS), set(stated) ^ set(KEYS)
+    for key, text in stated.items():
+        if key != "method":
+            assert float(text) == KEYS[key].default, (key, text, KEYS[key].default)
