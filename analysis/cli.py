@@ -63,6 +63,7 @@ NUMERIC = {
     "seed": lambda v: checks.count("--seed", v, lo=0, hi=2 ** 63 - 1),   # stored as an HDF5 int64
     "n_large": lambda v: checks.count("--n-large", v, lo=2, hi=10 ** 9),
     "n_min": lambda v: checks.count("--n-min", v, lo=1, hi=10 ** 9),
+    "region_span": lambda v: checks.number("--region-span", v, 0.0, 1e300, exclusive=True),
 }
 
 
@@ -124,6 +125,10 @@ def _parser():
     r.add_argument("--seed", default=0,
                    help="seed of the bootstrap; a point's resamples are drawn from it and the "
                         "point's parameters (default 0)")
+    r.add_argument("--region", action="store_true",
+                   help="pool each population's faults into its region over a common window of loading, each fault "
+                        "in proportion to its event rate; intervals resample faults (analysis/region.py)")
+    r.add_argument("--region-span", help="the window's span, T*nu (default: the shortest fault's)")
     r.add_argument("--force", action="store_true", help="overwrite an existing summary")
     pl = sub.add_parser("plot", help="summaries -> figure (their points overlaid)")
     pl.add_argument("summaries", nargs="+", metavar="summary",
@@ -247,7 +252,10 @@ def _prepare(args):
     """Options, output path, and the catalogs' task table (merge.Inputs); every check before the work."""
     check_numbers(args)                      # every option before any file is read
     out = check_summary_output(args.output or _default_output(args.catalogs), args.catalogs, args.force)
-    inputs = merge.read(args.catalogs, allow_partial=args.partial)   # checks each file's kind first
+    if args.region_span is not None and not args.region:
+        raise checks.UsageError("--region-span is the window of a regional reduction: give --region too")
+    # (checks each file's kind first)
+    inputs = merge.read(args.catalogs, allow_partial=args.partial, region=args.region, span=args.region_span)
     scale = _scales(args, inputs)
     opt = Options(parse_bins(scale["mu_bins"], "--mu-bins"), parse_bins(scale["tnu_bins"], "--tnu-bins"),
                   scale["mu_c"], args.window, scale["b_cut"], args.bootstrap, args.level, args.blocks, args.seed,
@@ -286,20 +294,23 @@ def _reduce_on(comm, args):
     _check_counts(inputs, per_task)
     points = []
     for params, ids in inputs.points:
-        result = point_statistics(per_task, ids, opt, merge.bootstrap_rng(opt.seed, params))
+        result = point_statistics(per_task, ids, opt, merge.bootstrap_rng(opt.seed, params),
+                                  whole="faults" if args.region else "seeds")
         result["params"] = params
         points.append(result)
+    for line in inputs.warnings:
+        print(f"warning: {line}", file=sys.stderr)
     summary.write(out, inputs, per_task, points, opt, force=args.force)
     if inputs.partial:
         print(inputs.partial)
     for i, p in enumerate(points):
         why = unreliable(p["units"], p["method"])
         if why:
-            print(f"warning: point {i} ({p['params']['law']}: "
-                  f"{', '.join(f'{k} = {v:g}' for k, v in p['params'].items() if k != 'law' and v == v)}): {why}",
-                  file=sys.stderr)
+            what = (f"region {i} ({p['params']['region']})" if args.region else f"point {i} ({p['params']['law']}: "
+                    f"{', '.join(f'{k} = {v:g}' for k, v in p['params'].items() if k != 'law' and v == v)})")
+            print(f"warning: {what}: {why}", file=sys.stderr)
     methods = sorted({p["method"] for p in points})
-    print(f"wrote {out}: {len(points)} parameter points, {len(per_task)} tasks"
+    print(f"wrote {out}: {len(points)} {'regions' if args.region else 'parameter points'}, {len(per_task)} tasks"
           + (f" from {len(inputs.paths)} catalogs" if len(inputs.paths) > 1 else "")
           + "; intervals from "
           f"{opt.bootstrap} bootstrap resamples over {' / '.join(methods)}"

@@ -39,6 +39,10 @@ def legend_labels(summaries, names=None):
         if all(labels[a] != labels[b] or rows[a] == rows[b]
                for a in range(len(rows)) for b in range(a)):
             break
+    if any("points/region" in s for s in summaries):   # regions: their drawn keys, then what differs
+        regions = [s["points/region_label"][i] if "points/region" in s else "single fault" for s in summaries
+                   for i in range(len(s["points/N"]))]
+        labels = [f"{r}; {label}" if label else r for r, label in zip(regions, labels)]
     repeated = {r for r in rows if rows.count(r) > 1}
     labels = [f"{label} ({names[j]})" if r in repeated else label
               for label, r, j in zip(labels, rows, owner)]

@@ -27,6 +27,7 @@ from ensemble.store import reader, schema
 from ensemble.store.errors import CatalogError
 from ensemble.config import loads
 
+from . import region as regions
 from .reduce import LAYOUT, PARAMS, reduce_tasks
 
 
@@ -44,8 +45,12 @@ class Inputs:
       point                   the task's point in the summary (index into `points`)
       seed_entropy, spawn_key its stream (filled in for tasks that have not finished)
     points: [(parameters {name: value, "law": its law}, [rows of `tasks` in stream order])], first
-                            appearance order
+                            appearance order; of regions (read(region=True), analysis/region.py)
+                            [({"region": its text, "law": its law}, [rows of its faults])], and tasks has
+      window_start, window_end  each fault's window (model time)
     partial: "" for finished runs, else the one-line statement of what is missing
+    spans: {region: its window's span W (T nu)} (regions only)
+    warnings: one line each, said before the summary is written (regions: a transient too short)
     """
     paths: list
     configs: list
@@ -53,13 +58,18 @@ class Inputs:
     tasks: dict
     points: list
     partial: str
+    spans: dict = None
+    warnings: list = ()
 
 
 def bootstrap_rng(seed, params):
     """The bootstrap generator of the point with these parameters:
     SeedSequence(seed, spawn_key=(N, bits(l), bits(nu), bits(x) for each of its law's keys x in
     PARAMS order)), where bits(x) is the IEEE-754 binary64 pattern of x as an unsigned integer (for
-    the aging law: bits(a), bits(b), bits(c)). Keys of other laws (NaN) are left out."""
+    the aging law: bits(a), bits(b), bits(c)). Keys of other laws (NaN) are left out. A region's:
+    SeedSequence(seed, spawn_key=region.bootstrap_key(its text))."""
+    if "region" in params:
+        return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=regions.bootstrap_key(params["region"])))
     key = [int(params["N"])] + [int(np.float64(params[name]).view(np.uint64)) for name in PARAMS[1:]
                                 if not np.isnan(params[name])]
     return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=tuple(key)))
@@ -82,15 +92,17 @@ def _unfinished(path, tasks, per_task):
     return int(np.count_nonzero(open_)), str(path).endswith(".partial")
 
 
-def read(paths, allow_partial=False):
-    """Inputs of the catalogs at `paths`; every check is made here, before any work."""
+def read(paths, allow_partial=False, region=False, span=None):
+    """Inputs of the catalogs at `paths`; every check is made here, before any work. region: pool the faults
+    of each population into its region over a common window (analysis/region.py), of span `span` (T nu) if
+    given, else the shortest of its faults'."""
     paths = [str(p) for p in paths]
     for i, a in enumerate(paths):
         filekind.require(a, "catalog", CatalogError)
         for b in paths[:i]:
             if os.path.samefile(a, b):
                 raise MergeError(f"{a} is given twice (also as {b}): give each catalog once")
-    tables, configs, per_tasks, unfinished = [], [], [], []
+    tables, configs, per_tasks, unfinished, discarded = [], [], [], [], []
     for path in paths:
         with filekind.reading(path, "the event catalog", CatalogError):
             per_task, tasks, attrs = reader.read_tasks(path)
@@ -98,6 +110,7 @@ def read(paths, allow_partial=False):
         tables.append(tasks)
         configs.append(str(attrs["config"]))
         per_tasks.append(int(per_task))
+        discarded.append(int(attrs.get("transient", 0)))
         unfinished.append(_unfinished(path, tasks, per_task))
     partial = _partial_statement(paths, tables, per_tasks, unfinished)
     if partial and not allow_partial:
@@ -108,8 +121,10 @@ def read(paths, allow_partial=False):
             f"{path} is an unfinished run ({what}); continue it with `python -m ensemble resume "
             f"{path.removesuffix('.partial')}`, or reduce what it holds with --partial")
     tasks = _concatenate(tables)
-    points = _points(paths, tasks)
-    return Inputs(paths, configs, per_tasks, tasks, points, partial)
+    if region:
+        points, spans, warnings = regions.group(paths, configs, discarded, tasks, span)
+        return Inputs(paths, configs, per_tasks, tasks, points, partial, spans, warnings)
+    return Inputs(paths, configs, per_tasks, tasks, _points(paths, tasks), partial)
 
 
 def _concatenate(tables):
@@ -172,6 +187,8 @@ def reduce_share(inputs, rows, opt, layout=LAYOUT):
     for c, path in enumerate(inputs.paths):
         mine = [g for g in rows if inputs.tasks["catalog"][g] == c]
         if mine:
-            local = reduce_tasks(path, [int(inputs.tasks["catalog_task"][g]) for g in mine], opt, layout)
+            windows = ({int(inputs.tasks["catalog_task"][g]): (inputs.tasks["window_start"][g], inputs.tasks["window_end"][g])
+                        for g in mine} if "window_start" in inputs.tasks else None)
+            local = reduce_tasks(path, [int(inputs.tasks["catalog_task"][g]) for g in mine], opt, layout, windows)
             out.update({g: local[int(inputs.tasks["catalog_task"][g])] for g in mine})
     return out

@@ -24,7 +24,7 @@ from typing import Callable
 
 import numpy as np
 
-from ensemble.config import TRANSIENT_PER_BLOCK
+from ensemble.config import MEASURED_TRANSIENT_PER_BLOCK, TRANSIENT_PER_BLOCK
 
 from . import stats, summary
 from .reduce import LAYOUT, PARAMS
@@ -32,11 +32,6 @@ from .report import LABELS, count_text, events_per_point, level_text, partial_te
 
 PAPER_EVENTS = 200_000      # events the paper recorded per point (one trajectory, N = 800) ...
 PAPER_TRANSIENT = 10_000    # ... after discarding these
-# the longest transient measured from the random start, events per block (b = 50, N = 800: 1000
-# events; benchmarks/results/transient.txt, docs/benchmarks.md); the default run.transient is
-# TRANSIENT_PER_BLOCK = 8x this
-MEASURED_TRANSIENT_PER_BLOCK = 1.25
-
 # the committed full-size panels (docs/paper.md), in the order whose claims read their own panel;
 # a reduced run's numbers are set beside theirs
 FULL_SIZE = Path(__file__).resolve().parents[1] / "docs" / "paper"

@@ -28,9 +28,25 @@ from .report import count_text  # noqa: E402
 from .stats import centers  # noqa: E402
 
 
+def fault_densities(s, i):
+    """R(mu) of each fault of region i of a regional summary, from its own counts in its window, (faults, bins)."""
+    from .reduce import LAYOUT
+    rows = np.flatnonzero(s["tasks/point"] == i)
+    counts = s["per_task/mu"][rows].sum(axis=1)
+    n = s["per_task/numbers"][rows][:, :, LAYOUT.column("numbers", "n_events")].sum(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return counts / (n[:, None] * np.diff(s["bins/mu"])[None, :])
+
+
 def magnitude(summaries, ax, keys, labels):
     points = points_of(summaries)
     opened = False
+    faults = [(s, i) for s, i in points if "points/region" in s]
+    for n, (s, i) in enumerate(faults):   # a region's single faults beneath it, thin and grey
+        for k, curve in enumerate(fault_densities(s, i)):
+            shown = curve > 0
+            ax.plot(centers(s["bins/mu"])[shown], curve[shown], color="0.6", lw=0.5, alpha=0.5, zorder=1,
+                    label="single faults (in the window)" if n == k == 0 else None)
     for (s, i), label, color in zip(points, labels, palette(len(points))):
         opened |= band(ax, centers(s["bins/mu"]), s["points/mu_density"][i], s["points/mu_lo"][i],
                        s["points/mu_hi"][i], label, color, log=True, open_ends=True)

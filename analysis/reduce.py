@@ -168,8 +168,10 @@ def _creep_stretches(inertial, creep, before, row, written, rows, k):
     return ((row + np.flatnonzero(creep)) * k) // max(rows or 0, row + len(creep))
 
 
-def reduce_tasks(path, task_indices, opt, layout=LAYOUT):
-    """TaskHistograms for the given tasks of a catalog (one rank's share)."""
+def reduce_tasks(path, task_indices, opt, layout=LAYOUT, windows=None):
+    """TaskHistograms for the given tasks of a catalog (one rank's share). windows: {task: (start, end)}, the
+    rows of a task with start <= t < end only (a region's window: analysis/region.py); the attribute `rows` is
+    still every committed row read."""
     out = {}
     # the catalog checks the ranges of the rows as they stream (an epicenter outside the chain
     # would also overflow RecurrenceScanner's buffers) and each task's checksum after its last chunk
@@ -178,10 +180,33 @@ def reduce_tasks(path, task_indices, opt, layout=LAYOUT):
         for k in task_indices:
             # every row read once: reduce_task keeps the creep episodes out of R(mu) and the recurrences
             rows = int(tasks["events_written"][k])
-            out[k] = reduce_task(cat.task_events(k, opt.chunk), cat.count(k, schema.KIND_EVENT),
-                                 float(tasks["nu"][k]), int(tasks["N"][k]), opt, rows, layout)
+            if windows is None:
+                out[k] = reduce_task(cat.task_events(k, opt.chunk), cat.count(k, schema.KIND_EVENT),
+                                     float(tasks["nu"][k]), int(tasks["N"][k]), opt, rows, layout)
+            else:
+                start, end = windows[k]
+                t, kind = cat.column(k, "t"), cat.column(k, "kind")
+                inside = _inside(t, start, end)
+                out[k] = reduce_task(_within(cat.task_events(k, opt.chunk), start, end),
+                                     int(np.count_nonzero(inside & (kind == schema.KIND_EVENT))),
+                                     float(tasks["nu"][k]), int(tasks["N"][k]), opt, int(np.count_nonzero(inside)), layout)
             out[k].rows = rows
     return out
+
+
+def _inside(t, start, end):
+    """The onsets in a window: start <= t < end (analysis/region.py)."""
+    return (t >= start) & (t < end)
+
+
+def _within(parts, start, end):
+    """The rows of the chunks inside the window (every chunk is still read, and so verified)."""
+    for part in parts:
+        keep = _inside(part["t"], start, end)
+        if keep.all():
+            yield part
+        elif keep.any():
+            yield {name: column[keep] for name, column in part.items()}
 
 
 # -- per point ------------------------------------------------------------------------------
@@ -202,8 +227,8 @@ def unreliable(units, method):
             "its tasks (reduce --blocks stretches per task, each holding a few recurrences)")
 
 
-def _units(per_task, task_ids):
-    """Resampling units of a point: its tasks if it has at least MIN_UNITS, else the stretches
+def _units(per_task, task_ids, whole="seeds"):
+    """Resampling units of a point: its tasks (`whole`: seeds, or a region's faults) if it has at least MIN_UNITS, else the stretches
     of all its tasks (task by task, in task order). pack(name): the units of an additive table stacked
     (units, width); of a sample, a list of one array per unit (a task's stretches one after the other)."""
     stack = [per_task[k] for k in task_ids]
@@ -212,7 +237,7 @@ def _units(per_task, task_ids):
             if isinstance(stack[0][name], list):
                 return [np.concatenate(h[name]) for h in stack]
             return np.stack([h[name].sum(axis=0) for h in stack])
-        return pack, "seeds"
+        return pack, whole
 
     def pack(name):
         if isinstance(stack[0][name], list):
@@ -224,7 +249,7 @@ def _units(per_task, task_ids):
 UNIT_ARRAYS = tuple(LAYOUT.tables)
 
 
-def point_statistics(per_task, task_ids, opt, rng, layout=LAYOUT, n_blocks=None):
+def point_statistics(per_task, task_ids, opt, rng, layout=LAYOUT, n_blocks=None, whole="seeds"):
     """Merged densities and summary numbers of one parameter point, with bootstrap intervals, and each
     statistic's extras (the recurrence peaks). n_blocks: the chain's N (for bins of the chain's own).
 
@@ -232,7 +257,7 @@ def point_statistics(per_task, task_ids, opt, rng, layout=LAYOUT, n_blocks=None)
     are the sums of the drawn units', its samples the drawn units' values concatenated in the order drawn.
     Returns curves (est, lo, hi, the curves one after the other) and curve {name: (est, lo, hi)}, numbers
     (numbers, 3), method, units, sums (the summed tables of all units, samples concatenated), and the extras."""
-    pack, method = _units(per_task, task_ids)
+    pack, method = _units(per_task, task_ids, whole)
     names = [name for name in layout.tables if name not in layout.samples]
     units = {name: pack(name) for name in layout.tables}
     m = len(units[names[0]]) if names else len(units[layout.samples[0]])

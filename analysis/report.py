@@ -108,8 +108,13 @@ def table(s):
                      f"from -{a['seis_long']:g}; rates per mainshock per block per T*nu")
     lines.append("")
     for i in range(len(s["points/N"])):
-        lines.append(f"point {i}: " + point_label(s, i, list(PARAMS)) +
-                     f"  (resampling {s['points/method'][i]}, {s['points/units'][i]} units)")
+        if "points/region" in s:    # a regional reduction (analysis/region.py)
+            lines.append(f"region {i}: {s['points/region_label'][i]}; {point_label(s, i, list(PARAMS))}  (resampling "
+                         f"{s['points/method'][i]}, {s['points/units'][i]} units; window {s['points/region_span'][i]:.6g} "
+                         "T*nu per fault)")
+        else:
+            lines.append(f"point {i}: " + point_label(s, i, list(PARAMS)) +
+                         f"  (resampling {s['points/method'][i]}, {s['points/units'][i]} units)")
         if unreliable(s, i):
             lines.append(f"    WARNING: {unreliable(s, i)}")
         for name in NUMBERS:

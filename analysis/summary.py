@@ -126,8 +126,18 @@ DATASETS = {
        for name, (unit, _, meaning) in ((n, catalog_schema.DATASETS[f"tasks/{n}"]) for n in PARAMS)},
     "points/law": ("text", _POINTS, "friction law of the point's tasks (a point is a law and its parameters)"),
     "points/method": ("text", _POINTS, "resampling units of the intervals: 'seeds' (the point's tasks, "
-                                       f"when it has at least {MIN_UNITS}) or 'blocks' (the stretches of all its tasks)"),
+                                       f"when it has at least {MIN_UNITS}; 'faults' those of a region) or 'blocks' "
+                                       "(the stretches of all its tasks)"),
     "points/units": ("count", _POINTS, "resampling units of the point"),
+    # a regional reduction's (reduce --region, analysis/region.py): each point a region, its parameters those its
+    # faults share (NaN where drawn); method 'faults' resamples the region's faults
+    "points/region": ("text", _POINTS, "the region: its law, its [model] values not drawn, each drawn key's distribution"),
+    "points/region_label": ("text", _POINTS, "its drawn keys in a few words (legends, the report)"),
+    "points/region_span": ("model length", _POINTS, "the span W of the region's window (T nu): every fault's rows "
+                                                    "with t0 <= t < t0 + W / nu, t0 its first recorded onset"),
+    "tasks/window_start": ("model time", "(tasks,)", "start of the fault's window: the onset of its first recorded "
+                                                     "inertial event (regional reduction)"),
+    "tasks/window_end": ("model time", "(tasks,)", "end of the fault's window, excluded (regional reduction)"),
     **{f"points/{name}_{part}": (unit, _CURVE.format(variable), f"{what} of the {variable} of {whose}")
        for name, (_, variable, whose, unit) in CURVES.items()
        for part, what in (("density", "probability density"), ("lo", "lower interval end of the density"),
@@ -191,6 +201,10 @@ def write(path, inputs, per_task, points, opt, force=False):
         for name in PARAMS:
             h5[f"points/{name}"] = np.array([p["params"][name] for p in points])
         h5["points/law"] = np.array([p["params"]["law"] for p in points], dtype="S")
+        if inputs.spans:    # a regional reduction (analysis/region.py)
+            h5["points/region"] = np.array([p["params"]["region"].encode() for p in points], dtype="S")
+            h5["points/region_label"] = np.array([p["params"]["region_label"].encode() for p in points], dtype="S")
+            h5["points/region_span"] = np.array([inputs.spans[i] for i in range(len(points))])
         h5["points/method"] = np.array([p["method"] for p in points], dtype="S")
         h5["points/units"] = np.array([p["units"] for p in points])
         start = 0
@@ -232,6 +246,9 @@ def read(path):
             raise SummaryError(f"{path}: summary format {out['attrs'].get('format', '(none)')}, this version "
                                f"reads {' and '.join(READS)}; reduce the catalog again")
         out["points/method"] = np.array([m.decode() for m in out["points/method"]])
+        for name in ("points/region", "points/region_label"):
+            if name in out:
+                out[name] = np.array([x.decode() for x in out[name]])
     for name in PARAMS:   # a summary from before the friction-law registry: aging points, no other keys
         out.setdefault(f"points/{name}", np.full(len(out["points/N"]), np.nan))
     if "points/law" in out:

@@ -11,14 +11,15 @@ import math
 import tomllib
 from dataclasses import dataclass, field, fields
 
-from . import filekind
+from . import filekind, population as populations
 from .config_rules import ConfigError, check_overflow, coerce, from_set, point_values
 from .integrators import INTEGRATORS
 from .integrators import KEYS as INTEGRATOR_KEYS
 from .model import laws
-from .sections import SECTION_NAMES
+from .sections import POPULATION, SECTION_NAMES, SWEEP
 
-__all__ = ["Config", "ConfigError", "DECORRELATION_PER_BLOCK", "Integrator", "LAW_KEYS", "Model", "Output", "Run",
+__all__ = ["Config", "ConfigError", "DECORRELATION_PER_BLOCK", "Integrator", "LAW_KEYS", "MEASURED_TRANSIENT_PER_BLOCK",
+           "Model", "Output", "Run",
            "SECTIONS", "TRANSIENT_PER_BLOCK", "from_dict", "load", "loads", "parse_override", "replace",
            "section_lines"]
 
@@ -63,6 +64,9 @@ Model.__module__ = __name__
 # N = 800, 0.3-0.6 per block at N = 1600; benchmarks/transient.py, docs/benchmarks.md); 10 is eight
 # times the longest.
 TRANSIENT_PER_BLOCK = 10
+# the longest transient measured from the random start, events per block (b = 50, N = 800: 1000 events;
+# benchmarks/results/transient.txt, docs/benchmarks.md); TRANSIENT_PER_BLOCK is 8x this
+MEASURED_TRANSIENT_PER_BLOCK = 1.25
 # run.decorrelation's default, in events per block of the longest chain of the sweep: two branches of
 # one spun-up state are as different as two independent chains after at most 0.30 events per block
 # (220 events at N = 800, b = 50; median 0.1-0.15; benchmarks/decorrelation.py, docs/benchmarks.md);
@@ -117,6 +121,7 @@ class Config:
     run: Run = field(default_factory=Run)
     integrator: Integrator = field(default_factory=Integrator)
     output: Output = field(default_factory=Output)
+    population: object = None   # population.Population: each task a fault drawn from it (None: no population)
 
     def __post_init__(self):
         """Resolve run.transient and run.decorrelation left out: TRANSIENT_PER_BLOCK and
@@ -132,6 +137,8 @@ class Config:
         """The resolved config as TOML text (stored in every catalog)."""
         out = []
         for name, cls in SECTIONS.items():
+            if name == "run" and self.population is not None:
+                out += ["[population]", *self.population.to_toml(), ""]
             if name == "run" and self.sweep:
                 out.append("[sweep]")
                 out += [f"{k} = [{', '.join(_toml_value(v) for v in vals)}]" for k, vals in self.sweep]
@@ -151,6 +158,8 @@ def section_lines(section):
 
 
 def _toml_value(v):
+    if isinstance(v, populations.Draw):
+        return v.to_toml()
     if isinstance(v, bool):
         return "true" if v else "false"
     if isinstance(v, str):
@@ -174,25 +183,48 @@ def _section(name, raw, overridden):
     return cls(**given)
 
 
-def _sweep(raw, overridden):
+def _sweep(raw, overridden, law_keys):
     if not isinstance(raw, dict):
         raise ConfigError("[sweep] must be a table")
     types = {f.name: f.type for f in fields(Model)}
     out = []
-    for key, values in raw.items():
+    for key, values in _flat(raw):
         with from_set(overridden, "sweep", key):
+            if key.startswith(POPULATION + "."):
+                drawn = key.partition(".")[2]
+                if not isinstance(values, list) or not values:
+                    raise ConfigError(f"sweep.{key} must be a non-empty list of distributions, e.g. "
+                                      f'{key} = [{{distribution = "uniform", min = 20, max = 30}}, [40]], got {values!r}')
+                out.append((key, _distinct(key, tuple(populations.parse_draw(drawn, v, types, law_keys, f"sweep.{key}")
+                                                      for v in values))))
+                continue
             if key not in types or key == "law":
                 raise ConfigError(f"unknown key sweep.{key} (only [model] keys can be swept: "
                                   f"{', '.join(k for k in types if k != 'law')})")
             if not isinstance(values, list) or not values:
                 raise ConfigError(f"sweep.{key} must be a non-empty list of values, e.g. {key} = [20, 40] "
                                   f"(on the command line: --set 'sweep.{key}=[20, 40]'), got {values!r}")
-            coerced = tuple(coerce("model", key, v, types[key], where=f"sweep.{key}") for v in values)
-            repeated = [v for i, v in enumerate(coerced) if v in coerced[:i]]
-            if repeated:   # the points would be one point run twice, then pooled by the reduction
-                raise ConfigError(f"sweep.{key} lists {repeated[0]!r} more than once")
-            out.append((key, coerced))
+            out.append((key, _distinct(key, tuple(coerce("model", key, v, types[key], where=f"sweep.{key}")
+                                                  for v in values))))
     return tuple(out)
+
+
+def _flat(raw):
+    """The [sweep] table's (key, values): `population.N = [...]` in the file is a table `population` in
+    TOML, from --set a key "population.N"; both are the key "population.N"."""
+    for key, values in raw.items():
+        if key == POPULATION and isinstance(values, dict):
+            yield from ((f"{POPULATION}.{k}", v) for k, v in values.items())
+        else:
+            yield key, values
+
+
+def _distinct(key, values):
+    repeated = [v for i, v in enumerate(values) if v in values[:i]]
+    if repeated:   # the points would be one point run twice, then pooled by the reduction
+        shown = repeated[0].to_toml() if isinstance(repeated[0], populations.Draw) else repr(repeated[0])
+        raise ConfigError(f"sweep.{key} lists {shown} more than once")
+    return values
 
 
 def from_dict(raw, overridden=None):
@@ -201,12 +233,18 @@ def from_dict(raw, overridden=None):
     overridden: {(section, key): "section.key=value"} of the values that came from --set.
     """
     overridden = overridden or {}
-    allowed = set(SECTIONS) | {"sweep"}
+    allowed = set(SECTIONS) | {SWEEP, POPULATION}
     for name in raw:
         if name not in allowed:
             raise ConfigError(f"unknown section [{name}] (known: {', '.join(sorted(allowed))})")
     parts = {name: _section(name, raw.get(name, {}), overridden) for name in SECTIONS}
-    cfg = Config(sweep=_sweep(raw.get("sweep", {}), overridden), **parts)
+    law_keys = parts["model"].law_keys()
+    types = {f.name: f.type for f in fields(Model)}
+    population = (populations.parse(raw[POPULATION], types, law_keys, overridden, from_set)
+                  if POPULATION in raw else None)
+    sweep = _sweep(raw.get(SWEEP, {}), overridden, law_keys)
+    populations.check_run(population, sweep, parts["run"])
+    cfg = Config(sweep=sweep, population=population, **parts)
     if "method" not in raw.get("integrator", {}):      # the law's own (the resolved config records it)
         cfg = dataclasses.replace(cfg, integrator=dataclasses.replace(cfg.integrator,
                                                                       method=laws.get(cfg.model.law).method))

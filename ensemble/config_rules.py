@@ -106,8 +106,15 @@ def from_set(overridden, section, key):
 
 def point_values(cfg, name):
     """Every value a key ("model.b", "run.init_stress") takes over the parameter points of a config
-    (config.Config), and the name to give it ("sweep.b" if swept)."""
+    (config.Config), and the name to give it ("sweep.b" if swept); of a key a population draws, the
+    extremes of its distributions ("population.b")."""
     section, key = name.split(".")
+    if section == "model" and cfg.population is not None:
+        # a swept spec replaces the [population] one at its points
+        specs = ([d for swept, vals in cfg.sweep if swept == f"population.{key}" for d in vals]
+                 or [d for k, d in cfg.population.draws if k == key])
+        if specs:
+            return f"population.{key}", tuple(v for d in specs for v in d.bounds())
     for swept, vals in cfg.sweep:
         if section == "model" and swept == key:
             return f"sweep.{key}", vals

@@ -17,7 +17,7 @@ import os
 import stat
 from contextlib import contextmanager
 
-from .sections import SECTION_NAMES, SWEEP
+from .sections import POPULATION, SECTION_NAMES, SWEEP
 
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 CATALOG_FORMAT_PREFIX = "bk-catalog-"
@@ -128,7 +128,7 @@ def _text_kind(head):
         doc = tomllib.loads(head.decode("utf-8"))
     except (UnicodeDecodeError, tomllib.TOMLDecodeError):
         return "other", ""
-    if doc and set(doc) <= {*SECTION_NAMES, SWEEP}:
+    if doc and set(doc) <= {*SECTION_NAMES, SWEEP, POPULATION}:
         return "config", ""
     return "toml", ""
 

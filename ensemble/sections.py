@@ -6,3 +6,4 @@ through filekind.py).
 """
 SECTION_NAMES = ("model", "run", "integrator", "output")
 SWEEP = "sweep"     # the table of swept values, beside the sections
+POPULATION = "population"   # the table of a population's draws (ensemble/population.py)

@@ -93,6 +93,8 @@ QUICK = {
                         "test_the_store_modules_are_small"],
     "test_compare_engine.py": ["test_the_engines_tables_of_the_comparison_are_the_events"],
     "test_integrator_keys.py": ["test_the_config_section_is_the_declaration", "test_each_key_reaches_the_kernels_by_name"],
+    "test_populations.py": ["test_a_faults_draws_are_its_own", "test_bad_population_specs_are_errors_naming_the_key",
+                            "test_a_region_of_two_faults_is_their_rate_weighted_mixture"],
     "test_mutation_targets.py": ["test_every_mutant_applies_once_and_names_existing_tests"],
     "test_quick_tier.py": ["test_every_test_named_in_the_quick_tier_exists",
                            "test_every_test_file_is_in_the_quick_tier_or_says_why_not"],

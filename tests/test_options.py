@@ -23,7 +23,7 @@ from .test_reduction import CONFIG, N_CHAIN, write_catalog
 
 SWEEP = "nu = [1.0]"
 # options that are not numbers: the parser's own, and these
-NOT_NUMERIC = {"help", "output", "title", "figure", "format", "force", "partial"}
+NOT_NUMERIC = {"help", "output", "title", "figure", "format", "force", "partial", "region"}
 
 # bad values of each numeric option (argparse dest): non-finite, beyond any honest range, not an integer
 BAD = {
@@ -47,6 +47,7 @@ BAD = {
     "seis_ring": ["nan", "inf", "-1", "1e400"],
     "seis_short": ["nan", "inf", "-1", "1e400"],
     "seis_long": ["nan", "inf", "-0.5", "1e400"],
+    "region_span": ["nan", "inf", "0", "-1", "1e400", "x"],
 }
 ENV = child_env(PYTHONPATH=str(ROOT))   # this checkout's packages, wherever the command runs
 OPTION = {dest: "--" + dest.replace("_", "-") for dest in BAD}

@@ -1,4 +1,5 @@
-"""Sweep x seeds -> tasks, each with its own random stream and initial state."""
+"""Sweep x seeds -> tasks, each with its own random stream and initial state; with a [population], sweep x
+faults (ensemble/population.py)."""
 import dataclasses
 import itertools
 from dataclasses import dataclass
@@ -7,6 +8,7 @@ import numpy as np
 
 from ..config import Model
 from ..model import laws
+from ..population import draw_values
 
 
 @dataclass(frozen=True)
@@ -15,18 +17,39 @@ class Task:
     point: int        # parameter point (row of the sweep's cartesian product)
     seed_index: int   # realisation at that point
     model: Model      # parameters of this task
+    region: int = -1  # with a [population]: the point of the sweep whose population the fault is of
+    fault: int = -1   # ... and the fault's index in it (the spawn key of its draws)
 
 
 def task_list(cfg):
-    """All tasks: the cartesian product of the sweep values (in the order given) x seeds."""
-    keys = [k for k, _ in cfg.sweep]
-    combos = list(itertools.product(*[vals for _, vals in cfg.sweep])) or [()]
+    """All tasks: the cartesian product of the sweep values (in the order given) x seeds. With a
+    [population], each point of the sweep is a region of population.faults faults, each fault a point
+    of its own with one task: task = point = region * faults + fault."""
     tasks = []
-    for point, values in enumerate(combos):
-        model = dataclasses.replace(cfg.model, **dict(zip(keys, values)))
-        for s in range(cfg.run.seeds):
-            tasks.append(Task(len(tasks), point, s, model))
+    types = {f.name: f.type for f in dataclasses.fields(Model)}
+    for point, (model, draws) in enumerate(sweep_points(cfg)):
+        if cfg.population is None:
+            for s in range(cfg.run.seeds):
+                tasks.append(Task(len(tasks), point, s, model))
+            continue
+        for f in range(cfg.population.faults):
+            drawn = draw_values(cfg.population, f, draws, types)
+            tasks.append(Task(len(tasks), len(tasks), 0, dataclasses.replace(model, **drawn), point, f))
     return tasks
+
+
+def sweep_points(cfg):
+    """(model, draws) of each point of the sweep: its [model] values, and with a [population] its
+    ((key, population.Draw), ...) (the swept specs in place of the [population]'s), else ()."""
+    keys = [k for k, _ in cfg.sweep]
+    out = []
+    for values in itertools.product(*[vals for _, vals in cfg.sweep]):
+        chosen = dict(zip(keys, values))
+        model = dataclasses.replace(cfg.model, **{k: v for k, v in chosen.items() if not k.startswith("population.")})
+        draws = dict(cfg.population.draws) if cfg.population is not None else {}
+        draws.update({k.partition(".")[2]: v for k, v in chosen.items() if k.startswith("population.")})
+        out.append((model, tuple(draws.items())))
+    return out
 
 
 def rng_for(cfg, task):
@@ -82,7 +105,8 @@ def perturb(force, perturbation, rng):
 
 def describe(tasks, cfg=None):
     """One line per task for `validate`, then one per spin-up (cfg given, run.branch)."""
-    lines = [f"task {t.index}: point {t.point} seed {t.seed_index} "
+    lines = [f"task {t.index}: point {t.point} " + (f"region {t.region} fault {t.fault} " if t.fault >= 0 else
+                                                    f"seed {t.seed_index} ")
              + " ".join(f"{f.name}={getattr(t.model, f.name)}" for f in dataclasses.fields(t.model))
              for t in tasks]
     for spin in spinups(cfg, tasks) if cfg is not None else []:

@@ -21,14 +21,15 @@ def element_seed(root_seed, point):
 
 
 def point_configs(cfg):
-    """One standalone config per parameter point of the sweep: the point's model values, no
-    sweep, all seeds, run.seed from element_seed()."""
-    from ..run.tasks import task_list
-    tasks = task_list(cfg)
-    firsts = [t for t in tasks if t.seed_index == 0]
-    return [dataclasses.replace(cfg, model=t.model, sweep=(),
-                                run=dataclasses.replace(cfg.run, seed=element_seed(cfg.run.seed, t.point)))
-            for t in firsts]
+    """One standalone config per parameter point of the sweep: the point's model values (with a
+    [population], its distributions: all its faults), no sweep, all seeds, run.seed from element_seed()."""
+    from ..run.tasks import sweep_points
+    out = []
+    for point, (model, draws) in enumerate(sweep_points(cfg)):
+        population = (None if cfg.population is None else dataclasses.replace(cfg.population, draws=draws))
+        out.append(dataclasses.replace(cfg, model=model, sweep=(), population=population,
+                                       run=dataclasses.replace(cfg.run, seed=element_seed(cfg.run.seed, point))))
+    return out
 
 
 def _single_configs(cfg, directory):
@@ -48,7 +49,8 @@ def _array_configs(cfg, directory):
     for i, sub in enumerate(point_configs(cfg)):
         catalog = points_dir / f"point-{i:04d}.h5"
         path = points_dir / f"point-{i:04d}.toml"
-        values = ", ".join(f"{key}={getattr(sub.model, key)!r}" for key, _ in cfg.sweep)
+        values = ", ".join(f"{key}={getattr(sub.model, key)!r}" if not key.startswith("population.") else
+                           f"{key}={dict(sub.population.draws)[key.partition('.')[2]].to_toml()}" for key, _ in cfg.sweep)
         path.write_text(f"# array element {i}: point {i} of the sweep ({values or 'no sweep'}); "
                         f"run.seed from SeedSequence({cfg.run.seed}, spawn_key=({i},))\n"
                         + replace(sub, "output", path=str(catalog)).to_toml())

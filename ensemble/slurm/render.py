@@ -45,6 +45,7 @@ PLACEHOLDERS = {
     "CATALOGS": "catalogs the reduction job reduces together into one summary (space-separated)",
     "SUMMARY_DIR": "where the reduction writes the summary, figures and report",
     "RESULT_NAME": "name of the summary, figures and report (catalog stem; the config's for an array)",
+    "REGION": "1 for a run with a [population]: the reduction job also writes the regional summary (reduce --region)",
 }
 PATH_PLACEHOLDERS = ("WORK_DIR", "LOG_DIR", "PYTHON", "CONFIG", "CATALOG", "SCRIPT", "POINTS_DIR",
                      "SUMMARY_DIR")
@@ -122,6 +123,7 @@ def render(cfg: Config, opt: JobOptions, directory, name="run", templates=TEMPLA
         "SCRIPT": check_path(run_script), "REDUCE_NTASKS": opt.reduce_ntasks,
         "CATALOGS": " ".join(check_path(c) for c in catalogs),
         "SUMMARY_DIR": check_path(directory / "results"), "RESULT_NAME": result_name,
+        "REGION": "1" if cfg.population is not None else "0",
     })
     reduce_script = directory / "reduce.sbatch"
     for src, dst in ((template, run_script), ("reduce.sbatch", reduce_script)):

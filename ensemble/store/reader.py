@@ -83,6 +83,15 @@ class Reader:
         base = task * self.per_task
         return int(np.count_nonzero(self.layout.events["kind"][base:base + written] == kind))
 
+    def column(self, task, name):
+        """The task's committed rows of one column (not verified: task_events verifies); e.g. the onset
+        times of a regional reduction's window (analysis/region.py)."""
+        written = int(self.tasks["events_written"][task])
+        if name not in self.layout.events:      # (a column supplied for older formats)
+            return np.full(written, SUPPLIED[name], dtype=EVENT_FIELDS[name])
+        base = task * self.per_task
+        return self.layout.events[name][base:base + written]
+
     def events(self):
         """Every committed event (dict of arrays, tasks in order), verified."""
         parts = [part for k in range(self.layout.n_tasks) for part in self.task_events(k)]

@@ -1,0 +1,122 @@
+"""Regions (`analysis reduce --region`): the faults of a population pooled as one region observes them.
+
+A region is the population of one point of a run's sweep (ensemble/population.py): its faults are the
+tasks of that point, each with parameters of its own. Catalogs whose regions have the same law, the same
+[model] values and the same distributions (text for text) pool into one region, as equal points do.
+
+The window. A region observes its faults over one common time, not one common number of events: every
+fault records run.events events, but a fault of few blocks has fewer events per unit of loading than a long
+one. Fault f's window starts at the onset t0_f of its first recorded inertial event and spans W of the
+plate's displacement: its rows (inertial events and creep episodes) with t0_f <= t < t0_f + W / nu. W is the
+shortest span (t_last - t0_f) nu of the region's faults, or `--region-span` (which may not exceed it), so
+that each fault contributes events in proportion to its rate. A recurrence is counted when both of its
+events are in the window; a window cuts no event in two (an event is in when its onset is).
+
+The transient. Each fault discarded the catalog's `transient` events before it recorded (run.transient,
+10 events per block of the longest fault by default: more per block for every shorter one). A fault whose
+discard is below what was measured to be needed, MEASURED_TRANSIENT_PER_BLOCK events per block of its own
+N (docs/benchmarks.md), is named in a warning.
+
+The bootstrap resamples faults (reduce._units: with at least MIN_UNITS faults; with fewer, the stretches
+of every fault's window, as for a point of few seeds), from SeedSequence(--seed, spawn_key from the
+region's text) (bootstrap_key).
+"""
+import hashlib
+
+import numpy as np
+
+from ensemble import filekind
+from ensemble.config import MEASURED_TRANSIENT_PER_BLOCK, loads
+from ensemble.run.tasks import sweep_points, task_list
+from ensemble.store import reader, schema
+from ensemble.store.errors import CatalogError
+
+from .reduce import PARAMS
+
+
+class RegionError(ValueError):
+    """Catalogs that cannot be reduced as regions (no population, no window); exit 2 like bad options."""
+
+
+def describe(model, draws):
+    """The text that names a region: its law, its [model] values not drawn, and each drawn key's distribution."""
+    drawn = dict(draws)
+    fixed = [f"{name}={getattr(model, name)!r}" for name in model.__dataclass_fields__
+             if name not in drawn and getattr(model, name) is not None]
+    return " ".join(fixed) + "; " + "; ".join(f"{k} ~ {spec.to_toml()}" for k, spec in sorted(drawn.items()))
+
+
+def label(draws):
+    """The drawn keys in a few words, for legends and reports: "N: power 2 on [100, 1600]; b: uniform on [20, 50]"."""
+    return "; ".join(f"{k}: {spec.short()}" for k, spec in sorted(dict(draws).items()))
+
+
+def bootstrap_key(text):
+    """The spawn key of a region's bootstrap generator: the 4 first 32-bit words of sha256(text)."""
+    digest = hashlib.sha256(text.encode()).digest()
+    return tuple(int.from_bytes(digest[i:i + 4], "little") for i in range(0, 16, 4))
+
+
+def group(paths, configs, discarded, tasks, span=None):
+    """Pool the tasks (merge.Inputs.tasks, every catalog's one after the other) into regions: set
+    tasks["point"] to the region, add tasks["window_start"], ["window_end"] (model time) and return
+    ([(params, rows)], spans {region: W}, warnings). discarded: the events each catalog's tasks discarded
+    before recording (its attribute `transient`). params: {"region": text (describe), "region_label": its
+    label, "law": law, and each of PARAMS: the value its faults share, NaN for a key drawn}."""
+    regions, texts = {}, []
+    for c, text in enumerate(configs):
+        cfg = loads(text)
+        if cfg.population is None:
+            raise RegionError(f"{paths[c]}: its run has no [population]; --region pools the faults of a population")
+        names = [(describe(model, draws), label(draws)) for model, draws in sweep_points(cfg)]
+        listed = task_list(cfg)
+        for g in np.flatnonzero(tasks["catalog"] == c):
+            name, short = names[listed[int(tasks["catalog_task"][g])].region]
+            if name not in regions:
+                regions[name] = []
+                texts.append((name, short))
+            regions[name].append(int(g))
+    start, last = _onsets(paths, tasks)
+    tasks["window_start"], tasks["window_end"] = start, np.full(len(start), np.nan)
+    points, spans, warnings = [], {}, []
+    for r, (name, short) in enumerate(texts):
+        rows = sorted(regions[name], key=lambda g: (int(tasks["seed_entropy"][g]), int(tasks["spawn_key"][g])))
+        tasks["point"][rows] = r
+        own = (last[rows] - start[rows]) * tasks["nu"][rows]
+        shortest = int(np.argmin(own))
+        where = f"{paths[tasks['catalog'][rows[shortest]]]} task {tasks['catalog_task'][rows[shortest]]}"
+        if not own[shortest] > 0:
+            raise RegionError(f"{where}: fewer than two inertial events recorded, so no window (region {r}: {name})")
+        if span is not None and span > own[shortest]:
+            raise RegionError(f"--region-span {span:g}: {where} spans only {own[shortest]:.6g} (T nu) of region {r}")
+        spans[r] = own[shortest] if span is None else span
+        tasks["window_end"][rows] = start[rows] + spans[r] / tasks["nu"][rows]
+        shared = {p: (float(tasks[p][rows[0]]) if np.all(tasks[p][rows] == tasks[p][rows[0]]) else np.nan) for p in PARAMS}
+        points.append(({**shared, "region": name, "region_label": short, "law": str(tasks["law"][rows[0]])}, rows))
+        warnings += _transient_warnings(paths, discarded, tasks, rows, r)
+    return points, spans, warnings
+
+
+def _onsets(paths, tasks):
+    """(first, last) onset times of every task's recorded inertial events (NaN without any)."""
+    n = len(tasks["point"])
+    first, last = np.full(n, np.nan), np.full(n, np.nan)
+    for c, path in enumerate(paths):
+        with filekind.reading(path, "the event catalog", CatalogError), reader.Reader(path) as cat:
+            for g in np.flatnonzero(tasks["catalog"] == c):
+                k = int(tasks["catalog_task"][g])
+                t = cat.column(k, "t")[cat.column(k, "kind") == schema.KIND_EVENT]
+                if len(t):
+                    first[g], last[g] = t.min(), t.max()
+    return first, last
+
+
+def _transient_warnings(paths, discarded, tasks, rows, r):
+    out = []
+    for g in rows:
+        need, c = MEASURED_TRANSIENT_PER_BLOCK * int(tasks["N"][g]), int(tasks["catalog"][g])
+        if discarded[c] < need:
+            out.append(f"region {r}: {paths[c]} task {tasks['catalog_task'][g]} (N = {tasks['N'][g]}) discarded "
+                       f"{discarded[c]} events before it recorded, fewer than the {need:g} its transient may last "
+                       f"({MEASURED_TRANSIENT_PER_BLOCK:g} per block)")
+    return out

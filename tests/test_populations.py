@@ -1,0 +1,323 @@
+"""Populations of faults ([population], ensemble/population.py) and their regions (reduce --region,
+analysis/region.py): the draws, the config's checks, the runner's promises, and a region's statistics
+against a hand computation."""
+import hashlib
+import math
+import sys
+
+import numpy as np
+import pytest
+
+from analysis import summary
+from ensemble.config import ConfigError, Model, loads
+from ensemble.population import Draw, draw_values
+from ensemble.run.tasks import task_list
+
+from .catalog_writer import write_events
+from .conftest import run_cli, write_config
+from .processes import child_env, run_bounded
+
+POPULATION = """
+[model]
+N = 40
+[run]
+events = 400
+transient = 5
+[population]
+faults = {faults}
+seed = 11
+b = {{distribution = "uniform", min = 20, max = 50}}
+{extra}
+"""
+
+
+def population(faults=6, extra="", sweep=""):
+    return loads(POPULATION.format(faults=faults, extra=extra) + (f"[sweep]\n{sweep}\n" if sweep else ""))
+
+
+def analysis_cli(*args):
+    return run_bounded([sys.executable, "-m", "analysis", *map(str, args)], 300, env=child_env())
+
+
+# -- the draws ---------------------------------------------------------------------------------
+
+def test_a_faults_draws_are_its_own():
+    """Fault f's value of a key depends on the root seed, f and the key only: not on how many faults are drawn,
+    nor on which other keys are; two regions of one sweep draw the same numbers (common random numbers)."""
+    few, many = task_list(population(4)), task_list(population(9))
+    assert [t.model.b for t in few] == [t.model.b for t in many[:4]]
+    with_a = task_list(population(4, 'a = {distribution = "loguniform", min = 1, max = 30}'))
+    assert [t.model.b for t in with_a] == [t.model.b for t in few] and len({t.model.a for t in with_a}) == 4
+    swept = task_list(population(3, sweep="population.N = [[20, 30], [200, 300]]"))
+    assert [t.region for t in swept] == [0, 0, 0, 1, 1, 1] and [t.point for t in swept] == list(range(6))
+    low = [t.model.N for t in swept[:3]]
+    assert set(low) <= {20, 30} and [{20: 200, 30: 300}[n] for n in low] == [t.model.N for t in swept[3:]]
+    assert [t.model.b for t in swept[:3]] == [t.model.b for t in swept[3:]]
+    other_seed = loads(POPULATION.format(faults=4, extra="").replace("seed = 11", "seed = 12"))
+    assert [t.model.b for t in task_list(other_seed)] != [t.model.b for t in few]
+
+
+def test_integer_power_law_draws_have_the_stated_probabilities():
+    """P(N = n) proportional to n^-exponent on [min, max], exactly: 40000 draws against the probabilities
+    (each frequency within 5 binomial standard deviations), exponents 0, 1 and 2.5."""
+    n = np.arange(2, 13)
+    for alpha in (0.0, 1.0, 2.5):
+        spec = Draw("power", 2, 12, alpha)
+        values = np.array([spec.sample(np.random.default_rng([7, k]), True) for k in range(40000)])
+        p = n ** -alpha / np.sum(n ** -alpha)
+        freq = np.array([np.mean(values == k) for k in n])
+        assert values.min() >= 2 and values.max() <= 12
+        assert np.all(np.abs(freq - p) <= 5 * np.sqrt(p * (1 - p) / len(values))), (alpha, freq, p)
+
+
+@pytest.mark.parametrize("kind,alpha,cdf", [
+    ("uniform", None, lambda x: (x - 2) / 6),
+    ("loguniform", None, lambda x: np.log(x / 2) / np.log(4)),
+    ("power", 2.0, lambda x: (1 / 2 - 1 / x) / (1 / 2 - 1 / 8)),
+    ("power", 1.0, lambda x: np.log(x / 2) / np.log(4)),
+])
+def test_float_draws_follow_their_distribution(kind, alpha, cdf):
+    """On [2, 8]: the KS distance of 20000 draws from the stated CDF is below the 0.1% critical value."""
+    spec = Draw(kind, 2.0, 8.0, alpha)
+    x = np.sort([spec.sample(np.random.default_rng([3, k]), False) for k in range(20000)])
+    ecdf = np.arange(1, len(x) + 1) / len(x)
+    assert 2 <= x[0] and x[-1] <= 8
+    assert np.max(np.abs(ecdf - cdf(x))) < 1.95 / math.sqrt(len(x))
+
+
+def test_a_list_draws_each_value_alike():
+    spec = Draw("list", values=(3.0, 6.0, 12.0))
+    x = np.array([spec.sample(np.random.default_rng([5, k]), False) for k in range(30000)])
+    assert all(abs(np.mean(x == v) - 1 / 3) < 5 * math.sqrt(2 / 9 / 30000) for v in (3.0, 6.0, 12.0))
+
+
+# -- the config ---------------------------------------------------------------------------------
+
+BAD = [  # (the [population] lines beyond faults and seed, the [run] lines, the [sweep] lines), what the error names
+    ('b = {distribution = "uniform", min = 50, max = 20}', "", "", "population.b: the range is empty"),
+    ('b = {distribution = "uniform", min = 20, max = 20}', "", "", "population.b: the range is empty"),
+    ('N = {distribution = "power", exponent = -1, min = 100, max = 1600}', "", "", "population.N.exponent must be >= 0"),
+    ('N = {distribution = "power", exponent = 2, min = 1, max = 1600}', "", "", "population.N.min must be at least 2"),
+    ("N = [1, 40]", "", "", "population.N must be at least 2"),
+    ('N = {distribution = "power", exponent = 2, min = 10.5, max = 1600}', "", "", "population.N.min must be an integer"),
+    ('b = {distribution = "normal", min = 20, max = 50}', "", "", "population.b.distribution must be one of"),
+    ('b = {min = 20, max = 50}', "", "", "population.b.distribution must be one of"),
+    ('b = {distribution = "uniform", min = 20}', "", "", "population.b.max is missing"),
+    ('a = {distribution = "loguniform", min = 0, max = 30}', "", "", "population.a.min must be > 0"),
+    ('b = {distribution = "uniform", min = 20, max = 50, exponent = 2}', "", "", "unknown key population.b.exponent"),
+    ("b = []", "", "", "population.b must be a non-empty list"),
+    ("b = 20", "", "", "population.b must be a list of values or a table"),
+    ("nu = [1e-8, 1e-7]", "", "", "population.nu: model.nu is not drawn"),
+    ("alpha = [1, 2]", "", "", "population.alpha does not belong to model.law"),
+    ("colour = [1, 2]", "", "", "unknown key population.colour"),
+    ('l = {distribution = "uniform", min = -1, max = 3}', "", "", "population.l.min must be > 0"),
+    ("", "seeds = 2", "", "run.seeds = 2: with a [population] each fault is one trajectory"),
+    ("", "branch = true", "", "run.branch = true: a population"),
+    ("", "", "b = [20, 30]", "sweep.b and population.b both set model.b"),
+    ("", "", "population.N = []", "sweep.population.N must be a non-empty list"),
+    ("", "", 'population.N = [[10], {distribution = "power", exponent = 1, min = 1, max = 10}]',
+     "sweep.population.N.min must be at least 2"),
+]
+
+
+@pytest.mark.parametrize("population_lines,run_lines,sweep_lines,message", BAD)
+def test_bad_population_specs_are_errors_naming_the_key(population_lines, run_lines, sweep_lines, message):
+    text = (f"[run]\nevents = 10\n{run_lines}\n[population]\nfaults = 3\n{population_lines or 'b = [20.0]'}\n"
+            + (f"[sweep]\n{sweep_lines}\n" if sweep_lines else ""))
+    with pytest.raises(ConfigError) as err:
+        loads(text)
+    assert message in str(err.value) and "\n" not in str(err.value)
+
+
+@pytest.mark.parametrize("lines,message", [
+    ("[population]\nfaults = 0\n", "population.faults must be an integer in [1,"),
+    ("[population]\nseed = 3\n", "population.faults is missing"),
+    ("[sweep]\npopulation.b = [[20]]\n", "sweep.population.b needs a [population] section"),
+])
+def test_a_population_needs_its_faults(lines, message):
+    with pytest.raises(ConfigError, match=message.replace("[", r"\[")):
+        loads(lines)
+
+
+def test_validate_refuses_a_bad_spec_in_one_line_and_lists_each_faults_parameters(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[population]\nfaults = 3\nN = {distribution = "power", exponent = -2, min = 100, max = 1600}\n')
+    res = run_cli("validate", bad)
+    assert res.returncode == 2 and res.stderr.strip().count("\n") == 0 and "population.N.exponent" in res.stderr
+    good = tmp_path / "good.toml"
+    good.write_text(POPULATION.format(faults=3, extra="N = [20, 30]"))
+    res = run_cli("validate", good)
+    assert res.returncode == 0, res.stderr
+    tasks = task_list(loads(good.read_text()))
+    for t in tasks:
+        assert f"# task {t.index}: point {t.index} region 0 fault {t.index} N={t.model.N} " in res.stdout
+        assert f"b={t.model.b!r}" in res.stdout
+
+
+def test_the_stored_config_reads_back_as_itself():
+    cfg = population(5, 'N = {distribution = "power", exponent = 2, min = 100, max = 1600}\nl = [3, 6]',
+                     sweep='population.a = [[0], {distribution = "loguniform", min = 0.5, max = 30}]\nc = [1e3, 1e4]')
+    again = loads(cfg.to_toml())
+    assert again == cfg and [t.model for t in task_list(again)] == [t.model for t in task_list(cfg)]
+    assert len(task_list(cfg)) == 4 * 5
+    # run.transient's default: 10 events per block of the longest fault any distribution allows
+    free = loads("[population]\nfaults = 2\nN = {distribution = \"power\", exponent = 2, min = 100, max = 1600}\n")
+    assert free.run.transient == 16000
+
+
+# -- a region's statistics against a hand computation ---------------------------------------------
+
+def _events(task, t, mu, n_chain=40):
+    n = len(t)
+    epi = (np.arange(n) * 7) % n_chain
+    return {"task": np.full(n, task, dtype=np.int64), "t": np.asarray(t, dtype=float), "epicenter": epi.astype(np.int64),
+            "mu": np.full(n, mu), "slip": np.full(n, 10.0 ** mu), "first": epi.astype(np.int64),
+            "last": epi.astype(np.int64), "n_slipped": np.ones(n, dtype=np.int64), "boundary": np.zeros(n, bool),
+            "duration": np.full(n, 0.5), "kind": np.zeros(n, np.int8), "ending": np.zeros(n, np.int8)}
+
+
+@pytest.fixture(scope="module")
+def two_faults(tmp_path_factory):
+    """Two faults of disjoint magnitudes and different rates: fault 0 an event every 1 (mu = 1.05) from t = 0,
+    fault 1 every 7 (mu = 3.05) from t = 100; 400 events each."""
+    d = tmp_path_factory.mktemp("region")
+    text = POPULATION.format(faults=2, extra="")
+    path = d / "two.h5"
+    write_events(path, text, [_events(0, np.arange(400.0), 1.05), _events(1, 100 + 7 * np.arange(400.0), 3.05)])
+    return d, path
+
+
+def test_a_region_of_two_faults_is_their_rate_weighted_mixture(two_faults):
+    """The window is the shorter span (fault 0: 399 / nu... of loading): fault 0 gives its events with
+    0 <= t < 399 (399 events), fault 1 those with 100 <= t < 499 (57); a single-fault reduction counts 400 each."""
+    d, path = two_faults
+    out = d / "two.region.h5"
+    res = analysis_cli("reduce", path, "--region", "-o", out, "--bootstrap", 50)
+    assert res.returncode == 0, res.stderr
+    # each fault discarded 5 events, fewer than the 50 its 40 blocks may need: both named
+    assert res.stderr.count("discarded 5 events before it recorded") == 2, res.stderr
+    s = summary.read(out)
+    numbers = {name: s[f"points/numbers/{name}"][0][0] for name in ("n_events", "n_large", "fraction_large", "gr_b")}
+    assert len(s["points/N"]) == 1 and s["points/method"][0] == "blocks"       # 2 faults: fewer than MIN_UNITS
+    assert numbers["n_events"] == 399 + 57
+    assert numbers["fraction_large"] == 0.0                                      # mu_c = 4: none large
+    edges = s["bins/mu"]
+    width = np.diff(edges)
+    expect = np.zeros(len(width))
+    expect[np.searchsorted(edges, 1.05) - 1] = 399 / (456 * width[10])
+    expect[np.searchsorted(edges, 3.05) - 1] = 57 / (456 * width[30])
+    assert np.allclose(s["points/mu_density"][0], expect, rtol=1e-12, atol=0)
+    # GR b above 3 from fault 1's 57 events alone (Aki: log10(e) / (mean - cut))
+    assert numbers["gr_b"] == pytest.approx(math.log10(math.e) / 0.05, rel=1e-9)
+    nu = loads(s["attrs"]["config"]).model.nu
+    assert s["points/region_span"][0] == pytest.approx(399 * nu, rel=1e-12)
+    assert list(s["tasks/window_start"]) == [0.0, 100.0]
+    assert np.allclose(s["tasks/window_end"], [399.0, 499.0], rtol=1e-12)
+    assert np.isnan(s["points/b"][0]) and s["points/N"][0] == 40                  # drawn / shared
+    # the same catalog point by point: every event of each fault
+    plain = d / "two.plain.h5"
+    assert analysis_cli("reduce", path, "-o", plain, "--bootstrap", 50).returncode == 0
+    p = summary.read(plain)
+    assert list(p["points/numbers/n_events"][:, 0]) == [400, 400]
+    res = analysis_cli("report", out)
+    assert res.returncode == 0 and "region 0: b: uniform on [20, 50]; N = 40" in res.stdout
+
+
+def test_region_errors_are_one_line(two_faults, tmp_path):
+    d, path = two_faults
+    res = analysis_cli("reduce", path, "--region", "--region-span", 1.0, "-o", tmp_path / "x.h5")
+    assert res.returncode == 2 and "--region-span 1: " in res.stderr and "task 0 spans only 3.99e-06" in res.stderr
+    assert res.stderr.strip().count("\n") == 0
+    res = analysis_cli("reduce", path, "--region-span", 1e-6, "-o", tmp_path / "x.h5")
+    assert res.returncode == 2 and "give --region too" in res.stderr
+    single = tmp_path / "single.h5"
+    text = "[model]\nN = 40\n[run]\nevents = 400\ntransient = 5\nseeds = 1\n"
+    write_events(single, text, [_events(0, np.arange(400.0), 1.05)])
+    res = analysis_cli("reduce", single, "--region", "-o", tmp_path / "y.h5")
+    assert res.returncode == 2 and "has no [population]" in res.stderr and not (tmp_path / "y.h5").exists()
+
+
+def test_a_region_of_many_faults_resamples_faults(tmp_path):
+    """12 faults with rates 1..12 over a common span: the events' interval is the bootstrap over faults by
+    hand, from the region's own generator (analysis/region.py)."""
+    path = tmp_path / "many.h5"
+    text = POPULATION.format(faults=12, extra="")
+    parts = [_events(k, np.arange(400.0) / (k + 1), 1.05 + 0.1 * (k % 3)) for k in range(12)]
+    write_events(path, text, parts)
+    out = tmp_path / "many.region.h5"
+    res = analysis_cli("reduce", path, "--region", "-o", out, "--bootstrap", 300, "--seed", 4)
+    assert res.returncode == 0, res.stderr
+    s = summary.read(out)
+    assert s["points/method"][0] == "faults" and s["points/units"][0] == 12
+    span = 399 / 12                                   # the fastest fault's
+    counts = np.array([np.count_nonzero(np.arange(400.0) / (k + 1) < span) for k in range(12)])
+    assert s["points/numbers/n_events"][0][0] == counts.sum()
+    # the region's generator as documented: SeedSequence(--seed, spawn_key = sha256(its text)'s first 4 words)
+    digest = hashlib.sha256(s["points/region"][0].encode()).digest()
+    rng = np.random.default_rng(np.random.SeedSequence(4, spawn_key=tuple(
+        int.from_bytes(digest[i:i + 4], "little") for i in range(0, 16, 4))))
+    draws = counts[rng.integers(0, 12, size=(300, 12))].sum(axis=1)
+    lo, hi = np.percentile(draws, [2.5, 97.5], method="linear")
+    assert s["points/numbers/n_events"][0][1:] == pytest.approx([lo, hi], rel=1e-12)
+
+
+def test_a_regions_magnitude_figure_shows_its_faults(two_faults):
+    d, path = two_faults
+    out = d / "fig.region.h5"
+    assert analysis_cli("reduce", path, "--region", "-o", out, "--bootstrap", 20).returncode == 0
+    from analysis import plot
+    import matplotlib.pyplot as plt
+    fig = plot.figure([summary.read(out)], "magnitude")
+    ax = fig.axes[0]
+    grey = [line for line in ax.get_lines() if line.get_color() == "0.6"]
+    assert len(grey) == 2      # one per fault
+    plt.close(fig)
+
+
+# -- the runner -----------------------------------------------------------------------------------
+
+def test_population_configs_of_an_array_job_are_one_per_region(tmp_path):
+    cfg = tmp_path / "pop.toml"
+    cfg.write_text(POPULATION.format(faults=3, extra="N = [20, 30]") + "[sweep]\npopulation.a = [[0], [5, 10]]\n")
+    res = run_cli("slurm", cfg, "--ntasks", 2, "--time", "10", "--kind", "array", "-o", tmp_path / "job")
+    assert res.returncode == 0, res.stderr
+    elements = sorted((tmp_path / "job" / "points").glob("*.toml"))
+    assert len(elements) == 2
+    whole = task_list(loads(cfg.read_text()))
+    for i, path in enumerate(elements):
+        one = loads(path.read_text())
+        assert one.sweep == () and one.population.faults == 3
+        assert [t.model for t in task_list(one)] == [t.model for t in whole if t.region == i]
+    assert "REGION=1" in (tmp_path / "job" / "reduce.sbatch").read_text()
+
+
+@pytest.mark.mpi
+def test_a_population_runs_alike_on_one_and_two_ranks_and_resumes(tmp_path):
+    from .same_catalogs import assert_same_events
+    from .test_mpi import mpirun, start_and_interrupt
+    cfg = write_config(tmp_path / "pop.toml", model={"N": 40, "b": 20.0},
+                       run={"seeds": 1, "events": 300, "transient": 30},
+                       population={"faults": 4, "seed": 2, "N": [24, 60]},
+                       integrator={"dt": 5e-4}, output={"batch": 50, "flush_seconds": 0.5, "progress_seconds": 0.5})
+    res = run_cli("run", cfg, "-o", tmp_path / "serial.h5")
+    assert res.returncode == 0, res.stderr
+    res = mpirun(2, "run", cfg, "-o", tmp_path / "two.h5")
+    assert res.returncode == 0, res.stderr
+    assert_same_events(tmp_path / "serial.h5", tmp_path / "two.h5")
+    code, log = start_and_interrupt(cfg, tmp_path / "cut.h5", "kill")
+    res = mpirun(2, "run", cfg, "-o", tmp_path / "cut.h5", "--resume")
+    assert res.returncode == 0, res.stderr + log
+    assert_same_events(tmp_path / "serial.h5", tmp_path / "cut.h5")
+    tasks = task_list(loads(cfg.read_text()))
+    from ensemble.store import reader
+    _, table, _ = reader.read_tasks(tmp_path / "cut.h5")
+    assert list(table["N"]) == [t.model.N for t in tasks] and set(table["N"]) <= {24, 60}
+
+
+def test_the_model_record_of_a_fault_is_its_draw():
+    cfg = population(5, "N = [20, 30]\nl = [3, 6]")
+    types = {f.name: f.type for f in Model.__dataclass_fields__.values()}
+    for t in task_list(cfg):
+        drawn = draw_values(cfg.population, t.fault, cfg.population.draws, types)
+        assert {k: getattr(t.model, k) for k in drawn} == drawn
+        assert isinstance(t.model.N, int) and t.model.c == 1000.0
