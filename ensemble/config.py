@@ -9,10 +9,11 @@ numbers the kernels' arithmetic cannot hold are refused (config_rules.OVERFLOW_R
 import dataclasses
 import math
 import tomllib
+from contextlib import contextmanager
 from dataclasses import dataclass, field, fields
 
 from . import filekind, population as populations
-from .config_rules import ConfigError, check_overflow, coerce, from_set, point_values
+from .config_rules import ConfigError, check_overflow, coerce, point_values
 from .integrators import INTEGRATORS
 from .integrators import KEYS as INTEGRATOR_KEYS
 from .model import laws
@@ -20,7 +21,7 @@ from .sections import POPULATION, SECTION_NAMES, SWEEP
 
 __all__ = ["Config", "ConfigError", "DECORRELATION_PER_BLOCK", "Integrator", "LAW_KEYS", "MEASURED_TRANSIENT_PER_BLOCK",
            "Model", "Output", "Run",
-           "SECTIONS", "TRANSIENT_PER_BLOCK", "from_dict", "load", "loads", "parse_override", "replace",
+           "SECTIONS", "TRANSIENT_PER_BLOCK", "from_dict", "load", "loads", "parse_override", "parse_section", "replace",
            "section_lines"]
 
 
@@ -169,6 +170,22 @@ def _toml_value(v):
     return str(v)
 
 
+@contextmanager
+def from_set(overridden, section, key):
+    """An error about a value that came from --set says so."""
+    try:
+        yield
+    except ConfigError as err:
+        if (section, key) not in overridden:
+            raise
+        raise ConfigError(f"{err} (from --set {overridden[section, key]})") from None
+
+
+def parse_section(name, raw):
+    """One section's dataclass from its table alone (a task's stored [integrator]): its keys' checks."""
+    return _section(name, raw, {})
+
+
 def _section(name, raw, overridden):
     cls = SECTIONS[name]
     if not isinstance(raw, dict):
@@ -209,6 +226,16 @@ def _sweep(raw, overridden, law_keys):
     return tuple(out)
 
 
+def _population(raw, overridden, types, law_keys):
+    if not isinstance(raw, dict):
+        raise ConfigError("[population] must be a table")
+    entries = []
+    for key, value in raw.items():
+        with from_set(overridden, POPULATION, key):
+            entries.append(populations.parse_entry(key, value, types, law_keys))
+    return populations.build(entries)
+
+
 def _flat(raw):
     """The [sweep] table's (key, values): `population.N = [...]` in the file is a table `population` in
     TOML, from --set a key "population.N"; both are the key "population.N"."""
@@ -240,8 +267,7 @@ def from_dict(raw, overridden=None):
     parts = {name: _section(name, raw.get(name, {}), overridden) for name in SECTIONS}
     law_keys = parts["model"].law_keys()
     types = {f.name: f.type for f in fields(Model)}
-    population = (populations.parse(raw[POPULATION], types, law_keys, overridden, from_set)
-                  if POPULATION in raw else None)
+    population = _population(raw[POPULATION], overridden, types, law_keys) if POPULATION in raw else None
     sweep = _sweep(raw.get(SWEEP, {}), overridden, law_keys)
     populations.check_run(population, sweep, parts["run"])
     cfg = Config(sweep=sweep, population=population, **parts)

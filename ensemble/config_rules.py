@@ -7,7 +7,6 @@ keys are declared with those keys (model/laws/, integrators.KEYS); the others ar
 """
 import itertools
 import math
-from contextlib import contextmanager
 
 from .integrators import KEYS as INTEGRATOR_KEYS
 from .model import laws
@@ -91,17 +90,6 @@ def coerce(section, key, value, typ, where=None):
     if rule is not None and not rule[0](value):
         raise ConfigError(f"{where} must be {rule[1]}, got {value!r}")
     return value
-
-
-@contextmanager
-def from_set(overridden, section, key):
-    """An error about a value that came from --set says so."""
-    try:
-        yield
-    except ConfigError as err:
-        if (section, key) not in overridden:
-            raise
-        raise ConfigError(f"{err} (from --set {overridden[section, key]})") from None
 
 
 def point_values(cfg, name):

@@ -124,22 +124,22 @@ def draw_values(population, fault, draws, types):
     return out
 
 
-def parse(raw, types, law_keys, overridden, from_set):
-    """Validate the [population] table; types: {model key: int or float} of the keys that can be drawn."""
-    if not isinstance(raw, dict):
-        raise ConfigError("[population] must be a table")
-    faults, seed, draws = None, 0, []
-    for key, value in raw.items():
-        with from_set(overridden, "population", key):
-            if key == "faults":
-                faults = _integer(value, "population.faults", 1, MAX_FAULTS)
-            elif key == "seed":
-                seed = _integer(value, "population.seed", 0, 2 ** 63 - 1)
-            else:
-                draws.append((key, parse_draw(key, value, types, law_keys, f"population.{key}")))
-    if faults is None:
+def parse_entry(key, value, types, law_keys):
+    """One key of the [population] table: ("faults", n), ("seed", s) or (key, Draw)."""
+    if key == "faults":
+        return key, _integer(value, "population.faults", 1, MAX_FAULTS)
+    if key == "seed":
+        return key, _integer(value, "population.seed", 0, 2 ** 63 - 1)
+    return key, parse_draw(key, value, types, law_keys, f"population.{key}")
+
+
+def build(entries):
+    """The Population of the table's parsed entries [(key, value)] in the order given."""
+    given = dict(entries)
+    if "faults" not in given:
         raise ConfigError("population.faults is missing: the number of faults drawn (each is one task)")
-    return Population(faults, seed, tuple(draws))
+    return Population(given["faults"], given.get("seed", 0),
+                      tuple((k, v) for k, v in entries if k not in ("faults", "seed")))
 
 
 def drawable(key, types, law_keys, where):

@@ -106,7 +106,8 @@ def test_rendered_scripts_are_complete_and_valid_bash(tmp_path, kind):
     # one reduction of every catalog of the run into one summary, named after the catalog
     assert f"CATALOGS=({' '.join(map(str, out.catalogs))})" in reduce and "NAME=tiny\n" in reduce
     assert out.summary == out.directory / "results" / "tiny.summary.h5"
-    assert reduce.count("-m analysis reduce") == 1
+    # one reduction of them all; a second, of the regions, only where the run has a [population]
+    assert reduce.count("-m analysis reduce") == 2 and "REGION=0\n" in reduce
     assert '"${launch[@]}" "$PYTHON" -m analysis reduce "${CATALOGS[@]}" -o "$summary" --force' in reduce
     # without partition, account and locking advice those lines are gone
     plain = render(cfg, JobOptions(kind=kind, ntasks=2, time="30"), tmp_path / "plain", "tiny")

@@ -9,8 +9,8 @@ import tomllib
 
 import numpy as np
 
-from ..config import ConfigError, from_dict, section_lines
-from ..integrators import kernel_params
+from ..config import ConfigError, parse_section, section_lines
+from ..integrators import INTEGRATORS, kernel_params
 from ..model.chain import simulate
 from ..model.workspace import (D_DURATION, D_ENDING, D_FIRST, D_KIND, D_LAST, D_NSLIP, D_SLIP, NDIAG, OK, PAUSED,
                                STATUS_TEXT, UNLIMITED, Workspace)
@@ -95,8 +95,11 @@ def integrator_text(integrator):
 
 
 def parse_integrator(text, where):
-    """The inverse of integrator_text, validated like a config."""
+    """The inverse of integrator_text, its keys checked as a config's."""
     try:
-        return from_dict({"integrator": tomllib.loads(text)}).integrator
+        section = parse_section("integrator", tomllib.loads(text))
+        if section.method not in INTEGRATORS:
+            raise ConfigError(f"integrator.method must be one of {', '.join(sorted(INTEGRATORS))}, got {section.method!r}")
+        return section
     except (tomllib.TOMLDecodeError, ConfigError) as err:
         raise CatalogError(f"{where}: stored integrator cannot be read ({err})") from None
