@@ -9,6 +9,10 @@
 # `python -m ensemble`, so the kernels are compiled once.
 PY := .venv/bin/python
 STACK ?= auto
+# `make test` runs the test files on this many pytest workers (pytest-xdist; a file's tests stay on one worker, so
+# its module fixtures are made once): 2 halves the suite's time on a 2-core machine (docs/tests.md); 1 runs it serially
+TEST_WORKERS ?= 2
+XDIST := $(if $(filter 1,$(TEST_WORKERS)),,-n $(TEST_WORKERS) --dist loadfile)
 TEST_STACK := $(if $(filter wheels,$(STACK)),wheels,parallel)
 export OMP_NUM_THREADS := 1
 export NUMBA_NUM_THREADS := 1
@@ -24,7 +28,7 @@ run: setup
 
 test:
 	STACK=$(TEST_STACK) bash scripts/setup.sh
-	ENSEMBLE_TEST_STACK=$(TEST_STACK) $(PY) -m pytest -q -m "not slow" --durations=30
+	ENSEMBLE_TEST_STACK=$(TEST_STACK) $(PY) -m pytest -q -m "not slow" $(XDIST) --durations=30
 
 # a tier of about two minutes that touches every module (the `quick` marker: tests/conftest.py)
 quick: setup

@@ -329,7 +329,8 @@ def test_a_full_disk_stops_the_run_with_one_line_and_nothing_lost(small, small_d
     assert status.returncode == 0 and "interrupted" in status.stdout
     # space freed: the same catalog, resumed, completes (the small config fits)
     assert run_bounded(["mount", "-o", "remount,size=8m", small_disk], TIMEOUT).returncode == 0
-    res = cli("resume", small_disk / "b.h5")
+    # (6000 events of rk4 from the start: about a minute alone, more beside other tests; the bound is a hang's)
+    res = cli("resume", small_disk / "b.h5", timeout=5 * TIMEOUT)
     assert res.returncode == 0, res.stderr
 
 
