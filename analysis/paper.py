@@ -81,7 +81,7 @@ def _shape(row, edges, c):
 
 def shape_statistics(s, i, level=None):
     """R(mu) shape numbers of point i with bootstrap intervals over its units (the summary's:
-    seeds, or the stretches of every trajectory):
+    seeds or a region's faults, or the stretches of every trajectory):
     {name: (estimate, lo, hi, share of resamples where it is infinite)}; a ratio over an empty
     bin is infinite."""
     level = s["attrs"]["level"] if level is None else level
@@ -89,7 +89,7 @@ def shape_statistics(s, i, level=None):
     c = stats.centers(edges)
     tasks = np.flatnonzero(s["tasks/point"] == i)
     counts, events = s["per_task/mu"][tasks], s["per_task/numbers"][tasks][:, :, LAYOUT.column("numbers", "n_events")]
-    if s["points/method"][i] == "seeds":     # the summary's own units: seeds, else every stretch
+    if s["points/method"][i] in ("seeds", "faults"):   # the summary's own units: seeds (a region's faults), else every stretch
         counts, events = counts.sum(axis=1, keepdims=True), events.sum(axis=1, keepdims=True)
     rows = np.concatenate([counts.reshape(-1, len(c)), events.reshape(-1, 1)], axis=1)
     est = _shape(rows.sum(axis=0), edges, c)

@@ -196,8 +196,9 @@ def write(path, inputs, per_task, points, opt, force=False):
             # text columns (a task's error, its integrator) are stored as UTF-8 bytes
             h5[f"tasks/{name}"] = np.char.encode(values) if values.dtype.kind == "U" else values
         order = sorted(per_task)
-        for name in reduce.UNIT_ARRAYS:
-            h5[f"per_task/{name}"] = np.stack([per_task[k][name] for k in order])
+        for name in reduce.UNIT_ARRAYS:   # (compressed: mostly zeros, e.g. the seismicity's maps of every stretch)
+            h5.create_dataset(f"per_task/{name}", data=np.stack([per_task[k][name] for k in order]),
+                              compression="gzip", compression_opts=4, shuffle=True)
         for name in PARAMS:
             h5[f"points/{name}"] = np.array([p["params"][name] for p in points])
         h5["points/law"] = np.array([p["params"]["law"] for p in points], dtype="S")

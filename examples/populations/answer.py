@@ -1,0 +1,186 @@
+"""The paper's question, answered from regional summaries (docs/populations.md):
+
+    python examples/populations/answer.py REGIONS.summary.h5 --faults FAULTS.summary.h5 -o docs/populations/answer
+
+REGIONS: `analysis reduce CATALOG --region` (each point a region); FAULTS: `analysis reduce CATALOG` of the same
+catalog (each fault a point of its own). For each region it gives, with 95% intervals over its faults:
+
+- events in its window, GR b above the summary's b_cut (Aki) and the KS distance of mu >= b_cut from that law
+  (the summary's numbers);
+- the best two decades: for every stretch [lo, lo + 2) of mu (lo on the bins' edges, at least MIN_EVENTS events
+  in it), the KS distance of the binned magnitudes from a Gutenberg-Richter law truncated to the stretch (b by
+  maximum likelihood on the bins); the smallest of them and its lo, and its b. A region "looks critical" where
+  that KS is below 0.05 (the working definition of the issue);
+- the fraction of large events (mu >= mu_c) and the hump: R at the large-magnitude peak over R at the dip below
+  it (analysis/paper.py's shape statistics);
+- the CV of the local recurrence times;
+- beside them the single faults of the region: the median and the 5-95% range of their own KS to GR (each fault
+  over all its recorded events).
+
+Writes OUT.md (the table) and OUT.json (every number).
+"""
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from analysis import stats, summary
+from analysis.paper import shape_statistics
+
+DECADES = 2.0        # the stretch of mu a critical-looking region must follow GR over
+MIN_EVENTS = 1000    # events a stretch needs for its KS distance to be read
+RESAMPLES = 300      # bootstrap resamples of the faults for the two-decade KS
+CRITICAL_KS = 0.05
+
+
+def truncated_gr_ks(counts, edges):
+    """(KS, b) of binned magnitudes on [edges[0], edges[-1]) against GR truncated to it, b by binned maximum likelihood."""
+    n = counts.sum()
+    if n <= 0:
+        return math.nan, math.nan
+    x = edges - edges[0]
+    width = x[-1]
+
+    def cdf(b):
+        if abs(b) < 1e-9:
+            return x / width
+        return np.expm1(-b * math.log(10) * x) / math.expm1(-b * math.log(10) * width)
+
+    def loglik(b):
+        p = np.diff(cdf(b))
+        with np.errstate(divide="ignore"):
+            return float(np.sum(counts * np.log(np.maximum(p, 1e-300))))
+
+    lo, hi = -4.0, 8.0        # golden-section search for the maximum (the binned likelihood is unimodal in b)
+    g = (math.sqrt(5) - 1) / 2
+    a, c = hi - g * (hi - lo), lo + g * (hi - lo)
+    fa, fc = loglik(a), loglik(c)
+    for _ in range(60):
+        if fa < fc:
+            lo, a, fa = a, c, fc
+            c = lo + g * (hi - lo)
+            fc = loglik(c)
+        else:
+            hi, c, fc = c, a, fa
+            a = hi - g * (hi - lo)
+            fa = loglik(a)
+    b = (lo + hi) / 2
+    return float(np.max(np.abs(np.cumsum(counts) / n - cdf(b)[1:]))), b
+
+
+def best_decades(counts, edges):
+    """(KS, lo, b) of the stretch [lo, lo + DECADES) with the smallest KS distance (MIN_EVENTS events in it)."""
+    step = int(round(DECADES / np.diff(edges).mean()))
+    best = (math.nan, math.nan, math.nan)
+    for i in range(0, len(edges) - step):
+        part = counts[i:i + step]
+        if part.sum() < MIN_EVENTS:
+            continue
+        ks, b = truncated_gr_ks(part, edges[i:i + step + 1])
+        if not best[0] <= ks:
+            best = (ks, edges[i], b)
+    return best
+
+
+def top_decades(counts, edges):
+    """(KS, lo, b) of the stretch of DECADES below the top of the magnitudes (the bin edge above the 99.9th
+    percentile of the events): the largest events, where a characteristic fault has its hump."""
+    cum = np.cumsum(counts)
+    if cum[-1] <= 0:
+        return math.nan, math.nan, math.nan
+    top = int(np.searchsorted(cum, 0.999 * cum[-1])) + 1
+    step = int(round(DECADES / np.diff(edges).mean()))
+    i = max(top - step, 0)
+    return (*truncated_gr_ks(counts[i:top], edges[i:top + 1])[:1], edges[i],
+            truncated_gr_ks(counts[i:top], edges[i:top + 1])[1])
+
+
+def _with_interval(fn, per_fault, edges, rng, level):
+    """fn(summed counts) of all the faults, and the interval of its first number over resampled faults."""
+    est = fn(per_fault.sum(axis=0), edges)
+    picks = rng.integers(0, len(per_fault), size=(RESAMPLES, len(per_fault)))
+    draws = np.array([fn(per_fault[p].sum(axis=0), edges)[0] for p in picks])
+    lo, hi = stats.percentile_interval(draws, level)
+    return {"ks": [float(est[0]), float(lo), float(hi)], "lo": float(est[1]), "gr_b": float(est[2])}
+
+
+def region_rows(s, f=None, level=0.95, rng=None):
+    rng = rng or np.random.default_rng(0)
+    out = []
+    for i in range(len(s["points/N"])):
+        rows = np.flatnonzero(s["tasks/point"] == i)
+        per_fault = s["per_task/mu"][rows].sum(axis=1)          # (faults, bins)
+        shape = shape_statistics(s, i, level)
+        row = {
+            "region": s["points/region_label"][i], "faults": int(len(rows)),
+            "span_tnu": float(s["points/region_span"][i]),
+            **{name: [float(v) for v in s[f"points/numbers/{name}"][i]]
+               for name in ("n_events", "gr_b", "ks_gr", "fraction_large", "cv_tnu") if f"points/numbers/{name}" in s},
+            "hump": [float(v) for v in shape["peak_over_dip"][:3]], "peak_mu": [float(v) for v in shape["peak_mu"][:3]],
+            "best_two_decades": _with_interval(best_decades, per_fault, s["bins/mu"], rng, level),
+            "top_two_decades": _with_interval(top_decades, per_fault, s["bins/mu"], rng, level),
+        }
+        if f is not None:
+            own, hists = _single_faults(s, rows, f)
+            best = np.array([best_decades(h, f["bins/mu"])[0] for h in hists])
+            top = np.array([top_decades(h, f["bins/mu"])[0] for h in hists])
+            row.update({f"single_faults_{name}": {"median": float(np.nanmedian(v)), "p5": float(np.nanpercentile(v, 5)),
+                                                  "p95": float(np.nanpercentile(v, 95))}
+                        for name, v in (("ks_gr", own), ("best_two_decades", best), ("top_two_decades", top))})
+        out.append(row)
+    return out
+
+
+def _single_faults(s, rows, f):
+    """KS to GR of each of the region's faults, and its histogram of mu over all its events, from the faults' summary
+    (matched by their task)."""
+    key = {(int(c), int(k)): g for g, (c, k) in enumerate(zip(f["tasks/catalog"], f["tasks/catalog_task"]))}
+    tasks = [key[(int(s["tasks/catalog"][g]), int(s["tasks/catalog_task"][g]))] for g in rows]
+    return f["points/numbers/ks_gr"][f["tasks/point"][tasks], 0], f["per_task/mu"][tasks].sum(axis=1).astype(float)
+
+
+def table(rows):
+    def iv(t, d=3):
+        return f"{t[0]:.{d}g} [{t[1]:.{d}g}, {t[2]:.{d}g}]"
+    head = ("| region | faults | events | GR b | KS to GR (mu >= b_cut) | best two decades: KS (from mu, b) | "
+            "top two decades: KS (from mu, b) | large (mu >= mu_c) | hump: peak / dip | CV of T nu | "
+            "single faults' KS to GR / best / top two decades (median, 5-95%) |")
+    lines = [head, "|" + " --- |" * (head.count("|") - 1)]
+    def decades(d):
+        return f"{iv(d['ks'])} (from {d['lo']:g}, b {d['gr_b']:.3g})"
+
+    def spread(d):
+        return f"{d['median']:.3g} ({d['p5']:.3g}-{d['p95']:.3g})"
+    for r in rows:
+        single = " / ".join(spread(r[f"single_faults_{n}"]) for n in ("ks_gr", "best_two_decades", "top_two_decades")
+                            if f"single_faults_{n}" in r) or "-"
+        lines.append(f"| {r['region']} | {r['faults']} | {r['n_events'][0]:.0f} | {iv(r['gr_b'])} | {iv(r['ks_gr'])} | "
+                     f"{decades(r['best_two_decades'])} | {decades(r['top_two_decades'])} | {iv(r['fraction_large'])} | "
+                     f"{iv(r['hump'])} | {iv(r['cv_tnu']) if 'cv_tnu' in r else '-'} | {single} |")
+    return "\n".join(lines)
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("regions", help="a regional summary (analysis reduce --region)")
+    p.add_argument("--faults", help="the same catalog reduced fault by fault (analysis reduce)")
+    p.add_argument("-o", "--output", required=True, help="OUT: writes OUT.md and OUT.json")
+    args = p.parse_args(argv)
+    s = summary.read(args.regions)
+    if "points/region" not in s:
+        print(f"error: {args.regions} is not a regional summary (analysis reduce --region)", file=sys.stderr)
+        return 2
+    rows = region_rows(s, summary.read(args.faults) if args.faults else None, float(s["attrs"]["level"]))
+    out = Path(args.output)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.with_suffix(".json").write_text(json.dumps(rows, indent=1))
+    out.with_suffix(".md").write_text(table(rows) + "\n")
+    print(table(rows))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
