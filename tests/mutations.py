@@ -357,7 +357,9 @@ def applied(text, mutation):
 
 
 def copy_repository(dest):
-    """The files git knows (tracked and untracked-but-not-ignored), as in the working tree."""
+    """The files git knows (tracked and untracked-but-not-ignored), as in the working tree; a `.git` file
+    pointing at this repository's, so that the tests that take older commits' code from git (the identity test,
+    the older catalog formats' attacks) find them in the copy."""
     names = subprocess.run(["git", "ls-files", "-z", "--cached", "--others", "--exclude-standard"],
                            cwd=ROOT, check=True, capture_output=True, timeout=60).stdout.split(b"\0")
     for name in filter(None, names):
@@ -365,6 +367,7 @@ def copy_repository(dest):
         if src.is_file():
             (dest / name.decode()).parent.mkdir(parents=True, exist_ok=True)
             shutil.copy2(src, dest / name.decode())
+    (dest / ".git").write_text(f"gitdir: {subprocess.run(['git', 'rev-parse', '--absolute-git-dir'], cwd=ROOT, check=True, capture_output=True, text=True, timeout=60).stdout.strip()}\n")
 
 
 def run_tests(copy, tests, cache, timeout):
