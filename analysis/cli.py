@@ -64,6 +64,7 @@ NUMERIC = {
     "n_large": lambda v: checks.count("--n-large", v, lo=2, hi=10 ** 9),
     "n_min": lambda v: checks.count("--n-min", v, lo=1, hi=10 ** 9),
     "region_span": lambda v: checks.number("--region-span", v, 0.0, 1e300, exclusive=True),
+    "region_skip": lambda v: checks.number("--region-skip", v, 0.0, 1e300),
 }
 
 
@@ -129,6 +130,7 @@ def _parser():
                    help="pool each population's faults into its region over a common window of loading, each fault "
                         "in proportion to its event rate; intervals resample faults (analysis/region.py)")
     r.add_argument("--region-span", help="the window's span, T*nu (default: the shortest fault's)")
+    r.add_argument("--region-skip", help="start every fault's window this far after its first onset, T*nu (default 0)")
     r.add_argument("--force", action="store_true", help="overwrite an existing summary")
     pl = sub.add_parser("plot", help="summaries -> figure (their points overlaid)")
     pl.add_argument("summaries", nargs="+", metavar="summary",
@@ -252,10 +254,12 @@ def _prepare(args):
     """Options, output path, and the catalogs' task table (merge.Inputs); every check before the work."""
     check_numbers(args)                      # every option before any file is read
     out = check_summary_output(args.output or _default_output(args.catalogs), args.catalogs, args.force)
-    if args.region_span is not None and not args.region:
-        raise checks.UsageError("--region-span is the window of a regional reduction: give --region too")
+    for given in ("region_span", "region_skip"):
+        if getattr(args, given) is not None and not args.region:
+            raise checks.UsageError(f"--{given.replace('_', '-')} sets the window of a regional reduction: give --region too")
     # (checks each file's kind first)
-    inputs = merge.read(args.catalogs, allow_partial=args.partial, region=args.region, span=args.region_span)
+    inputs = merge.read(args.catalogs, allow_partial=args.partial, region=args.region, span=args.region_span,
+                        skip=args.region_skip or 0.0)
     scale = _scales(args, inputs)
     opt = Options(parse_bins(scale["mu_bins"], "--mu-bins"), parse_bins(scale["tnu_bins"], "--tnu-bins"),
                   scale["mu_c"], args.window, scale["b_cut"], args.bootstrap, args.level, args.blocks, args.seed,

@@ -92,10 +92,10 @@ def _unfinished(path, tasks, per_task):
     return int(np.count_nonzero(open_)), str(path).endswith(".partial")
 
 
-def read(paths, allow_partial=False, region=False, span=None):
+def read(paths, allow_partial=False, region=False, span=None, skip=0.0):
     """Inputs of the catalogs at `paths`; every check is made here, before any work. region: pool the faults
     of each population into its region over a common window (analysis/region.py), of span `span` (T nu) if
-    given, else the shortest of its faults'."""
+    given, else the shortest of its faults', each window starting `skip` (T nu) after its fault's first onset."""
     paths = [str(p) for p in paths]
     for i, a in enumerate(paths):
         filekind.require(a, "catalog", CatalogError)
@@ -122,7 +122,7 @@ def read(paths, allow_partial=False, region=False, span=None):
             f"{path.removesuffix('.partial')}`, or reduce what it holds with --partial")
     tasks = _concatenate(tables)
     if region:
-        points, spans, warnings = regions.group(paths, configs, discarded, tasks, span)
+        points, spans, warnings = regions.group(paths, configs, discarded, tasks, span, skip)
         return Inputs(paths, configs, per_tasks, tasks, points, partial, spans, warnings)
     return Inputs(paths, configs, per_tasks, tasks, _points(paths, tasks), partial)
 

@@ -62,7 +62,8 @@ def magnitude(summaries, ax, keys, labels):
         handles.append(Line2D([], [], marker=OPEN, color="0.3", mfc="none", ls="none"))
         texts.append(OPEN_NOTE)
     # outside the axes: a legend never covers a curve
-    ax.legend(handles, texts, title="varying " + ", ".join(keys), fontsize=FONT, title_fontsize=FONT + 1,
+    title = "regions (drawn keys; shared values)" if faults else "varying " + ", ".join(keys)
+    ax.legend(handles, texts, title=title, fontsize=FONT, title_fontsize=FONT + 1,
               loc="upper left", bbox_to_anchor=(1.01, 1.0), ncol=legend_columns(len(points)))
 
 

@@ -9,7 +9,9 @@ fault records run.events events, but a fault of few blocks has fewer events per 
 one. Fault f's window starts at the onset t0_f of its first recorded inertial event and spans W of the
 plate's displacement: its rows (inertial events and creep episodes) with t0_f <= t < t0_f + W / nu. W is the
 shortest span (t_last - t0_f) nu of the region's faults, or `--region-span` (which may not exceed it), so
-that each fault contributes events in proportion to its rate. A recurrence is counted when both of its
+that each fault contributes events in proportion to its rate. `--region-skip S` starts every window S (T nu)
+later (the shortest span shrinks by S): a region's first and second halves, reduced apart, show whether the
+transient was long enough. A recurrence is counted when both of its
 events are in the window; a window cuts no event in two (an event is in when its onset is).
 
 The transient. Each fault discarded the catalog's `transient` events before it recorded (run.transient,
@@ -57,11 +59,12 @@ def bootstrap_key(text):
     return tuple(int.from_bytes(digest[i:i + 4], "little") for i in range(0, 16, 4))
 
 
-def group(paths, configs, discarded, tasks, span=None):
+def group(paths, configs, discarded, tasks, span=None, skip=0.0):
     """Pool the tasks (merge.Inputs.tasks, every catalog's one after the other) into regions: set
     tasks["point"] to the region, add tasks["window_start"], ["window_end"] (model time) and return
     ([(params, rows)], spans {region: W}, warnings). discarded: the events each catalog's tasks discarded
-    before recording (its attribute `transient`). params: {"region": text (describe), "region_label": its
+    before recording (its attribute `transient`). skip: the windows start this far (T nu) after each fault's
+    first onset (--region-skip: the later part of the record alone, e.g. to see that the transient is gone). params: {"region": text (describe), "region_label": its
     label, "law": law, and each of PARAMS: the value its faults share, NaN for a key drawn}."""
     regions, texts = {}, []
     for c, text in enumerate(configs):
@@ -82,15 +85,18 @@ def group(paths, configs, discarded, tasks, span=None):
     for r, (name, short) in enumerate(texts):
         rows = sorted(regions[name], key=lambda g: (int(tasks["seed_entropy"][g]), int(tasks["spawn_key"][g])))
         tasks["point"][rows] = r
-        own = (last[rows] - start[rows]) * tasks["nu"][rows]
+        own = (last[rows] - start[rows]) * tasks["nu"][rows] - skip
         shortest = int(np.argmin(own))
         where = f"{paths[tasks['catalog'][rows[shortest]]]} task {tasks['catalog_task'][rows[shortest]]}"
         if not own[shortest] > 0:
-            raise RegionError(f"{where}: fewer than two inertial events recorded, so no window (region {r}: {name})")
+            raise RegionError(f"{where}: fewer than two inertial events recorded" + (f" after --region-skip {skip:g}"
+                              if skip else "") + f", so no window (region {r}: {name})")
         if span is not None and span > own[shortest]:
-            raise RegionError(f"--region-span {span:g}: {where} spans only {own[shortest]:.6g} (T nu) of region {r}")
+            raise RegionError(f"--region-span {span:g}: {where} spans only {own[shortest]:.6g} (T nu)"
+                              + (f" after --region-skip {skip:g}" if skip else "") + f" of region {r}")
         spans[r] = own[shortest] if span is None else span
-        tasks["window_end"][rows] = start[rows] + spans[r] / tasks["nu"][rows]
+        tasks["window_start"][rows] = start[rows] + skip / tasks["nu"][rows]
+        tasks["window_end"][rows] = tasks["window_start"][rows] + spans[r] / tasks["nu"][rows]
         shared = {p: (float(tasks[p][rows[0]]) if np.all(tasks[p][rows] == tasks[p][rows[0]]) else np.nan) for p in PARAMS}
         points.append(({**shared, "region": name, "region_label": short, "law": str(tasks["law"][rows[0]])}, rows))
         warnings += _transient_warnings(paths, discarded, tasks, rows, r)

@@ -48,6 +48,7 @@ BAD = {
     "seis_short": ["nan", "inf", "-1", "1e400"],
     "seis_long": ["nan", "inf", "-0.5", "1e400"],
     "region_span": ["nan", "inf", "0", "-1", "1e400", "x"],
+    "region_skip": ["nan", "inf", "-1", "1e400", "x"],
 }
 ENV = child_env(PYTHONPATH=str(ROOT))   # this checkout's packages, wherever the command runs
 OPTION = {dest: "--" + dest.replace("_", "-") for dest in BAD}

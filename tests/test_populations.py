@@ -221,6 +221,13 @@ def test_a_region_of_two_faults_is_their_rate_weighted_mixture(two_faults):
     assert list(p["points/numbers/n_events"][:, 0]) == [400, 400]
     res = analysis_cli("report", out)
     assert res.returncode == 0 and "region 0: b: uniform on [20, 50]; N = 40" in res.stdout
+    # the later part alone: windows from 100 (T nu / nu) after each first onset, for the 299 left of the shorter span
+    later = d / "two.later.h5"
+    res = analysis_cli("reduce", path, "--region", "--region-skip", 100 * nu, "-o", later, "--bootstrap", 20)
+    assert res.returncode == 0, res.stderr
+    s = summary.read(later)
+    assert np.allclose(s["tasks/window_start"], [100.0, 200.0], rtol=1e-12)
+    assert s["points/numbers/n_events"][0][0] == 299 + 42      # t in [100, 399) and 100 + 7k in [200, 499)
 
 
 def test_region_errors_are_one_line(two_faults, tmp_path):
@@ -230,6 +237,8 @@ def test_region_errors_are_one_line(two_faults, tmp_path):
     assert res.stderr.strip().count("\n") == 0
     res = analysis_cli("reduce", path, "--region-span", 1e-6, "-o", tmp_path / "x.h5")
     assert res.returncode == 2 and "give --region too" in res.stderr
+    res = analysis_cli("reduce", path, "--region", "--region-skip", 1.0, "-o", tmp_path / "x.h5")
+    assert res.returncode == 2 and "fewer than two inertial events recorded after --region-skip 1" in res.stderr
     single = tmp_path / "single.h5"
     text = "[model]\nN = 40\n[run]\nevents = 400\ntransient = 5\nseeds = 1\n"
     write_events(single, text, [_events(0, np.arange(400.0), 1.05)])
