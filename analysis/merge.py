@@ -122,7 +122,7 @@ def read(paths, allow_partial=False, region=False, span=None, skip=0.0):
             f"{path.removesuffix('.partial')}`, or reduce what it holds with --partial")
     tasks = _concatenate(tables)
     if region:
-        points, spans, warnings = regions.group(paths, configs, discarded, tasks, span, skip)
+        points, spans, warnings = regions.group(paths, configs, discarded, tasks, span, skip, bool(partial))
         return Inputs(paths, configs, per_tasks, tasks, points, partial, spans, warnings)
     return Inputs(paths, configs, per_tasks, tasks, _points(paths, tasks), partial)
 

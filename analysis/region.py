@@ -59,13 +59,24 @@ def bootstrap_key(text):
     return tuple(int.from_bytes(digest[i:i + 4], "little") for i in range(0, 16, 4))
 
 
-def group(paths, configs, discarded, tasks, span=None, skip=0.0):
+def group(paths, configs, discarded, tasks, span=None, skip=0.0, partial=False):
     """Pool the tasks (merge.Inputs.tasks, every catalog's one after the other) into regions: set
     tasks["point"] to the region, add tasks["window_start"], ["window_end"] (model time) and return
     ([(params, rows)], spans {region: W}, warnings). discarded: the events each catalog's tasks discarded
     before recording (its attribute `transient`). skip: the windows start this far (T nu) after each fault's
-    first onset (--region-skip: the later part of the record alone, e.g. to see that the transient is gone). params: {"region": text (describe), "region_label": its
+    first onset (--region-skip: the later part of the record alone, e.g. to see that the transient is gone).
+    partial: a reduction of unfinished runs; its faults with fewer than two inertial events are left out of
+    `tasks` (said in a warning). params: {"region": text (describe), "region_label": its
     label, "law": law, and each of PARAMS: the value its faults share, NaN for a key drawn}."""
+    warnings = []
+    start, last = _onsets(paths, tasks)
+    if partial and not np.all(last > start):
+        kept = last > start
+        warnings.append(f"{np.count_nonzero(~kept)} of {len(kept)} faults left out: fewer than two inertial events "
+                        "recorded yet (a partial reduction)")
+        for name in tasks:
+            tasks[name] = tasks[name][kept]
+        start, last = start[kept], last[kept]
     regions, texts = {}, []
     for c, text in enumerate(configs):
         cfg = loads(text)
@@ -79,9 +90,8 @@ def group(paths, configs, discarded, tasks, span=None, skip=0.0):
                 regions[name] = []
                 texts.append((name, short))
             regions[name].append(int(g))
-    start, last = _onsets(paths, tasks)
-    tasks["window_start"], tasks["window_end"] = start, np.full(len(start), np.nan)
-    points, spans, warnings = [], {}, []
+    tasks["window_start"], tasks["window_end"] = start.copy(), np.full(len(start), np.nan)
+    points, spans = [], {}
     for r, (name, short) in enumerate(texts):
         rows = sorted(regions[name], key=lambda g: (int(tasks["seed_entropy"][g]), int(tasks["spawn_key"][g])))
         tasks["point"][rows] = r

@@ -230,6 +230,21 @@ def test_a_region_of_two_faults_is_their_rate_weighted_mixture(two_faults):
     assert s["points/numbers/n_events"][0][0] == 299 + 42      # t in [100, 399) and 100 + 7k in [200, 499)
 
 
+def test_a_partial_region_leaves_out_the_faults_not_yet_recorded(tmp_path):
+    """An unfinished run: a third fault with no events yet is left out with --partial (said), and the region is
+    the two faults' mixture."""
+    path = tmp_path / "three.h5"
+    write_events(path, POPULATION.format(faults=3, extra=""), [
+        _events(0, np.arange(400.0), 1.05), _events(1, 100 + 7 * np.arange(400.0), 3.05), _events(2, [], 2.0)])
+    res = analysis_cli("reduce", path, "--region", "-o", tmp_path / "r.h5")
+    assert res.returncode == 1 and "unfinished run" in res.stderr
+    res = analysis_cli("reduce", path, "--region", "--partial", "-o", tmp_path / "r.h5", "--bootstrap", 20)
+    assert res.returncode == 0, res.stderr
+    assert "1 of 3 faults left out: fewer than two inertial events recorded yet" in res.stderr
+    s = summary.read(tmp_path / "r.h5")
+    assert s["points/numbers/n_events"][0][0] == 399 + 57 and list(s["tasks/catalog_task"]) == [0, 1]
+
+
 def test_region_errors_are_one_line(two_faults, tmp_path):
     d, path = two_faults
     res = analysis_cli("reduce", path, "--region", "--region-span", 1.0, "-o", tmp_path / "x.h5")

@@ -9,7 +9,7 @@ catalog (each fault a point of its own). For each region it gives, with 95% inte
   (the summary's numbers);
 - the best two decades: for every stretch [lo, lo + 2) of mu (lo on the bins' edges, at least MIN_EVENTS events
   in it), the KS distance of the binned magnitudes from a Gutenberg-Richter law truncated to the stretch (b by
-  maximum likelihood on the bins); the smallest of them and its lo, and its b. A region "looks critical" where
+  maximum likelihood on the bins, within B_RANGE: a law that falls); the smallest of them and its lo, and its b. A region "looks critical" where
   that KS is below 0.05 (the working definition of the issue);
 - the fraction of large events (mu >= mu_c) and the hump: R at the large-magnitude peak over R at the dip below
   it (analysis/paper.py's shape statistics);
@@ -34,6 +34,9 @@ DECADES = 2.0        # the stretch of mu a critical-looking region must follow G
 MIN_EVENTS = 1000    # events a stretch needs for its KS distance to be read
 RESAMPLES = 300      # bootstrap resamples of the faults for the two-decade KS
 CRITICAL_KS = 0.05
+# a Gutenberg-Richter law falls with mu: b is fitted within this range (a rising R(mu) is no GR law; at the lower
+# end the fit is a flat R(mu), and its KS says how far the data are from even that)
+B_RANGE = (0.01, 8.0)
 
 
 def truncated_gr_ks(counts, edges):
@@ -54,7 +57,7 @@ def truncated_gr_ks(counts, edges):
         with np.errstate(divide="ignore"):
             return float(np.sum(counts * np.log(np.maximum(p, 1e-300))))
 
-    lo, hi = -4.0, 8.0        # golden-section search for the maximum (the binned likelihood is unimodal in b)
+    lo, hi = B_RANGE          # golden-section search for the maximum (the binned likelihood is unimodal in b)
     g = (math.sqrt(5) - 1) / 2
     a, c = hi - g * (hi - lo), lo + g * (hi - lo)
     fa, fc = loglik(a), loglik(c)
