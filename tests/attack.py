@@ -121,7 +121,8 @@ class Workshop:
         self.cfg = self.root / "cfg.toml"
         self.cfg.write_text(CONFIG)
         self.full = self.root / "full.h5"
-        res = _python("ensemble", "run", self.cfg, "-o", self.full)
+        # (the first run of a session may compile the kernels: about a minute alone, more beside other tests)
+        res = _python("ensemble", "run", self.cfg, "-o", self.full, timeout=COMPILE)
         assert res.returncode == 0, res.stderr
         self.crashed = self.root / "crashed.h5"
         res = _python("ensemble", "run", self.cfg, "-o", self.crashed, setup="inject.crash_at_write(60)")

@@ -42,7 +42,8 @@ def files(tmp_path_factory):
     d = tmp_path_factory.mktemp("input_errors")
     cfg = write_config(d / "cfg.toml", run={"seeds": 2, "events": 40, "transient": 5},
                        integrator={"method": "ark4"})
-    assert run("ensemble", "run", cfg, "-o", d / "cat.h5").returncode == 0
+    # (the first run of a session may compile the kernels: about a minute alone, more beside other tests)
+    assert run("ensemble", "run", cfg, "-o", d / "cat.h5", timeout=5 * TIMEOUT).returncode == 0
     res = run("analysis", "reduce", d / "cat.h5", "-o", d / "sum.h5", "--bootstrap", "20")
     assert res.returncode == 0, res.stderr
     data = (d / "cat.h5").read_bytes()
