@@ -58,6 +58,7 @@ Model = dataclasses.make_dataclass(
     "Model", [(name, float, field(default=None)) for name in LAW_KEYS], bases=(_Chain,), frozen=True)
 Model.__doc__ = _Chain.__doc__
 Model.__module__ = __name__
+MODEL_TYPES = {f.name: f.type for f in fields(Model)}   # [model] key -> int, float or str
 
 
 # run.transient's default, in events per block of the longest chain of the sweep: from the random
@@ -203,7 +204,7 @@ def _section(name, raw, overridden):
 def _sweep(raw, overridden, law_keys):
     if not isinstance(raw, dict):
         raise ConfigError("[sweep] must be a table")
-    types = {f.name: f.type for f in fields(Model)}
+    types = MODEL_TYPES
     out = []
     for key, values in _flat(raw):
         with from_set(overridden, "sweep", key):
@@ -266,7 +267,7 @@ def from_dict(raw, overridden=None):
             raise ConfigError(f"unknown section [{name}] (known: {', '.join(sorted(allowed))})")
     parts = {name: _section(name, raw.get(name, {}), overridden) for name in SECTIONS}
     law_keys = parts["model"].law_keys()
-    types = {f.name: f.type for f in fields(Model)}
+    types = MODEL_TYPES
     population = _population(raw[POPULATION], overridden, types, law_keys) if POPULATION in raw else None
     sweep = _sweep(raw.get(SWEEP, {}), overridden, law_keys)
     populations.check_run(population, sweep, parts["run"])

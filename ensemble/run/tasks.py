@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..config import Model
+from ..config import MODEL_TYPES, Model
 from ..model import laws
 from ..population import draw_values
 
@@ -26,7 +26,7 @@ def task_list(cfg):
     [population], each point of the sweep is a region of population.faults faults, each fault a point
     of its own with one task: task = point = region * faults + fault."""
     tasks = []
-    types = {f.name: f.type for f in dataclasses.fields(Model)}
+    types = MODEL_TYPES
     for point, (model, draws) in enumerate(sweep_points(cfg)):
         if cfg.population is None:
             for s in range(cfg.run.seeds):
