@@ -40,52 +40,55 @@ B_RANGE = (0.01, 8.0)
 
 
 def truncated_gr_ks(counts, edges):
-    """(KS, b) of binned magnitudes on [edges[0], edges[-1]) against GR truncated to it, b by binned maximum likelihood."""
-    n = counts.sum()
-    if n <= 0:
-        return math.nan, math.nan
-    x = edges - edges[0]
-    width = x[-1]
+    """(KS, b) of binned magnitudes on [edges[0], edges[-1]) against GR truncated to it, b by binned maximum
+    likelihood. counts may be a stack of histograms (rows) on the same bins: then arrays of KS and b."""
+    counts = np.asarray(counts, dtype=float)
+    x = np.asarray(edges, dtype=float) - edges[0]
+    rows = np.atleast_2d(counts)
+    n = rows.sum(axis=1)
 
-    def cdf(b):
-        if abs(b) < 1e-9:
-            return x / width
-        return np.expm1(-b * math.log(10) * x) / math.expm1(-b * math.log(10) * width)
+    def cdf(b):               # (rows, bins + 1): GR truncated to [0, width), one b per row
+        k = (b * math.log(10))[:, None]
+        flat = np.abs(k) < 1e-9
+        with np.errstate(invalid="ignore", divide="ignore"):
+            out = np.expm1(-k * x) / np.expm1(-k * x[-1])
+        return np.where(flat, x / x[-1], out)
 
     def loglik(b):
-        p = np.diff(cdf(b))
         with np.errstate(divide="ignore"):
-            return float(np.sum(counts * np.log(np.maximum(p, 1e-300))))
+            return np.sum(rows * np.log(np.maximum(np.diff(cdf(b), axis=1), 1e-300)), axis=1)
 
-    lo, hi = B_RANGE          # golden-section search for the maximum (the binned likelihood is unimodal in b)
+    # golden-section search for the maximum of each row (the binned likelihood is unimodal in b)
+    lo, hi = np.full(len(rows), B_RANGE[0]), np.full(len(rows), B_RANGE[1])
     g = (math.sqrt(5) - 1) / 2
     a, c = hi - g * (hi - lo), lo + g * (hi - lo)
     fa, fc = loglik(a), loglik(c)
-    for _ in range(60):
-        if fa < fc:
-            lo, a, fa = a, c, fc
-            c = lo + g * (hi - lo)
-            fc = loglik(c)
-        else:
-            hi, c, fc = c, a, fa
-            a = hi - g * (hi - lo)
-            fa = loglik(a)
+    for _ in range(45):     # the bracket shrinks by 0.618^45 = 4e-10
+        right = fa < fc         # the maximum lies in [a, hi]
+        lo, hi = np.where(right, a, lo), np.where(right, hi, c)
+        a, c = np.where(right, c, hi - g * (hi - lo)), np.where(right, lo + g * (hi - lo), a)
+        fresh = np.where(right, c, a)
+        f_new = loglik(fresh)
+        fa, fc = np.where(right, fc, f_new), np.where(right, f_new, fa)
     b = (lo + hi) / 2
-    return float(np.max(np.abs(np.cumsum(counts) / n - cdf(b)[1:]))), b
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ks = np.max(np.abs(np.cumsum(rows, axis=1) / n[:, None] - cdf(b)[:, 1:]), axis=1)
+    ks, b = np.where(n > 0, ks, np.nan), np.where(n > 0, b, np.nan)
+    return (ks, b) if counts.ndim == 2 else (float(ks[0]), float(b[0]))
 
 
 def best_decades(counts, edges):
     """(KS, lo, b) of the stretch [lo, lo + DECADES) with the smallest KS distance (MIN_EVENTS events in it)."""
     step = int(round(DECADES / np.diff(edges).mean()))
-    best = (math.nan, math.nan, math.nan)
-    for i in range(0, len(edges) - step):
-        part = counts[i:i + step]
-        if part.sum() < MIN_EVENTS:
-            continue
-        ks, b = truncated_gr_ks(part, edges[i:i + step + 1])
-        if not best[0] <= ks:
-            best = (ks, edges[i], b)
-    return best
+    starts = np.arange(0, len(edges) - step)
+    windows = np.lib.stride_tricks.sliding_window_view(np.asarray(counts, dtype=float), step)[starts]
+    enough = windows.sum(axis=1) >= MIN_EVENTS
+    if not enough.any():
+        return math.nan, math.nan, math.nan
+    # equal bins: every stretch has the same bin offsets, so all are fitted at once
+    ks, b = truncated_gr_ks(windows[enough], edges[:step + 1])
+    i = int(np.argmin(ks))
+    return float(ks[i]), float(edges[starts[enough][i]]), float(b[i])
 
 
 def top_decades(counts, edges):
@@ -97,8 +100,8 @@ def top_decades(counts, edges):
     top = int(np.searchsorted(cum, 0.999 * cum[-1])) + 1
     step = int(round(DECADES / np.diff(edges).mean()))
     i = max(top - step, 0)
-    return (*truncated_gr_ks(counts[i:top], edges[i:top + 1])[:1], edges[i],
-            truncated_gr_ks(counts[i:top], edges[i:top + 1])[1])
+    ks, b = truncated_gr_ks(counts[i:top], edges[i:top + 1])
+    return ks, float(edges[i]), b
 
 
 def _with_interval(fn, per_fault, edges, rng, level):
