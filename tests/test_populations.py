@@ -345,3 +345,41 @@ def test_the_model_record_of_a_fault_is_its_draw():
         drawn = draw_values(cfg.population, t.fault, cfg.population.draws, types)
         assert {k: getattr(t.model, k) for k in drawn} == drawn
         assert isinstance(t.model.N, int) and t.model.c == 1000.0
+
+
+def _answer():
+    """examples/populations/answer.py, the table of docs/populations.md (a script, not a module of the package)."""
+    sys.path.insert(0, str(__import__("pathlib").Path(__file__).parents[1] / "examples" / "populations"))
+    try:
+        import answer
+    finally:
+        sys.path.pop(0)
+    return answer
+
+
+def _gr_counts(b, lo, hi, n, edges):
+    """The expected (not drawn) counts of n magnitudes of GR(b) truncated to [lo, hi), in the bins of edges."""
+    k = b * math.log(10)
+    cdf = np.clip((1 - np.exp(-k * (edges - lo))) / (1 - math.exp(-k * (hi - lo))), 0, 1)
+    return n * np.diff(cdf)
+
+
+def test_the_answers_two_decade_fit_recovers_a_gutenberg_richter_law():
+    """answer.py's truncated-GR fit: exact GR counts give b back and KS 0; the best stretch of a GR law with a
+    hump of large events is found below the hump; the top stretch, over the hump, is far from GR; a stack of
+    histograms is fitted as each alone."""
+    answer = _answer()
+    edges = np.linspace(0, 7, 701)
+    gr = _gr_counts(0.7, 1.0, 7.0, 1e5, edges)
+    ks, b = answer.truncated_gr_ks(gr[100:300], edges[100:301])
+    assert b == pytest.approx(0.7, abs=1e-6) and ks < 1e-7
+    hump = gr + 2e4 * np.diff(0.5 * (1 + np.vectorize(math.erf)((edges - 5.2) / (0.2 * math.sqrt(2)))))
+    ks, lo, b = answer.best_decades(hump, edges)
+    assert ks < 1e-6 and lo + 2 <= 4.4 and b == pytest.approx(0.7, abs=1e-4)
+    ks, lo, b = answer.top_decades(hump, edges)
+    assert ks > 0.3 and 3 <= lo < 4.5
+    rows = np.stack([gr[200:400], hump[200:400], np.zeros(200)])
+    ks_all, b_all = answer.truncated_gr_ks(rows, edges[200:401])
+    for i in range(2):
+        assert (ks_all[i], b_all[i]) == pytest.approx(answer.truncated_gr_ks(rows[i], edges[200:401]), rel=1e-9)
+    assert np.isnan(ks_all[2]) and np.isnan(b_all[2])
