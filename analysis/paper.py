@@ -79,16 +79,21 @@ def _shape(row, edges, c):
         return np.array([c[k], r[k], c[j], r[j], r[k] / r[j], r[flat].max() / r[flat].min()])
 
 
-def shape_statistics(s, i, level=None):
+def shape_statistics(s, i, level=None, merge=1):
     """R(mu) shape numbers of point i with bootstrap intervals over its units (the summary's:
     seeds or a region's faults, or the stretches of every trajectory):
     {name: (estimate, lo, hi, share of resamples where it is infinite)}; a ratio over an empty
-    bin is infinite."""
+    bin is infinite. merge: read R(mu) in bins of that many of the summary's (a peak and a dip
+    read from narrow bins are their noise's extremes, and the ratio's resamples lie above it)."""
     level = s["attrs"]["level"] if level is None else level
-    edges = s["bins/mu"]
+    edges = s["bins/mu"][::merge]
     c = stats.centers(edges)
     tasks = np.flatnonzero(s["tasks/point"] == i)
     counts, events = s["per_task/mu"][tasks], s["per_task/numbers"][tasks][:, :, LAYOUT.column("numbers", "n_events")]
+    if merge > 1:
+        if (len(s["bins/mu"]) - 1) % merge:
+            raise ValueError(f"{len(s['bins/mu']) - 1} bins of mu do not merge by {merge}")
+        counts = counts.reshape(*counts.shape[:-1], len(c), merge).sum(axis=-1)
     if s["points/method"][i] in ("seeds", "faults"):   # the summary's own units: seeds (a region's faults), else every stretch
         counts, events = counts.sum(axis=1, keepdims=True), events.sum(axis=1, keepdims=True)
     rows = np.concatenate([counts.reshape(-1, len(c)), events.reshape(-1, 1)], axis=1)

@@ -166,6 +166,22 @@ def test_shape_intervals_resample_the_summarys_units():
     assert lo == est == hi
 
 
+def test_shapes_in_merged_bins_are_those_of_the_coarser_summary():
+    """shape_statistics(merge=k) reads R(mu) as a summary whose bins are k of these each: the same numbers and
+    intervals as that summary; bins that do not merge by k are an error."""
+    s = summary.read(DOCS / "fig1_b.summary.h5")
+    coarse = dict(s)
+    coarse["bins/mu"] = s["bins/mu"][::5]
+    coarse["per_task/mu"] = s["per_task/mu"].reshape(*s["per_task/mu"].shape[:-1], -1, 5).sum(axis=-1)
+    for i in range(len(s["points/b"])):
+        merged, direct = paper.shape_statistics(s, i, merge=5), paper.shape_statistics(coarse, i)
+        for name in paper.SHAPES:
+            assert merged[name] == pytest.approx(direct[name], nan_ok=True), name
+    assert paper.shape_statistics(s, 0, merge=5)["dip_r"][0] != paper.shape_statistics(s, 0)["dip_r"][0]
+    with pytest.raises(ValueError, match="do not merge by 3"):
+        paper.shape_statistics(s, 0, merge=3)
+
+
 def test_tables_py_on_a_reduced_run_says_reduced(reduced, tmp_path):
     """The reported case: examples/paper/tables.py on a reduced Fig. 1 top summary printed
     "346 [160, nan]" under a heading saying full size. It is analysis paper's table now."""

@@ -12,7 +12,7 @@ catalog (each fault a point of its own). For each region it gives, with 95% inte
   maximum likelihood on the bins, within B_RANGE: a law that falls); the smallest of them and its lo, and its b. A region "looks critical" where
   that KS is below 0.05 (the working definition of the issue);
 - the fraction of large events (mu >= mu_c) and the hump: R at the large-magnitude peak over R at the dip below
-  it (analysis/paper.py's shape statistics);
+  it (analysis/paper.py's shape statistics, in bins of 0.1);
 - the CV of the local recurrence times;
 - beside them the single faults of the region: the median and the 5-95% range of their own KS to GR (each fault
   over all its recorded events).
@@ -34,6 +34,7 @@ DECADES = 2.0        # the stretch of mu a critical-looking region must follow G
 MIN_EVENTS = 1000    # events a stretch needs for its KS distance to be read
 RESAMPLES = 300      # bootstrap resamples of the faults for the two-decade KS
 CRITICAL_KS = 0.05
+HUMP_MERGE = 10      # the hump is read in bins of 0.1 in mu (10 of the summary's 0.01): from 0.01 bins its dip is noise
 # a Gutenberg-Richter law falls with mu: b is fitted within this range (a rising R(mu) is no GR law; at the lower
 # end the fit is a flat R(mu), and its KS says how far the data are from even that)
 B_RANGE = (0.01, 8.0)
@@ -119,7 +120,7 @@ def region_rows(s, f=None, level=0.95, rng=None):
     for i in range(len(s["points/N"])):
         rows = np.flatnonzero(s["tasks/point"] == i)
         per_fault = s["per_task/mu"][rows].sum(axis=1)          # (faults, bins)
-        shape = shape_statistics(s, i, level)
+        shape = shape_statistics(s, i, level, merge=HUMP_MERGE)
         row = {
             "region": s["points/region_label"][i], "faults": int(len(rows)),
             "span_tnu": float(s["points/region_span"][i]),
