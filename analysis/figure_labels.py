@@ -60,8 +60,8 @@ def _values(values, fmt="{}"):
 
 
 def _units(s):
-    """What a summary's bands resample: "20 stretches", "4 seeds" (or a range of counts)."""
-    words = {"blocks": "stretches", "seeds": "seeds"}
+    """What a summary's bands resample: "20 stretches", "4 seeds", "200 faults" (or a range of counts)."""
+    words = {"blocks": "stretches", "seeds": "seeds", "faults": "faults"}
     return " / ".join(dict.fromkeys(
         f"{min(n)}-{max(n)} {words[m]}" if min(n) != max(n) else f"{n[0]} {words[m]}"
         for m in dict.fromkeys(s["points/method"])

@@ -17,7 +17,7 @@
     /points/{N, l, nu, <law keys>}              parameters of each point (first appearance order;
                                                 the keys of every friction law, NaN if not its law's)
     /points/law                                 its friction law (two laws may share keys: aging, slip)
-    /points/method, /points/units               resampling used ("seeds" or "blocks") and unit count
+    /points/method, /points/units               resampling used ("seeds", "faults" or "blocks") and unit count
     /points/{mu, tnu, tnu_interior}_density     (points, bins): estimate; *_lo, *_hi: interval
     /points/{creep_mu, creep_duration}_density  the same for the creep episodes (format 3)
     /points/numbers/<name>                      (points, 3): estimate, lo, hi (see reduce.NUMBERS)

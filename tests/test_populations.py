@@ -283,6 +283,13 @@ def test_a_region_of_many_faults_resamples_faults(tmp_path):
     draws = counts[rng.integers(0, 12, size=(300, 12))].sum(axis=1)
     lo, hi = np.percentile(draws, [2.5, 97.5], method="linear")
     assert s["points/numbers/n_events"][0][1:] == pytest.approx([lo, hi], rel=1e-12)
+    # the figure says what its bands resample (a region's faults)
+    from analysis import plot
+    import matplotlib.pyplot as plt
+    fig = plot.figure([s], "magnitude")
+    words = [t.get_text() for t in fig.findobj(match=lambda a: hasattr(a, "get_text"))]
+    assert any("bootstrap over 12 faults" in w for w in words), words
+    plt.close(fig)
 
 
 def test_a_regions_magnitude_figure_shows_its_faults(two_faults):
