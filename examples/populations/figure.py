@@ -1,0 +1,116 @@
+"""The figure of docs/populations.md and the README: does a region of many characteristic faults look critical?
+
+    python examples/populations/figure.py REGIONS.summary.h5 ANSWER.json -o docs/populations/regions.png
+
+REGIONS: `analysis reduce CATALOG --region --mu-bins 0:7:70` (R(mu) in bins of 0.1); ANSWER.json: what
+examples/populations/answer.py wrote from the same catalog in bins of 0.01. One panel per region: its R(mu) with
+its 95% band over faults, the 5-95% range of its single faults' own R(mu) (each in its window) in grey, the
+Gutenberg-Richter law fitted to its best two decades (answer.py) over them, and a law of slope b = 2/3 (a real
+catalog's, in mu = log10 of the slip) through the same point. A last panel: the KS distance of the best and of
+the top two decades, each region's with its interval over faults beside its single faults' 5-95% range, and the
+working definition of critical, KS < 0.05.
+"""
+import argparse
+import json
+import math
+import sys
+
+import numpy as np
+
+from analysis import summary
+from analysis.drawing import FONT, band
+from analysis.plot import fault_densities, plt
+from analysis.stats import centers
+
+REAL_B = 2 / 3       # GR b of a real catalog (about 1 in moment magnitude) in mu = log10 of the slip
+CRITICAL_KS = 0.05
+
+
+def gr_line(s, i, fit, edges):
+    """(mu, R) of the truncated GR law fitted on [lo, lo + 2): the region's share of events there, spread as the law."""
+    lo, b = fit["lo"], fit["gr_b"]
+    c = centers(edges)
+    inside = (c >= lo) & (c < lo + 2)
+    share = float(np.sum(s["points/mu_density"][i][inside] * np.diff(edges)[inside]))
+    mu = np.linspace(lo, lo + 2, 50)
+    k = b * math.log(10)
+    return mu, share * k * np.exp(-k * (mu - lo)) / -math.expm1(-2 * k)
+
+
+def region_panel(ax, s, i, row):
+    edges = s["bins/mu"]
+    c = centers(edges)
+    faults = fault_densities(s, i)
+    with np.errstate(invalid="ignore"):
+        p5, p95 = np.nanpercentile(np.where(faults > 0, faults, np.nan), [5, 95], axis=0)
+    ok = np.isfinite(p5) & np.isfinite(p95)
+    ax.fill_between(c[ok], p5[ok], p95[ok], color="0.85", lw=0, label="single faults: 5-95%", zorder=1)
+    band(ax, c, s["points/mu_density"][i], s["points/mu_lo"][i], s["points/mu_hi"][i], "the region", "C0",
+         log=True, open_ends=True)
+    mu, r = gr_line(s, i, row["best_two_decades"], edges)
+    fit = row["best_two_decades"]
+    ax.plot(mu, r, color="C3", lw=1.5, label="GR law fitted to the best two decades", zorder=4)
+    ax.text(0.03, 0.03, f"best two decades: b = {fit['gr_b']:.2f}, KS = {fit['ks'][0]:.3f}",
+            transform=ax.transAxes, fontsize=FONT - 1)
+    ax.plot(mu, r[0] * 10 ** (-REAL_B * (mu - mu[0])), color="k", ls="--", lw=1,
+            label="slope of a real catalog (b = 2/3)", zorder=4)
+    ax.set_yscale("log")
+    ax.set_ylim(1e-4, 5)
+    ax.set_xlabel(r"magnitude $\mu$")
+    ax.set_title(row["region"].split(";")[0] + f"\n{row['faults']} faults, {row['n_events'][0]:.3g} events",
+                 fontsize=FONT)
+
+
+def ks_panel(ax, rows):
+    x = np.arange(len(rows))
+    for shift, key, color, name in ((-0.12, "best_two_decades", "C3", "best two decades"),
+                                    (0.12, "top_two_decades", "C1", "top two decades")):
+        est = np.array([r[key]["ks"] for r in rows])
+        ax.errorbar(x + shift, est[:, 0], yerr=[est[:, 0] - est[:, 1], est[:, 2] - est[:, 0]], fmt="o",
+                    color=color, label=f"region, {name}", zorder=3)
+        single = [r.get(f"single_faults_{key}") for r in rows]
+        if all(single):
+            ax.vlines(x + shift + 0.06, [d["p5"] for d in single], [d["p95"] for d in single], color="0.6", lw=3,
+                      label="single faults' KS: 5-95%" if key == "best_two_decades" else None)
+            ax.plot(x + shift + 0.06, [d["median"] for d in single], "_", color="k", ms=8,
+                    label="single faults' KS: median" if key == "best_two_decades" else None)
+    ax.axhline(CRITICAL_KS, color="k", ls=":", lw=1, label="critical: KS < 0.05")
+    ax.set_yscale("log")
+    ax.set_xticks(x, [r["region"].split(";")[0].replace("N: ", "N ") for r in rows], fontsize=FONT - 1,
+                  rotation=15)
+    ax.set_ylabel("KS distance to a truncated GR law")
+    ax.set_title("two decades of mu against GR", fontsize=FONT)
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("regions", help="a regional summary in bins of 0.1 (analysis reduce --region --mu-bins 0:7:70)")
+    p.add_argument("answer", help="the ANSWER.json of examples/populations/answer.py")
+    p.add_argument("-o", "--output", required=True)
+    args = p.parse_args(argv)
+    s = summary.read(args.regions)
+    rows = json.loads(open(args.answer).read())
+    labels = list(s["points/region_label"])
+    if [r["region"] for r in rows] != labels:
+        print(f"error: {args.answer} is not the answer of {args.regions}'s regions", file=sys.stderr)
+        return 2
+    fig, axes = plt.subplots(1, len(rows) + 1, figsize=(4.2 * (len(rows) + 1), 4.6),
+                             gridspec_kw={"width_ratios": [1] * len(rows) + [1.1]})
+    for i, (ax, row) in enumerate(zip(axes, rows)):
+        region_panel(ax, s, i, row)
+        if i:
+            ax.sharey(axes[0])
+    axes[0].set_ylabel(r"$R(\mu)$")
+    handles, texts = axes[0].get_legend_handles_labels()
+    ks_panel(axes[-1], rows)
+    h2, t2 = axes[-1].get_legend_handles_labels()
+    fig.legend(handles + h2, texts + t2,
+               loc="lower center", ncol=4, fontsize=FONT, bbox_to_anchor=(0.5, -0.02))
+    fig.tight_layout(rect=(0, 0.12, 1, 1))
+    fig.savefig(args.output, dpi=110)
+    print(f"wrote {args.output}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
