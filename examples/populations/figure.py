@@ -2,9 +2,8 @@
 
     python examples/populations/figure.py REGIONS.summary.h5 ANSWER.json -o docs/populations/regions.png
 
-REGIONS: `analysis reduce CATALOG --region --mu-bins 0:7:70` (R(mu) in bins of 0.1); ANSWER.json: what
-examples/populations/answer.py wrote from the same catalog in bins of 0.01. One panel per region: its R(mu) with
-its 95% band over faults, the 5-95% range of its single faults' own R(mu) (each in its window) in grey, the
+REGIONS: `analysis reduce CATALOG --region --mu-bins 0:7:700`; ANSWER.json: what examples/populations/answer.py
+wrote from it. One panel per region: its R(mu) in bins of 0.1 with its 95% band (a bootstrap over its faults), the 5-95% range of its single faults' own R(mu) (each in its window) in grey, the
 Gutenberg-Richter law fitted to its best two decades (answer.py) over them, and a law of slope b = 2/3 (a real
 catalog's, in mu = log10 of the slip) through the same point. A last panel: the KS distance of the best and of
 the top two decades, each region's with its interval over faults beside its single faults' 5-95% range, and the
@@ -15,44 +14,62 @@ import json
 import math
 import sys
 
+import warnings
+
 import numpy as np
 
-from analysis import summary
+from analysis import stats, summary
 from analysis.drawing import FONT, band
-from analysis.plot import fault_densities, plt
+from analysis.plot import plt
+from analysis.reduce import LAYOUT
 from analysis.stats import centers
 
 REAL_B = 2 / 3       # GR b of a real catalog (about 1 in moment magnitude) in mu = log10 of the slip
 CRITICAL_KS = 0.05
+MERGE = 10           # R(mu) drawn in bins of 0.1: 10 of the summary's 0.01
+RESAMPLES = 1000
 
 
-def gr_line(s, i, fit, edges):
+def merged(s, i, merge):
+    """Region i's faults in bins of `merge` of the summary's: (edges, counts (faults, bins), events per fault in
+    and out of range)."""
+    rows = np.flatnonzero(s["tasks/point"] == i)
+    counts = s["per_task/mu"][rows].sum(axis=1)
+    counts = counts.reshape(len(rows), -1, merge).sum(axis=2)
+    events = s["per_task/numbers"][rows][:, :, LAYOUT.column("numbers", "n_events")].sum(axis=1)
+    return s["bins/mu"][::merge], counts, events
+
+
+def gr_line(edges, r, fit):
     """(mu, R) of the truncated GR law fitted on [lo, lo + 2): the region's share of events there, spread as the law."""
     lo, b = fit["lo"], fit["gr_b"]
-    c = centers(edges)
-    inside = (c >= lo) & (c < lo + 2)
-    share = float(np.sum(s["points/mu_density"][i][inside] * np.diff(edges)[inside]))
+    inside = (centers(edges) >= lo) & (centers(edges) < lo + 2)
+    share = float(np.sum(r[inside] * np.diff(edges)[inside]))
     mu = np.linspace(lo, lo + 2, 50)
     k = b * math.log(10)
     return mu, share * k * np.exp(-k * (mu - lo)) / -math.expm1(-2 * k)
 
 
-def region_panel(ax, s, i, row):
-    edges = s["bins/mu"]
+def region_panel(ax, s, i, row, merge, level, rng):
+    edges, counts, events = merged(s, i, merge)
     c = centers(edges)
-    faults = fault_densities(s, i)
-    with np.errstate(invalid="ignore"):
+    faults = stats.density(counts, edges, events[:, None])
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)       # a bin no fault reaches
         p5, p95 = np.nanpercentile(np.where(faults > 0, faults, np.nan), [5, 95], axis=0)
     ok = np.isfinite(p5) & np.isfinite(p95)
     ax.fill_between(c[ok], p5[ok], p95[ok], color="0.85", lw=0, label="single faults: 5-95%", zorder=1)
-    band(ax, c, s["points/mu_density"][i], s["points/mu_lo"][i], s["points/mu_hi"][i], "the region", "C0",
-         log=True, open_ends=True)
-    mu, r = gr_line(s, i, row["best_two_decades"], edges)
+    units = np.concatenate([counts, events[:, None]], axis=1)
+    r = stats.density(counts.sum(axis=0), edges, events.sum())
+    lo, hi = stats.percentile_interval(stats.bootstrap(
+        units, lambda u: stats.density(u[:-1], edges, u[-1]), RESAMPLES, rng), level)
+    band(ax, c, r, lo, hi, "the region (band: its faults resampled)", "C0", log=True, open_ends=True)
     fit = row["best_two_decades"]
-    ax.plot(mu, r, color="C3", lw=1.5, label="GR law fitted to the best two decades", zorder=4)
+    mu, gr = gr_line(edges, r, fit)
+    ax.plot(mu, gr, color="C3", lw=1.5, label="GR law fitted to the best two decades", zorder=4)
     ax.text(0.03, 0.03, f"best two decades: b = {fit['gr_b']:.2f}, KS = {fit['ks'][0]:.3f}",
             transform=ax.transAxes, fontsize=FONT - 1)
-    ax.plot(mu, r[0] * 10 ** (-REAL_B * (mu - mu[0])), color="k", ls="--", lw=1,
+    ax.plot(mu, gr[0] * 10 ** (-REAL_B * (mu - mu[0])), color="k", ls="--", lw=1,
             label="slope of a real catalog (b = 2/3)", zorder=4)
     ax.set_yscale("log")
     ax.set_ylim(1e-4, 5)
@@ -84,7 +101,7 @@ def ks_panel(ax, rows):
 
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("regions", help="a regional summary in bins of 0.1 (analysis reduce --region --mu-bins 0:7:70)")
+    p.add_argument("regions", help="a regional summary in bins of 0.01 (analysis reduce --region --mu-bins 0:7:700)")
     p.add_argument("answer", help="the ANSWER.json of examples/populations/answer.py")
     p.add_argument("-o", "--output", required=True)
     args = p.parse_args(argv)
@@ -97,7 +114,7 @@ def main(argv=None):
     fig, axes = plt.subplots(1, len(rows) + 1, figsize=(4.2 * (len(rows) + 1), 4.6),
                              gridspec_kw={"width_ratios": [1] * len(rows) + [1.1]})
     for i, (ax, row) in enumerate(zip(axes, rows)):
-        region_panel(ax, s, i, row)
+        region_panel(ax, s, i, row, MERGE, float(s["attrs"]["level"]), np.random.default_rng(i))
         if i:
             ax.sharey(axes[0])
     axes[0].set_ylabel(r"$R(\mu)$")
