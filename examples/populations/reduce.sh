@@ -20,6 +20,8 @@ for name in $PARTS; do
       $PY examples/populations/answer.py "$DOCS/$name.region.summary.h5" --faults "$RUNS/$name.faults.summary.h5" \
         -o "$DOCS/$name.answer" > /dev/null
       $PY examples/populations/figure.py "$DOCS/$name.region.summary.h5" "$DOCS/$name.answer.json" -o "$DOCS/$name.png"
+      # where the faults' large events lie, by length and b (lengths.py)
+      $PY examples/populations/lengths.py "$RUNS/$name.h5" --fit-only > "$DOCS/$name.large_events.txt"
       # the transient, checked on the record: the first and the second half of every fault's window
       half=$($PY -c "import sys; from analysis import summary; print(min(summary.read(sys.argv[1])['points/region_span']) / 2)" \
              "$DOCS/$name.region.summary.h5")
