@@ -1,6 +1,7 @@
 """The figure of docs/populations.md and the README: does a region of many characteristic faults look critical?
 
-    python examples/populations/figure.py REGIONS.summary.h5 ANSWER.json -o docs/populations/regions.png
+    python examples/populations/figure.py REGIONS.summary.h5 ANSWER.json [MORE.summary.h5 MORE.json ...] \
+        [--columns 3] -o docs/populations/regions.png
 
 REGIONS: `analysis reduce CATALOG --region --mu-bins 0:7:700`; ANSWER.json: what examples/populations/answer.py
 wrote from it. One panel per region: its R(mu) in bins of 0.1 with its 95% band (a bootstrap over its faults), the 5-95% range of its single faults' own R(mu) (each in its window) in grey, the
@@ -102,29 +103,43 @@ def ks_panel(ax, rows):
 
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("regions", help="a regional summary in bins of 0.01 (analysis reduce --region --mu-bins 0:7:700)")
-    p.add_argument("answer", help="the ANSWER.json of examples/populations/answer.py")
+    p.add_argument("pairs", nargs="+", metavar="REGIONS ANSWER",
+                   help="a regional summary in bins of 0.01 (analysis reduce --region --mu-bins 0:7:700) and the "
+                        "ANSWER.json examples/populations/answer.py wrote from it; several pairs: their regions "
+                        "in rows of COLUMNS panels")
+    p.add_argument("--columns", type=int, default=0, help="panels per row (default: all in one row)")
     p.add_argument("-o", "--output", required=True)
     args = p.parse_args(argv)
-    s = summary.read(args.regions)
-    rows = json.loads(open(args.answer).read())
-    labels = list(s["points/region_label"])
-    if [r["region"] for r in rows] != labels:
-        print(f"error: {args.answer} is not the answer of {args.regions}'s regions", file=sys.stderr)
+    if len(args.pairs) % 2:
+        print("error: give pairs of a regional summary and its ANSWER.json", file=sys.stderr)
         return 2
-    fig, axes = plt.subplots(1, len(rows) + 1, figsize=(4.2 * (len(rows) + 1), 4.6),
-                             gridspec_kw={"width_ratios": [1] * len(rows) + [1.1]})
-    for i, (ax, row) in enumerate(zip(axes, rows)):
-        region_panel(ax, s, i, row, MERGE, float(s["attrs"]["level"]), np.random.default_rng(i))
-        if i:
+    regions = []
+    for path, answer in zip(args.pairs[::2], args.pairs[1::2]):
+        s = summary.read(path)
+        rows = json.loads(open(answer).read())
+        if [r["region"] for r in rows] != list(s["points/region_label"]):
+            print(f"error: {answer} is not the answer of {path}'s regions", file=sys.stderr)
+            return 2
+        regions += [(s, i, row) for i, row in enumerate(rows)]
+    panels = len(regions) + 1
+    columns = args.columns or panels
+    nrows = -(-panels // columns)
+    height = 4.3 * nrows + 1.1           # inches: the panels, and the legend beneath them
+    fig, axes = plt.subplots(nrows, columns, figsize=(4.2 * columns, height), squeeze=False)
+    axes = axes.ravel()
+    for k, (ax, (s, i, row)) in enumerate(zip(axes, regions)):
+        region_panel(ax, s, i, row, MERGE, float(s["attrs"]["level"]), np.random.default_rng(k))
+        if k:
             ax.sharey(axes[0])
-    axes[0].set_ylabel(r"$R(\mu)$")
+        if k % columns == 0:
+            ax.set_ylabel(r"$R(\mu)$")
     handles, texts = axes[0].get_legend_handles_labels()
-    ks_panel(axes[-1], rows)
-    h2, t2 = axes[-1].get_legend_handles_labels()
-    fig.legend(handles + h2, texts + t2,
-               loc="lower center", ncol=4, fontsize=FONT, bbox_to_anchor=(0.5, -0.02))
-    fig.tight_layout(rect=(0, 0.12, 1, 1))
+    ks_panel(axes[len(regions)], [row for _, _, row in regions])
+    for ax in axes[panels:]:
+        ax.set_visible(False)
+    h2, t2 = axes[len(regions)].get_legend_handles_labels()
+    fig.legend(handles + h2, texts + t2, loc="lower center", ncol=4, fontsize=FONT, bbox_to_anchor=(0.5, 0.0))
+    fig.tight_layout(rect=(0, 1.1 / height, 1, 1))
     fig.savefig(args.output, dpi=110)
     print(f"wrote {args.output}")
     return 0

@@ -10,7 +10,7 @@ RUNS=runs/populations
 DOCS=docs/populations
 export OMP_NUM_THREADS=1 NUMBA_NUM_THREADS=1
 mkdir -p "$DOCS"
-PARTS=${*:-regions short lengths discreteness}
+PARTS=${*:-regions short lengths discreteness answer}
 for name in $PARTS; do
   case $name in
     regions|short)
@@ -46,6 +46,11 @@ for name in $PARTS; do
       done
       $PY examples/populations/discreteness.py "$DOCS"/discrete_l{3,6,12}.summary.h5 > "$DOCS/discreteness.md"
       ;;
-    *) echo "error: unknown part $name (regions, short, lengths, discreteness)" >&2; exit 2 ;;
+    answer)
+      # the README's figure: the long faults' regions beside the short ones'
+      $PY examples/populations/figure.py "$DOCS/regions.region.summary.h5" "$DOCS/regions-answer.json" \
+        "$DOCS/short.region.summary.h5" "$DOCS/short-answer.json" --columns 3 -o "$DOCS/answer.png"
+      ;;
+    *) echo "error: unknown part $name (regions, short, lengths, discreteness, answer)" >&2; exit 2 ;;
   esac
 done
