@@ -38,11 +38,12 @@ for name in $PARTS; do
       $PY examples/populations/lengths.py "$RUNS/lengths.h5" > "$DOCS/lengths.md"
       ;;
     discreteness)
-      # the large-event threshold and the recurrence window scaled with the blocks per unit length (discreteness.py)
+      # the large-event threshold, GR's cut and the recurrence window scaled with the blocks per unit length (discreteness.py)
       for l in 3 6 12; do
         n=$((400 * l / 3))
-        $PY -m analysis reduce "$RUNS/discrete_l$l.h5" --mu-c "$($PY -c "import math; print(4 + math.log10($n / 400))")" \
-          --window $((10 * n / 400)) -o "$DOCS/discrete_l$l.summary.h5" --force
+        shift=$($PY -c "import math; print(math.log10($n / 400))")
+        $PY -m analysis reduce "$RUNS/discrete_l$l.h5" --mu-c "$($PY -c "print(4 + $shift)")" \
+          --b-cut "$($PY -c "print(3 + $shift)")" --window $((10 * n / 400)) -o "$DOCS/discrete_l$l.summary.h5" --force
       done
       $PY examples/populations/discreteness.py "$DOCS"/discrete_l{3,6,12}.summary.h5 > "$DOCS/discreteness.md"
       ;;
