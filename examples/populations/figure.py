@@ -13,6 +13,7 @@ working definition of critical, KS < 0.05.
 import argparse
 import json
 import math
+import re
 import sys
 
 import warnings
@@ -79,6 +80,12 @@ def region_panel(ax, s, i, row, merge, level, rng):
                  fontsize=FONT)
 
 
+def short_label(region):
+    """'N: power 1.66667 on [2, 200]; b: ...' -> 'N^-1.67\n2-200' (the drawn N); else the region's first key."""
+    m = re.match(r"N: power ([\d.e+-]+) on \[(\S+), (\S+)\]", region)
+    return f"N^-{float(m[1]):.3g}\n{m[2]}-{m[3]}" if m else region.split(";")[0]
+
+
 def ks_panel(ax, rows):
     x = np.arange(len(rows))
     for shift, key, color, name in ((-0.12, "best_two_decades", "C3", "best two decades"),
@@ -95,8 +102,7 @@ def ks_panel(ax, rows):
                     label="single faults' KS: median" if key == "best_two_decades" else None)
     ax.axhline(CRITICAL_KS, color="k", ls=":", lw=1, label="critical: KS < 0.05")
     ax.set_yscale("log")
-    ax.set_xticks(x, [r["region"].split(";")[0].replace("N: ", "N ") for r in rows], fontsize=FONT - 1,
-                  rotation=15)
+    ax.set_xticks(x, [short_label(r["region"]) for r in rows], fontsize=FONT - 1)
     ax.set_ylabel("KS distance to a truncated GR law")
     ax.set_title("two decades of mu against GR", fontsize=FONT)
 
