@@ -431,3 +431,28 @@ def test_the_answer_finds_a_region_of_gr_faults_critical_and_a_characteristic_on
         monkeypatch.setattr(figure, "RESAMPLES", 30)
         assert figure.main([str(out), str(tmp_path / f"{name}.json"), "-o", str(tmp_path / f"{name}.png")]) == 0
         assert (tmp_path / f"{name}.png").stat().st_size > 10000
+
+
+@pytest.mark.parametrize("name", ["regions", "short"])
+def test_the_docs_tables_are_the_committed_summaries(name):
+    """docs/populations.md's tables are answer.py's, from the committed regional summaries: the region's numbers,
+    its hump and its best and top two decades recomputed here (a number edited by hand anywhere fails)."""
+    import json
+    from pathlib import Path
+    from analysis.paper import shape_statistics
+    answer = _answer()
+    docs = Path(__file__).parents[1] / "docs" / "populations"
+    s = summary.read(docs / f"{name}.region.summary.h5")
+    rows = json.loads((docs / f"{name}-answer.json").read_text())
+    assert [r["region"] for r in rows] == list(s["points/region_label"])
+    for i, row in enumerate(rows):
+        for key in ("n_events", "gr_b", "ks_gr", "fraction_large", "cv_tnu"):
+            assert row[key] == pytest.approx(list(s[f"points/numbers/{key}"][i]), rel=1e-12), key
+        assert row["hump"] == pytest.approx(list(shape_statistics(s, i, merge=answer.HUMP_MERGE)["peak_over_dip"][:3]))
+        counts = s["per_task/mu"][s["tasks/point"] == i].sum(axis=(0, 1))
+        for key, fn in (("best_two_decades", answer.best_decades), ("top_two_decades", answer.top_decades)):
+            ks, lo, b = fn(counts, s["bins/mu"])
+            assert (row[key]["ks"][0], row[key]["lo"], row[key]["gr_b"]) == pytest.approx((ks, lo, b), rel=1e-9), key
+    table = answer.table(rows)
+    assert table == (docs / f"{name}-answer.md").read_text().strip()
+    assert table in (docs.parent / "populations.md").read_text()
