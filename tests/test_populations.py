@@ -456,3 +456,22 @@ def test_the_docs_tables_are_the_committed_summaries(name):
     table = answer.table(rows)
     assert table == (docs / f"{name}-answer.md").read_text().strip()
     assert table in (docs.parent / "populations.md").read_text()
+
+
+def test_the_discreteness_table_is_the_committed_summaries(capsys):
+    """docs/populations.md's discreteness table is examples/populations/discreteness.py's, from the committed
+    summaries of l = 3, 6, 12; the large-event threshold of each is scaled with its blocks per unit length."""
+    from pathlib import Path
+    root = Path(__file__).parents[1]
+    sys.path.insert(0, str(root / "examples" / "populations"))
+    try:
+        import discreteness
+    finally:
+        sys.path.pop(0)
+    paths = [root / "docs" / "populations" / f"discrete_l{l}.summary.h5" for l in (3, 6, 12)]
+    assert discreteness.main([str(p) for p in paths]) == 0
+    table = capsys.readouterr().out.strip()
+    assert table == (root / "docs" / "populations" / "discreteness.md").read_text().strip()
+    assert table in (root / "docs" / "populations.md").read_text()
+    for l, p in zip((3, 6, 12), paths):
+        assert float(summary.read(p)["attrs"]["mu_c"]) == pytest.approx(4 + math.log10(l / 3))

@@ -20,6 +20,13 @@ from analysis.paper import ratio, shape_statistics, with_interval
 REFERENCE_N = 400     # the l = 3 chain's length: mu' = mu - log10(N / REFERENCE_N)
 
 
+def dip(quad):
+    """The peak over the dip, or, where a bin between the dip's start and the peak holds no event, that said."""
+    if math.isinf(quad[0]):
+        return "unbounded: a bin of 0.1 from mu' = 2.5 to the peak holds no event"
+    return ratio(quad, "the dip bin")
+
+
 def row(path):
     s = summary.read(path)
     if len(s["points/N"]) != 1:
@@ -33,7 +40,7 @@ def row(path):
     def num(name):
         return with_interval(s[f"points/numbers/{name}"][0]) if f"points/numbers/{name}" in s else "-"
     return (f"| {l:g} | {n:.0f} | {float(s['attrs']['mu_c']):.2f} | {num('n_events')} | {num('creep_share')} | "
-            f"{num('fraction_large')} | {with_interval(shape['peak_mu'][:3])} | {ratio(shape['peak_over_dip'], 'the dip bin')} | "
+            f"{num('fraction_large')} | {with_interval(shape['peak_mu'][:3])} | {dip(shape['peak_over_dip'])} | "
             f"{num('cv_tnu')} | {num('ks_gr')} |")
 
 
