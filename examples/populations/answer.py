@@ -1,6 +1,6 @@
 """The paper's question, answered from regional summaries (docs/populations.md):
 
-    python examples/populations/answer.py REGIONS.summary.h5 --faults FAULTS.summary.h5 -o docs/populations/answer
+    python examples/populations/answer.py REGIONS.summary.h5 --faults FAULTS.summary.h5 -o docs/populations/NAME-answer
 
 REGIONS: `analysis reduce CATALOG --region` (each point a region); FAULTS: `analysis reduce CATALOG` of the same
 catalog (each fault a point of its own). For each region it gives, with 95% intervals over its faults:
@@ -183,8 +183,8 @@ def main(argv=None):
     rows = region_rows(s, summary.read(args.faults) if args.faults else None, float(s["attrs"]["level"]))
     out = Path(args.output)
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.with_suffix(".json").write_text(json.dumps(rows, indent=1))
-    out.with_suffix(".md").write_text(table(rows) + "\n")
+    Path(f"{out}.json").write_text(json.dumps(rows, indent=1))      # (OUT + suffix: a dot in OUT is kept)
+    Path(f"{out}.md").write_text(table(rows) + "\n")
     print(table(rows))
     return 0
 
