@@ -145,7 +145,12 @@ def main(argv=None):
         ax.set_visible(False)
     h2, t2 = axes[len(regions)].get_legend_handles_labels()
     fig.legend(handles + h2, texts + t2, loc="lower center", ncol=4, fontsize=FONT, bbox_to_anchor=(0.5, 0.0))
-    fig.tight_layout(rect=(0, 1.1 / height, 1, 1))
+    s0 = regions[0][0]
+    names = ", ".join(path.rsplit("/", 1)[-1].removesuffix(".region.summary.h5") for path in args.pairs[::2])
+    fig.suptitle(f"{names}: regions of {regions[0][2]['faults']} faults; l = {s0['points/l'][0]:g}, "
+                 f"a = {s0['points/a'][0]:g}, c = {s0['points/c'][0]:g}, nu = {s0['points/nu'][0]:g}; "
+                 "R(mu) in bins of 0.1, bands: 95% bootstrap over faults", fontsize=FONT + 1)
+    fig.tight_layout(rect=(0, 1.1 / height, 1, 0.97))
     fig.savefig(args.output, dpi=110)
     print(f"wrote {args.output}")
     return 0
