@@ -187,7 +187,8 @@ def reduce_tasks(path, task_indices, opt, layout=LAYOUT, windows=None):
                 start, end = windows[k]
                 t, kind = cat.column(k, "t"), cat.column(k, "kind")
                 inside = _inside(t, start, end)
-                out[k] = reduce_task(_within(cat.task_events(k, opt.chunk), start, end),
+                out[k] = reduce_task(reader.rows_where(cat.task_events(k, opt.chunk),
+                                                       lambda part, s=start, e=end: _inside(part["t"], s, e)),
                                      int(np.count_nonzero(inside & (kind == schema.KIND_EVENT))),
                                      float(tasks["nu"][k]), int(tasks["N"][k]), opt, int(np.count_nonzero(inside)), layout)
             out[k].rows = rows
@@ -197,16 +198,6 @@ def reduce_tasks(path, task_indices, opt, layout=LAYOUT, windows=None):
 def _inside(t, start, end):
     """The onsets in a window: start <= t < end (analysis/region.py)."""
     return (t >= start) & (t < end)
-
-
-def _within(parts, start, end):
-    """The rows of the chunks inside the window (every chunk is still read, and so verified)."""
-    for part in parts:
-        keep = _inside(part["t"], start, end)
-        if keep.all():
-            yield part
-        elif keep.any():
-            yield {name: column[keep] for name, column in part.items()}
 
 
 # -- per point ------------------------------------------------------------------------------

@@ -73,7 +73,7 @@ class Reader:
         parts = self.layout.task_events(task, int(self.tasks["events_written"][task]), chunk)
         if kind is None:
             return parts
-        return _of_kind(parts, kind)
+        return rows_where(parts, lambda part: part["kind"] == kind)
 
     def count(self, task, kind):
         """The task's committed rows of that kind (/events/kind alone, not verified: task_events verifies)."""
@@ -109,9 +109,11 @@ class Reader:
         self.close()
 
 
-def _of_kind(parts, kind):
+def rows_where(parts, keep_of):
+    """The rows of chunks (dicts of columns) where keep_of(chunk) is True; chunks with none left out.
+    Every chunk is still consumed, and so verified as it streams."""
     for part in parts:
-        keep = part["kind"] == kind
+        keep = keep_of(part)
         if keep.all():
             yield part
         elif keep.any():
