@@ -27,7 +27,7 @@ import numpy as np
 from ensemble.config import MEASURED_TRANSIENT_PER_BLOCK, TRANSIENT_PER_BLOCK
 
 from . import stats, summary
-from .reduce import LAYOUT, PARAMS
+from .reduce import PARAMS
 from .report import LABELS, count_text, events_per_point, level_text, partial_text, point_label, size_text
 
 PAPER_EVENTS = 200_000      # events the paper recorded per point (one trajectory, N = 800) ...
@@ -86,14 +86,8 @@ def shape_statistics(s, i, level=None, merge=1):
     bin is infinite. merge: read R(mu) in bins of that many of the summary's (a peak and a dip
     read from narrow bins are their noise's extremes, and the ratio's resamples lie above it)."""
     level = s["attrs"]["level"] if level is None else level
-    edges = s["bins/mu"][::merge]
+    edges, counts, events = summary.point_units(s, i, merge)
     c = stats.centers(edges)
-    tasks = np.flatnonzero(s["tasks/point"] == i)
-    counts, events = s["per_task/mu"][tasks], s["per_task/numbers"][tasks][:, :, LAYOUT.column("numbers", "n_events")]
-    if merge > 1:
-        if (len(s["bins/mu"]) - 1) % merge:
-            raise ValueError(f"{len(s['bins/mu']) - 1} bins of mu do not merge by {merge}")
-        counts = counts.reshape(*counts.shape[:-1], len(c), merge).sum(axis=-1)
     if s["points/method"][i] in ("seeds", "faults"):   # the summary's own units: seeds (a region's faults), else every stretch
         counts, events = counts.sum(axis=1, keepdims=True), events.sum(axis=1, keepdims=True)
     rows = np.concatenate([counts.reshape(-1, len(c)), events.reshape(-1, 1)], axis=1)

@@ -30,12 +30,9 @@ from .stats import centers  # noqa: E402
 
 def fault_densities(s, i):
     """R(mu) of each fault of region i of a regional summary, from its own counts in its window, (faults, bins)."""
-    from .reduce import LAYOUT
-    rows = np.flatnonzero(s["tasks/point"] == i)
-    counts = s["per_task/mu"][rows].sum(axis=1)
-    n = s["per_task/numbers"][rows][:, :, LAYOUT.column("numbers", "n_events")].sum(axis=1)
+    edges, counts, n = summary_file.point_units(s, i)
     with np.errstate(invalid="ignore", divide="ignore"):
-        return counts / (n[:, None] * np.diff(s["bins/mu"])[None, :])
+        return counts.sum(axis=1) / (n.sum(axis=1)[:, None] * np.diff(edges)[None, :])
 
 
 def magnitude(summaries, ax, keys, labels):

@@ -268,6 +268,21 @@ def point_laws(s):
     return np.where(np.isnan(alpha), "aging", "carlson-langer")
 
 
+def point_units(s, i, merge=1):
+    """Point i's resampling units of summary `s` (read): (mu edges, counts (tasks, stretches, bins) of R(mu),
+    inertial events (tasks, stretches)). A region's tasks are its faults. merge: bins of that many of the
+    summary's (ValueError where they do not divide)."""
+    edges = s["bins/mu"][::merge]
+    tasks = np.flatnonzero(s["tasks/point"] == i)
+    counts = s["per_task/mu"][tasks]
+    events = s["per_task/numbers"][tasks][:, :, reduce.LAYOUT.column("numbers", "n_events")]
+    if merge > 1:
+        if (len(s["bins/mu"]) - 1) % merge:
+            raise ValueError(f"{len(s['bins/mu']) - 1} bins of mu do not merge by {merge}")
+        counts = counts.reshape(*counts.shape[:-1], len(edges) - 1, merge).sum(axis=-1)
+    return edges, counts, events
+
+
 def has_creep(s):
     """Whether summary `s` (read) holds the creep statistics (format 3; format 2 reduced none)."""
     return "points/numbers/n_creep" in s

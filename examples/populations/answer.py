@@ -119,7 +119,7 @@ def region_rows(s, f=None, level=0.95, rng=None):
     out = []
     for i in range(len(s["points/N"])):
         rows = np.flatnonzero(s["tasks/point"] == i)
-        per_fault = s["per_task/mu"][rows].sum(axis=1)          # (faults, bins)
+        per_fault = summary.point_units(s, i)[1].sum(axis=1)    # (faults, bins)
         shape = shape_statistics(s, i, level, merge=HUMP_MERGE)
         row = {
             "region": s["points/region_label"][i], "faults": int(len(rows)),

@@ -23,7 +23,6 @@ import numpy as np
 from analysis import stats, summary
 from analysis.drawing import FONT, band
 from analysis.plot import plt
-from analysis.reduce import LAYOUT
 from analysis.stats import centers
 
 REAL_B = 2 / 3       # GR b of a real catalog (about 1 in moment magnitude) in mu = log10 of the slip
@@ -35,11 +34,8 @@ RESAMPLES = 1000
 def merged(s, i, merge):
     """Region i's faults in bins of `merge` of the summary's: (edges, counts (faults, bins), events per fault in
     and out of range)."""
-    rows = np.flatnonzero(s["tasks/point"] == i)
-    counts = s["per_task/mu"][rows].sum(axis=1)
-    counts = counts.reshape(len(rows), -1, merge).sum(axis=2)
-    events = s["per_task/numbers"][rows][:, :, LAYOUT.column("numbers", "n_events")].sum(axis=1)
-    return s["bins/mu"][::merge], counts, events
+    edges, counts, events = summary.point_units(s, i, merge)
+    return edges, counts.sum(axis=1), events.sum(axis=1)
 
 
 def gr_line(edges, r, fit):
