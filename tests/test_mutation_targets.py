@@ -20,3 +20,9 @@ def test_every_mutant_applies_once_and_names_existing_tests():
                 stale.append(f"{m.name}: no test {test}")
     assert not stale, "\n".join(stale)
     assert len({m.name for m in mutations.MUTATIONS}) == len(mutations.MUTATIONS), "two mutants share a name"
+
+
+def test_the_readme_counts_the_mutants():
+    readme = (ROOT / "README.md").read_text()
+    assert f"`make mutations`: {len(mutations.MUTATIONS)} plausible bugs" in readme, \
+        "README's count of the mutation check's bugs is not len(MUTATIONS)"
