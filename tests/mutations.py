@@ -124,7 +124,7 @@ MUTATIONS = (
              "a paused event resumes with two of its loop variables exchanged"),
     Mutation("runner-transient-off-by-one", "ensemble/run/worker.py",
              "recording = traj.done >= traj.discarded", "recording = traj.done >= traj.discarded - 1",
-             ("tests/test_cli.py",),
+             ("tests/test_cli.py::test_the_transient_is_exactly_run_transient_events_whatever_the_kernel_calls",),
              "the last transient event is recorded"),
     Mutation("catalog-oldest-commit-wins", "ensemble/store/layout.py",
              "if best is None or seq > best.seq:", "if best is None or seq < best.seq:",

@@ -61,6 +61,26 @@ def test_same_seed_same_catalog_other_seed_differs(small_run, tmp_path):
     assert not np.array_equal(a["slip"], c["slip"])
 
 
+def test_the_transient_is_exactly_run_transient_events_whatever_the_kernel_calls(tmp_path):
+    """A task records its events from event run.transient on: its rows are the tail of a run of the same seed
+    that discards nothing. output.batch = 1 makes every kernel call one event long, so that a call ends
+    after every event, the last transient one included, whatever the machine's speed. (The calls' length
+    otherwise follows the wall clock, and an off-by-one in the transient shows only where a call happens
+    to end one event early.)"""
+    transient, events = 7, 12
+    one = write_config(tmp_path / "one.toml", run={"seeds": 1, "events": events, "transient": transient},
+                       output={"batch": 1})
+    none = write_config(tmp_path / "none.toml", run={"seeds": 1, "events": transient + events, "transient": 0})
+    for cfg in (one, none):
+        res = run_cli("run", cfg)
+        assert res.returncode == 0, res.stderr
+    a, _, attrs = reader.read(tmp_path / "one.h5")
+    b, _, _ = reader.read(tmp_path / "none.h5")
+    assert attrs["transient"] == transient and len(a["t"]) == events
+    for name in schema.EVENT_FIELDS:
+        np.testing.assert_array_equal(a[name], b[name][transient:], err_msg=name)
+
+
 def test_refuses_to_overwrite_without_force(small_run):
     d, cfg = small_run
     before = (d / "cfg.h5").read_bytes()
