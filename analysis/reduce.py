@@ -188,7 +188,7 @@ def reduce_tasks(path, task_indices, opt, layout=LAYOUT, windows=None):
                 t, kind = cat.column(k, "t"), cat.column(k, "kind")
                 inside = _inside(t, start, end)
                 out[k] = reduce_task(reader.rows_where(cat.task_events(k, opt.chunk),
-                                                       lambda part, s=start, e=end: _inside(part["t"], s, e)),
+                                                       lambda part: _inside(part["t"], start, end)),
                                      int(np.count_nonzero(inside & (kind == schema.KIND_EVENT))),
                                      float(tasks["nu"][k]), int(tasks["N"][k]), opt, int(np.count_nonzero(inside)), layout)
             out[k].rows = rows

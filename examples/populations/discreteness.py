@@ -14,16 +14,18 @@ units: seeds, or stretches of every trajectory with fewer than 10).
 import math
 import sys
 
+import numpy as np
+
 from analysis import summary
-from analysis.paper import ratio, shape_statistics, with_interval
+from analysis.paper import DIP_FROM, ratio, shape_statistics, with_interval
 
 REFERENCE_N = 400     # the l = 3 chain's length: mu' = mu - log10(N / REFERENCE_N)
 
 
-def dip(quad):
+def dip(quad, edges):
     """The peak over the dip, or, where a bin between the dip's start and the peak holds no event, that said."""
     if math.isinf(quad[0]):
-        return "unbounded: a bin of 0.1 from mu' = 2.5 to the peak holds no event"
+        return f"unbounded: a bin of {np.diff(edges).mean():.2g} from mu' = {DIP_FROM:g} to the peak holds no event"
     return ratio(quad, "the dip bin")
 
 
@@ -40,7 +42,7 @@ def row(path):
     def num(name):
         return with_interval(s[f"points/numbers/{name}"][0]) if f"points/numbers/{name}" in s else "-"
     return (f"| {l:g} | {n:.0f} | {float(s['attrs']['mu_c']):.2f} | {num('n_events')} | {num('creep_share')} | "
-            f"{num('fraction_large')} | {with_interval(shape['peak_mu'][:3])} | {dip(shape['peak_over_dip'])} | "
+            f"{num('fraction_large')} | {with_interval(shape['peak_mu'][:3])} | {dip(shape['peak_over_dip'], s['bins/mu'])} | "
             f"{num('cv_tnu')} | {num('ks_gr')} |")
 
 
