@@ -33,14 +33,15 @@ import numba as nb
 import numpy as np
 
 from .geometry import left, right
-from .laws import creep_state, creep_weakening, creeps, friction, friction_slopes, onset_delay, rest_state, state_rate, threshold
-from .schedule import advance_clock, elapsed, materialize, onset_key, tree_min, tree_set
+from .laws import (creep_state, creep_weakening, creeps, friction, friction_slopes, onset_delay, rest_state, state_rate,
+                   threshold)
+from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
 from .workspace import (CR_DIAG, CR_DPSI, CR_DU, CR_EP, CR_H, CR_HB, CR_LEFT, CR_PSI, CR_RES, CR_SERIAL, CR_UPPER, CR_V,
-                        CR_VN, CR_W, CS_DIRTY, CS_ENDED, CS_FRESH, CS_H, CS_NCREEP, CS_SERIAL, CS_T_HI, CS_T_LO, E_ACTIVE, E_BLOCK_STEPS,
-                        E_END_HI, E_END_LO, E_EPICENTER, E_FIRST, E_LAST, E_LOAD_WORK, E_NBLOCKS, E_RUNNING,
-                        E_RUPTURED, E_SERIAL, E_SLIP, E_START_HI, E_START_LO, E_STATE, E_STOPPED, E_VMAX, E_WORK,
-                        F0, P, D_BLOCK_STEPS, D_DURATION, D_ELASTIC, D_ENDING, D_ENERGY_SCALE, D_FIRST, D_KIND,
-                        D_LAST, D_LOAD_WORK, D_NSLIP, D_RESIDUAL, D_SLIP, D_VMAX, D_WORK, EV_NT, KIND_CREEP,
+                        CR_VN, CR_W, CS_DIRTY, CS_ENDED, CS_FRESH, CS_H, CS_NCREEP, CS_SERIAL, CS_T_HI, CS_T_LO,
+                        E_ACTIVE, E_BLOCK_STEPS, E_END_HI, E_END_LO, E_EPICENTER, E_FIRST, E_LAST, E_LOAD_WORK,
+                        E_NBLOCKS, E_RUNNING, E_RUPTURED, E_SERIAL, E_SLIP, E_START_HI, E_START_LO, E_STATE, E_STOPPED,
+                        E_VMAX, E_WORK, F0, P, D_BLOCK_STEPS, D_DURATION, D_ELASTIC, D_ENDING, D_ENERGY_SCALE, D_FIRST,
+                        D_KIND, D_LAST, D_LOAD_WORK, D_NSLIP, D_RESIDUAL, D_SLIP, D_VMAX, D_WORK, EV_NT, KIND_CREEP,
                         PAUSED, SLIDING, V)
 
 # what continue_creep returns besides PAUSED
@@ -139,11 +140,6 @@ def fastest_creep(C, n, l2, nu, lo, hi):
     C[hi, CR_RES] /= C[hi, CR_DIAG]
     for i in range(hi - 1, lo - 1, -1):
         C[i, CR_RES] = (C[i, CR_RES] + l2 * C[i + 1, CR_RES]) / C[i, CR_DIAG]
-
-
-@nb.njit(cache=True, inline="always")
-def _creep_time(cs):
-    return cs[CS_T_HI], cs[CS_T_LO]
 
 
 @nb.njit(cache=True)
@@ -748,7 +744,8 @@ def report(arrays, n, out_t, out_epicenter, out_diag, k):
             out_t[k] = E[slot, E_START_HI] + E[slot, E_START_LO]
             out_epicenter[k] = int(E[slot, E_EPICENTER])
             out_diag[k, :] = 0.0
-            out_diag[k, D_DURATION] = (E[slot, E_END_HI] - E[slot, E_START_HI]) + (E[slot, E_END_LO] - E[slot, E_START_LO])
+            out_diag[k, D_DURATION] = ((E[slot, E_END_HI] - E[slot, E_START_HI])
+                                       + (E[slot, E_END_LO] - E[slot, E_START_LO]))
             out_diag[k, D_SLIP] = E[slot, E_SLIP]
             out_diag[k, D_FIRST] = E[slot, E_FIRST]
             out_diag[k, D_LAST] = E[slot, E_LAST]

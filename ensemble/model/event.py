@@ -46,12 +46,12 @@ from .steppers import FIRST_KEPT, FIRST_LAST, FIRST_NEW
 from .transitions import (NO_CUT, ONSET_LOADING, ONSET_NEIGHBOUR, STICK, above_threshold, event_nu, force_now,
                           loading_cut, locate, pressed, rest_psi, velocity_slopes)
 from .undo import clear_log, log_block
-from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D_ENERGY_SCALE, D_FIRST,
-                        D_LAST, D_LOAD_WORK, D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK,
-                        EV_BLOCK_STEPS, EV_CUTS, EV_EPICENTER, EV_ERR_PREV, EV_FAR, EV_H_NEXT, EV_NA, EV_NT,
-                        EV_PHASE, EV_REJECTED, EV_SLIP_TIME, EV_STEPS, EV_T_FAR, EV_TAU, EV_TRACED, EV_VMAX,
-                        EV_WORK, EV_YREST, F0, HD0, CR_HB, CR_V, CR_VN, HD1, IN_EVENT, NONFINITE, OK, P, P0, PAUSED, SLIDING,
-                        STOPPED, TOO_LONG, TR, TS, UNLIMITED, UNSTABLE, UNTOUCHED, V, V0, Y, Y0, YS, PausedEvent)
+from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D_ENERGY_SCALE, D_FIRST, D_LAST,
+                        D_LOAD_WORK, D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK, EV_BLOCK_STEPS,
+                        EV_CUTS, EV_EPICENTER, EV_ERR_PREV, EV_FAR, EV_H_NEXT, EV_NA, EV_NT, EV_PHASE, EV_REJECTED,
+                        EV_SLIP_TIME, EV_STEPS, EV_T_FAR, EV_TAU, EV_TRACED, EV_VMAX, EV_WORK, EV_YREST, F0, HD0, CR_HB,
+                        CR_V, CR_VN, HD1, IN_EVENT, NONFINITE, OK, P, P0, PAUSED, SLIDING, STOPPED, TOO_LONG, TR, TS,
+                        UNLIMITED, UNSTABLE, UNTOUCHED, V, V0, Y, Y0, YS, PausedEvent)
 
 # Stability limit of classical RK4 on the negative real axis: the state equation
 # relaxes at rate 1/theta (= v in steady sliding), so dt / theta must stay below it.
@@ -163,8 +163,9 @@ def begin_event(arrays, t0, n, epicenter, v_start, p):
 @nb.njit(cache=True)
 def begin_handover(arrays, t0, n, epicenter, p):
     """Start an event where creep hands over to inertia (creep.continue_creep): `epicenter` starts
-    at time t0 from its creep velocity (from rest if it was joining), and every block creeping in its run slides from its creep velocity (as
-    begin_event otherwise; the creep arrays keep them until the event's end, creep.after_event)."""
+    at time t0 from its creep velocity (from rest if it was joining), and every block creeping in its run slides
+    from its creep velocity (as begin_event otherwise; the creep arrays keep them until the event's end,
+    creep.after_event)."""
     W, event, C = arrays.W, arrays.event, arrays.creep
     na, nt, yrest = _start(arrays, 0, 0, t0, p, epicenter, 0.0, 0.0)
     lo, hi = run_of(C, n, epicenter)

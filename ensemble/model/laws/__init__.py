@@ -109,11 +109,6 @@ def get(name):
     return LAWS[name]
 
 
-def of_params(params):
-    """The Law whose parameter record this is."""
-    return _BY_PARAMS[type(params)]
-
-
 # The kernels' calls. Each is a stub that numba replaces by the law's function.
 
 def friction(law, v, psi):

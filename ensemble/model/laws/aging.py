@@ -205,8 +205,10 @@ LAW = Law(
     params=AgingParams,
     keys={
         "a": Key(0.0, "model force", lambda x: x >= 0, ">= 0", "velocity-strengthening coefficient of a ln(1 + v)"),
-        "b": Key(20.0, "model force", lambda x: x > 0, "> 0", "state coefficient of b ln(theta) (slip weakening of slope b)"),
-        "c": Key(1000.0, "model force", math.isfinite, "finite", "constant friction (removed exactly by a uniform shift of u)"),
+        "b": Key(20.0, "model force", lambda x: x > 0, "> 0",
+                 "state coefficient of b ln(theta) (slip weakening of slope b)"),
+        "c": Key(1000.0, "model force", math.isfinite, "finite",
+                 "constant friction (removed exactly by a uniform shift of u)"),
     },
     convention="rate- and state-dependent friction c + a ln(1 + v) + b ln(theta) with the aging law "
                "theta' = 1 - v theta (Ohmura & Kawamura, EPL 77, 69001, 2007); a block at rest holds while "

@@ -73,8 +73,10 @@ LAW = Law(
     name="carlson-langer",
     params=CarlsonLangerParams,
     keys={
-        "alpha": Key(2.0, "model time / model length", lambda x: x >= 0, ">= 0", "velocity weakening: friction slope -2 alpha at v = 0+"),
-        "sigma": Key(0.01, "model force", lambda x: 0 < x < 1, "in (0, 1)", "drop of friction from the static 1 to 1 - sigma as a block starts"),
+        "alpha": Key(2.0, "model time / model length", lambda x: x >= 0, ">= 0",
+                     "velocity weakening: friction slope -2 alpha at v = 0+"),
+        "sigma": Key(0.01, "model force", lambda x: 0 < x < 1, "in (0, 1)",
+                     "drop of friction from the static 1 to 1 - sigma as a block starts"),
     },
     convention="velocity-weakening friction (1 - sigma) / (1 + 2 alpha v / (1 - sigma)) while sliding, static "
                "threshold 1 at rest, no state (Carlson & Langer 1989; Mori & Kawamura 2005, 2006); the loader "
