@@ -29,9 +29,9 @@ import numpy as np
 
 from ensemble import filekind
 from ensemble.config import MEASURED_TRANSIENT_PER_BLOCK, loads
-from ensemble.run.tasks import sweep_points, task_list
 from ensemble.store import reader, schema
 from ensemble.store.errors import CatalogError
+from ensemble.sweep import sweep_points, task_list
 
 from .reduce import PARAMS
 

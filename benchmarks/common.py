@@ -19,7 +19,7 @@ import numpy as np
 from ensemble.config import Config, Integrator, Model, Run
 from ensemble.integrators import INTEGRATORS
 from ensemble.run.trajectory import Trajectory
-from ensemble.run.tasks import task_list
+from ensemble.sweep import task_list
 
 # right-hand-side evaluations per block-step of the kernel's methods
 STAGES = {name: method.stages for name, method in INTEGRATORS.items()}

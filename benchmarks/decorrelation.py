@@ -55,7 +55,8 @@ from ensemble.config import Config, Model, Run
 from ensemble.store.checkpoint import Checkpoint
 from ensemble.model.workspace import D_NSLIP
 from ensemble.run.trajectory import Trajectory
-from ensemble.run.tasks import branch_rng, perturb, task_list
+from ensemble.run.tasks import branch_rng, perturb
+from ensemble.sweep import task_list
 
 from .common import Clock, minutes, parse_setting, pyplot, save_figure, write_outputs
 

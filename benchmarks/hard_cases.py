@@ -39,7 +39,7 @@ from ensemble.config import Config, Integrator, Model, Run
 from ensemble.events import relative_energy_residual
 from ensemble.model.workspace import D_ENERGY_SCALE, D_RESIDUAL, D_SLIP, D_VMAX, NDIAG
 from ensemble.run.trajectory import SimulationError, Trajectory
-from ensemble.run.tasks import task_list
+from ensemble.sweep import task_list
 
 from .common import Clock, ks_distance, minutes, parse_setting, rough_events_per_second, write_outputs
 

@@ -22,7 +22,7 @@ from ensemble.events import relative_energy_residual
 from ensemble.model.workspace import (D_BLOCK_STEPS, D_DURATION, D_ENERGY_SCALE, D_KIND, D_NSLIP, D_RESIDUAL, D_SLIP,
                                       D_STEPS, KIND_CREEP, KIND_EVENT)
 from ensemble.run.trajectory import Trajectory
-from ensemble.run.tasks import task_list
+from ensemble.sweep import task_list
 
 
 def main():

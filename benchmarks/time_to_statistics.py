@@ -42,7 +42,7 @@ import numpy as np
 
 from ensemble.config import load, replace
 from ensemble.run.trajectory import Trajectory
-from ensemble.run.tasks import task_list
+from ensemble.sweep import task_list
 
 from .common import Clock, pyplot, save_figure, write_outputs
 

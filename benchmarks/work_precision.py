@@ -30,7 +30,7 @@ import numpy as np
 from ensemble.config import Config, Integrator, Model, Run
 from ensemble.events import advance_to_onset, check, run_event
 from ensemble.run.trajectory import Trajectory
-from ensemble.run.tasks import task_list
+from ensemble.sweep import task_list
 
 from .baselines import BASELINES, Timeout, run_baseline
 from .common import STAGES, cost_at_error, minutes, parse_setting, pyplot, save_figure, write_outputs

@@ -55,7 +55,8 @@ def _config(args):
 
 def _validate(args):
     from . import environment
-    from .run.tasks import describe, task_list
+    from .run.tasks import describe
+    from .sweep import task_list
     cfg = _config(args)
     # before any output: a writer this stack cannot provide fails here, before a job is submitted
     stack = environment.describe(cfg.output.writer)

@@ -9,7 +9,7 @@ from ensemble.store.checkpoint import Checkpoint, carries_creep
 from ensemble.config import loads
 from ensemble.model.workspace import Workspace
 from ensemble.run.trajectory import integrator_text
-from ensemble.run.tasks import task_list
+from ensemble.sweep import task_list
 
 
 def write_events(path, config_text, parts, streams=None):

@@ -38,7 +38,7 @@ def test_the_size_checked_before_creation_bounds_the_catalog(tmp_path, sets):
 
     from ensemble.store.create import create_layout, estimate_bytes
     from ensemble.config import load
-    from ensemble.run.tasks import task_list
+    from ensemble.sweep import task_list
     cfg = load(attack.ROOT / "examples" / "small.toml", sets)
     tasks = task_list(cfg)
     path = tmp_path / "c.h5"

@@ -387,7 +387,7 @@ def test_decorrelation_forces_are_read_at_one_time():
     from benchmarks.decorrelation import Follower
     from ensemble.config import Config, Run
     from ensemble.run.trajectory import Trajectory
-    from ensemble.run.tasks import task_list
+    from ensemble.sweep import task_list
     cfg = Config(model=Model(N=40, b=20.0), run=Run(seeds=1))
     task = task_list(cfg)[0]
     traj = Trajectory(cfg, task)
@@ -412,7 +412,8 @@ def test_decorrelation_unperturbed_branch_continues_the_trajectory():
     from benchmarks.decorrelation import branched
     from ensemble.config import Config, Run
     from ensemble.run.trajectory import Trajectory
-    from ensemble.run.tasks import branch_rng, task_list
+    from ensemble.run.tasks import branch_rng
+    from ensemble.sweep import task_list
     cfg = Config(model=Model(N=40, b=20.0), run=Run(seeds=2))
     tasks = task_list(cfg)
     traj = Trajectory(cfg, tasks[0])

@@ -208,7 +208,7 @@ def test_a_branch_lowers_the_blocks_at_rest_and_keeps_the_creeping_ones_in_balan
     each by its own draw in [0, perturbation), and the branches run."""
     from ensemble.run.branching import branch_start, creeping
     from ensemble.config import load
-    from ensemble.run.tasks import task_list
+    from ensemble.sweep import task_list
     perturbation = 1e-3
     # (rows end with every block at rest as a rule; at N = 200, b = 15 the 11th ends with one creeping)
     cfg_path = write_config(tmp_path / "creep.toml", model={"N": 200, "b": 15.0},

@@ -22,7 +22,7 @@ from ensemble.model import event, workspace
 from ensemble.model.chain import simulate
 from ensemble.model.workspace import F0, NDIAG, OK, P, PAUSED, UNLIMITED, PausedEvent, Workspace
 from ensemble.run.trajectory import Trajectory
-from ensemble.run.tasks import task_list
+from ensemble.sweep import task_list
 
 MODELS = {"b = 20": Model(N=60, b=20.0), "a = 2": Model(N=60, b=20.0, a=2.0)}
 METHODS = ["rk4", "ark4"]

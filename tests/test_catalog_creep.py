@@ -195,7 +195,7 @@ def test_a_checkpoint_packs_its_creep_state_and_a_slot_of_another_size_is_refuse
 
     from ensemble.config import loads
     from ensemble.run.trajectory import integrator_text
-    from ensemble.run.tasks import task_list
+    from ensemble.sweep import task_list
     cfg = loads(f"[model]\nN = {n}\nb = 15.0\n[run]\nevents = 4\ntransient = 0\n")
     assert carries_creep(cfg.model) and not carries_creep(loads("[model]\nN = 5\n").model)
     writer = writers.Rank0Writer(str(tmp_path / "c.h5"), MPI.COMM_SELF, cfg, task_list(cfg),
@@ -219,7 +219,7 @@ def test_unperturbed_branches_carry_the_spun_up_creep_state(tmp_path):
     here), so the branches need its creep state, not only its forces and states."""
     from ensemble.config import loads
     from ensemble.run.trajectory import Trajectory
-    from ensemble.run.tasks import task_list
+    from ensemble.sweep import task_list
     run = {"seeds": 2, "events": 100, "transient": 40, "branch": True, "decorrelation": 20, "perturbation": 0.0}
     cfg = write_config(tmp_path / "branch.toml", model={"N": 50, "b": CREEPING}, run=run,
                        integrator={"method": "ark4"})
@@ -255,7 +255,7 @@ def test_a_record_laid_out_for_another_kernel_is_not_continued(tmp_path, monkeyp
 
     from ensemble.config import loads
     from ensemble.run.trajectory import integrator_text
-    from ensemble.run.tasks import task_list
+    from ensemble.sweep import task_list
     cfg = loads("[model]\nN = 5\nb = 15.0\n[run]\nevents = 4\ntransient = 0\n")
     path = str(tmp_path / "c.h5")
     writers.Rank0Writer(path, MPI.COMM_SELF, cfg, task_list(cfg), integrator_text(cfg.integrator)).close()

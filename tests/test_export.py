@@ -22,7 +22,7 @@ from analysis import export, summary
 from ensemble.store import reader, schema, writers
 from ensemble.store.errors import CatalogError
 from ensemble.config import loads
-from ensemble.run.tasks import task_list
+from ensemble.sweep import task_list
 
 from .test_reduction import CONFIG, N_CHAIN, ROOT, write_catalog
 
@@ -433,7 +433,7 @@ from mpi4py import MPI
 from ensemble.store import writers
 from ensemble.config import loads
 from ensemble.run.trajectory import integrator_text
-from ensemble.run.tasks import task_list
+from ensemble.sweep import task_list
 cfg = loads(sys.argv[2])
 writer = writers.ParallelWriter(sys.argv[1], MPI.COMM_WORLD, cfg, task_list(cfg), integrator_text(cfg.integrator))
 writer.close()

@@ -19,7 +19,7 @@ from ensemble.config import Config, Integrator, Model, Run
 from ensemble.events import relative_energy_residual
 from ensemble.model.workspace import D_ENERGY_SCALE, D_RESIDUAL, D_SLIP, D_VMAX
 from ensemble.run.trajectory import Trajectory
-from ensemble.run.tasks import task_list
+from ensemble.sweep import task_list
 
 ADAPTIVE = ["ark3", "ark4", "exp4"]           # adaptive methods, run at Integrator()'s defaults (a new one is one word here)
 METHODS = ["rk4", *ADAPTIVE]

@@ -79,7 +79,7 @@ import dataclasses, json, math, os
 import numpy as np
 from ensemble.config import Config, Integrator, Model, Run
 from ensemble.run.trajectory import SimulationError, Trajectory
-from ensemble.run.tasks import task_list
+from ensemble.sweep import task_list
 from tests.test_hard_cases import CASES
 from tests.test_nonfinite import run_simulate
 

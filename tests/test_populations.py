@@ -11,7 +11,7 @@ import pytest
 from analysis import summary
 from ensemble.config import ConfigError, Model, loads
 from ensemble.population import Draw, draw_values
-from ensemble.run.tasks import task_list
+from ensemble.sweep import task_list
 
 from .catalog_writer import write_events
 from .conftest import run_cli, write_config

@@ -23,7 +23,7 @@ import pytest
 from analysis import stats
 from ensemble.store import reader, schema
 from ensemble.config import loads
-from ensemble.run.tasks import task_list
+from ensemble.sweep import task_list
 
 from . import reduction_reference as ref
 from .catalog_writer import write_events

@@ -1,7 +1,7 @@
 """A run: config -> tasks -> kernel calls on every rank -> one catalog, one module per job:
 
     context.py      RunContext: the config, ranks, paths, options and (once open) writer, counter, progress
-    tasks.py        sweep x seeds -> tasks, each with its own random stream and initial state
+    tasks.py        each task's own random stream and initial state (which tasks: ensemble/sweep.py)
     branching.py    run.branch: the spin-ups a run needs, and the state a branch starts from
     decision.py     rank 0's decision about the files before any work: new, resume, complete, refused
     runner.py       run(ctx): the lock, the decision, the catalog opened, the work served, closed and renamed
@@ -16,6 +16,7 @@
 The catalog itself is ensemble/store/, the kernels ensemble/model/; the command line (cli.py) makes the
 RunContext and calls runner.run. Shared with other commands and left beside the package: space.py (the
 disk check, also the store's), environment.py (the software stack, also validate's and the Slurm
-jobs'), checks.py and filekind.py. Nothing is imported here: callers import the module they use
+jobs'), sweep.py (the task list, also the store's, the Slurm jobs' and the regional reduction's), checks.py
+and filekind.py. Nothing is imported here: callers import the module they use
 (`from ensemble.run import runner`).
 """

@@ -1,6 +1,6 @@
 """Branching (run.branch): which spin-ups a run needs, and the state a branch starts from.
 
-Each parameter point is spun up once (tasks.spinups: from its seed 0's initial state, run.transient
+Each parameter point is spun up once (sweep.spinups: from its seed 0's initial state, run.transient
 events); its tasks then start from that state, each perturbed by its own stream (tasks.perturb,
 tasks.branch_rng). The runner (runner.py, worker.py) runs the spin-ups first, then the tasks.
 """
@@ -11,14 +11,15 @@ import numpy as np
 from ..store.checkpoint import Checkpoint
 from ..store.schema import FAILED, OPEN
 from ..model.workspace import CR_EP, CR_KEEP
-from .tasks import Task, branch_rng, perturb, point_tasks, spinups
+from ..sweep import Task, point_tasks, spinups
+from .tasks import branch_rng, perturb
 
 
 @dataclass(frozen=True)
 class Spin:
     """A point's spin-up to run (or read) before its tasks branch (run.branch)."""
     point: int
-    task: Task      # whose initial state it starts from (tasks.spinups)
+    task: Task      # whose initial state it starts from (sweep.spinups)
     rerun: bool     # its point's tasks all failed: a spin-up not finished failed, rerun it with `rerun`
 
 

@@ -15,8 +15,8 @@ from ..store import reader
 from ..store.create import estimate_bytes
 from ..store.errors import CatalogError
 from ..store.schema import FAILED, FINISHED
+from ..sweep import task_list
 from .branching import spins_needed
-from .tasks import task_list
 
 
 class Refused(RuntimeError):

@@ -10,11 +10,11 @@ import time
 
 from .. import environment
 from ..store import writers
+from ..sweep import task_list
 from .decision import check_output, prepare
 from .lock import RunLock
 from .parallel import Coordinator
 from .progress import Progress
-from .tasks import task_list
 from .trajectory import Trajectory, integrator_text
 from .worker import TaskRunner, work
 

@@ -15,8 +15,8 @@ from ..store.checkpoint import Checkpoint
 from ..store.errors import CatalogError
 from ..store.schema import FAILED, FINISHED
 from ..model.workspace import UNLIMITED
+from ..sweep import point_tasks
 from .branching import branch_start
-from .tasks import point_tasks
 from .trajectory import SimulationError, Trajectory, event_rows, integrator_text, parse_integrator
 
 # work budget of a kernel call, in block-steps (chain.simulate): ~0.05 s at the ~200 ns per

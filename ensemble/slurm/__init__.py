@@ -24,6 +24,6 @@ queued run reads). mpi4py and h5py are built against one MPI, which the nodes mu
 scripts and the command's output name it (stack.python_stack()).
 
 A package beside ensemble/run/, not inside it: it starts no run (the jobs do, through
-`python -m ensemble run|resume`) and imports nothing of the run but the task list (run/tasks.py).
+`python -m ensemble run|resume`) and imports nothing of the run (the task list is ensemble/sweep.py).
 Nothing is imported here: callers import the module they use (`from ensemble.slurm import render`).
 """

@@ -99,7 +99,7 @@ def command(args):
 
 def describe(cfg, opt, out):
     """A few lines on what was written and what the jobs will do."""
-    from ..run.tasks import task_list
+    from ..sweep import task_list
     n_tasks = len(task_list(cfg))
     per_job = n_tasks // len(out.catalogs)
     lines = [f"wrote {rel(out.directory)}/: "

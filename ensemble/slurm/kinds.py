@@ -23,7 +23,7 @@ def element_seed(root_seed, point):
 def point_configs(cfg):
     """One standalone config per parameter point of the sweep: the point's model values (with a
     [population], its distributions: all its faults), no sweep, all seeds, run.seed from element_seed()."""
-    from ..run.tasks import sweep_points
+    from ..sweep import sweep_points
     out = []
     for point, (model, draws) in enumerate(sweep_points(cfg)):
         population = (None if cfg.population is None else dataclasses.replace(cfg.population, draws=draws))

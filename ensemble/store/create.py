@@ -9,7 +9,7 @@ import numpy as np
 
 from .. import __version__
 from ..model import laws
-from ..run.tasks import spinups as spinup_points
+from ..sweep import spinups as spinup_points
 from . import tables
 from .checkpoint import carries_creep, state_size
 from .layout import fixed_digest

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..config import LAW_KEYS, ConfigError, loads
 from ..model.workspace import KIND_EVENT, NEPISODE
-from ..run.tasks import spinups as spinup_points, task_list
+from ..sweep import spinups as spinup_points, task_list
 from . import tables
 from .checkpoint import Checkpoint, Head, TaskRecord, carries_creep, state_size
 from .errors import CatalogError, writing
