@@ -1,58 +1,10 @@
-"""The project's import graph: no circle among its modules, and the packages' modules small.
-
-Every import counts, a function's own included (one placed there to dodge a circle is still one).
-The graph is read from the sources (ast), nothing is imported, so the test takes well under a second.
+"""The project's import graph (read from the sources: tests/import_graph.py): no circle among its modules, and the
+packages' modules small.
 """
-import ast
-import functools
-from pathlib import Path
+from .import_graph import ROOT, graph
 
-ROOT = Path(__file__).resolve().parents[1]
-PACKAGES = ("ensemble", "analysis")
 MODULE_LINES = 400      # lines at most of a module of the packages below (one job each)
 SMALL_PACKAGES = ("ensemble/store", "ensemble/run", "ensemble/slurm")
-
-
-def modules(root=ROOT):
-    """{dotted name: path} of every module of the packages (a package is its __init__.py)."""
-    out = {}
-    for package in PACKAGES:
-        for path in sorted((root / package).rglob("*.py")):
-            parts = path.relative_to(root).with_suffix("").parts
-            out[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
-    return out
-
-
-def imports(name, path, known):
-    """The project's modules that module `name` (at `path`) imports, anywhere in it."""
-    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
-    found = set()
-    for node in ast.walk(ast.parse(path.read_text(), str(path))):
-        if isinstance(node, ast.Import):
-            targets = [alias.name for alias in node.names]
-        elif isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = package.split(".")[:len(package.split(".")) - (node.level - 1)]
-                base = ".".join(base + ([node.module] if node.module else []))
-            else:
-                base = node.module
-            # `from pkg import sub` imports the module pkg.sub; `from mod import name` the module mod
-            targets = [f"{base}.{alias.name}" if f"{base}.{alias.name}" in known else base for alias in node.names]
-        else:
-            continue
-        for target in targets:
-            while target and target not in known:     # `import a.b.c` where only a.b is ours, or a name
-                target = target.rpartition(".")[0]
-            if target and target != name:
-                found.add(target)
-    return found
-
-
-@functools.cache
-def graph(root=ROOT):
-    """{module: the project's modules it imports} (read once per session)."""
-    known = modules(root)
-    return {name: imports(name, path, known) for name, path in known.items()}
 
 
 def cycles(edges):
