@@ -3,10 +3,13 @@
 An entry's tableau decides the rest: an IMEX pair of tableaux.py gives an adaptive method (its
 stages, its step-size control exponent from the embedded order, its error weights), an
 exponential scheme of exponential.py the adaptive exponential integrator written out there
-(_STEPPERS: the stepper of each kind of tableau), None the classical RK4 at the fixed step dt. The kernels receive the method as a record
-(KernelParams.method) of a class of its own, so numba compiles them once per method, and each
-call here resolves at compile time to that method's stepper with its tableau frozen in as
-constants: no branch on the method at run time (the friction laws' pattern, laws/__init__.py).
+(_STEPPERS: the stepper of each kind of tableau), None the classical RK4 at the fixed step dt.
+
+The kernels receive the method as a record (KernelParams.method, a MethodRecord) of one type for every
+method, so numba compiles them once per friction law and every method is in that one compilation:
+take_step branches on the method's index once a step (not per block; docs/benchmarks.md measures its
+cost) to the method's own stepper, each compiled with its tableau frozen in as constants. Each stepper
+is the same code, with the same arithmetic, as when the kernels were compiled once per method.
 
 The registry lives beside the kernels because it decides what they compile: the numba cache is
 keyed on the sources of this package (model/__init__.py).
@@ -15,8 +18,8 @@ Adding a method: its pair in tableaux.py, one entry in METHODS. A method may ref
 (Method.refusal: exp4 needs a state linear in theta = exp(psi)).
 """
 import functools
-from collections import namedtuple
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numba as nb
 import numpy as np
@@ -26,6 +29,14 @@ from .exponential import ETDRK4_KROGSTAD, ExponentialScheme, exp_step
 from .steppers import ark_step, rk4_step
 from .tableaux import ARK324, ARK436, ARK548, ArkPair
 from .workspace import ARK_STAGES
+
+
+class MethodRecord(NamedTuple):
+    """A method as the kernels see it (KernelParams.method): one type for every method, so that the
+    kernels are compiled once per friction law, not once per law and method."""
+    index: int                # its place in METHODS: take_step calls its stepper
+    adaptive: bool            # it controls its step (rk4 does not)
+    control_exponent: float   # -1 / (q + 1), q the embedded order (0 for rk4)
 
 
 @dataclass(frozen=True)
@@ -40,12 +51,6 @@ class Method:
         if self.tableau is not None and len(self.tableau.c) > ARK_STAGES:
             raise ValueError(f"{self.name}: {len(self.tableau.c)} stages, the work array holds "
                              f"{ARK_STAGES} (workspace.ARK_STAGES)")
-        # the record's class, importable by name: pickle and numba's cache index find it so
-        record = namedtuple(self.name.upper(), ["control_exponent"])
-        record.__module__ = __name__
-        record.method = self
-        globals()[record.__name__] = record
-        object.__setattr__(self, "_record", record)
 
     @property
     def adaptive(self):
@@ -63,7 +68,8 @@ class Method:
 
     def kernel_params(self):
         """The method's record for the kernels (KernelParams.method)."""
-        return self._record(control_exponent=self.control_exponent)
+        return MethodRecord(index=list(METHODS).index(self.name), adaptive=self.adaptive,
+                            control_exponent=self.control_exponent)
 
     def refusal(self, law):
         """Why this method cannot integrate the friction law `law` (laws.Law), one line naming the
@@ -92,16 +98,6 @@ METHODS = {m.name: m for m in (
                                     "explicit; step controlled by integrator.rtol / atol, max_step; laws "
                                     "with a state need Law.linear_state (aging)"),
 )}
-
-
-def _method(record_type):
-    """The Method of a method record's numba type."""
-    return record_type.instance_class.method
-
-
-def _method_of(params_type):
-    """The Method of a KernelParams record's numba type."""
-    return _method(params_type.types[params_type.fields.index("method")])
 
 
 def _ark_stepper(pair):
@@ -138,7 +134,45 @@ def _stepper(method):
     return _STEPPERS[type(method.tableau)][0](method.tableau)
 
 
-# The kernels' calls; each stub is replaced by numba with the method's own code.
+def _branch(steppers, k):
+    """A numba function (index, step's arguments) that calls steppers[index], for index >= k: one
+    comparison per method, once a step (not per block); the steppers themselves are not inlined."""
+    here = steppers[k]
+    if k == len(steppers) - 1:
+        @nb.njit
+        def last(index, W, act, na, n, tau, h, p, yrest, first, at_first):
+            return here(W, act, na, n, tau, h, p, yrest, first, at_first)
+        return last
+    rest = _branch(steppers, k + 1)
+
+    @nb.njit
+    def branch(index, W, act, na, n, tau, h, p, yrest, first, at_first):
+        if index == k:
+            return here(W, act, na, n, tau, h, p, yrest, first, at_first)
+        return rest(index, W, act, na, n, tau, h, p, yrest, first, at_first)
+    return branch
+
+
+@functools.cache
+def _dispatch():
+    """take_step's body: the stepper of the method whose index (MethodRecord.index) the kernel is given."""
+    return _branch([_stepper(m) for m in METHODS.values()], 0)
+
+
+def _error_weight_rows():
+    """(rows, lengths): row k of `rows` holds b - bhat of method k's pair (METHODS' order; none for rk4),
+    its first lengths[k] entries; the rest are zero."""
+    weights = [_STEPPERS[type(m.tableau)][1](m.tableau) if m.adaptive else np.zeros(0) for m in METHODS.values()]
+    rows = np.zeros((len(weights), max(len(w) for w in weights)))
+    for k, w in enumerate(weights):
+        rows[k, :len(w)] = w
+    return rows, np.array([len(w) for w in weights])
+
+
+_ERROR_WEIGHTS, _STAGES = _error_weight_rows()
+
+
+# The kernels' calls on the method record.
 
 def take_step(W, act, na, n, tau, h, p, yrest, first, at_first):
     """One step of the method p.method of the active blocks from (Y0, V0, P0) by h (steppers.py);
@@ -148,29 +182,20 @@ def take_step(W, act, na, n, tau, h, p, yrest, first, at_first):
     at the step's first and last evaluation, which a method that reuses neither leaves (0, 0)."""
 
 
-def error_weights(method):
-    """b - bhat of an adaptive method's pair (float array; steppers.block_error)."""
-
-
-def adaptive(method):
-    """The method controls its step (a compile-time constant)."""
-
-
 @overload(take_step, inline="always")
 def _take_step(W, act, na, n, tau, h, p, yrest, first, at_first):
-    step = _stepper(_method_of(p))
-    return lambda W, act, na, n, tau, h, p, yrest, first, at_first: step(W, act, na, n, tau, h, p, yrest,
-                                                                         first, at_first)
+    dispatch = _dispatch()
+    return lambda W, act, na, n, tau, h, p, yrest, first, at_first: dispatch(p.method.index, W, act, na, n, tau,
+                                                                             h, p, yrest, first, at_first)
 
 
-@overload(error_weights, inline="always")
-def _error_weights(method):
-    m = _method(method)
-    bd = _STEPPERS[type(m.tableau)][1](m.tableau) if m.adaptive else np.zeros(0)
-    return lambda method: bd
+@nb.njit(cache=True, inline="always")
+def error_weights(method):
+    """b - bhat of an adaptive method's pair (float array; steppers.block_error); empty for rk4."""
+    return _ERROR_WEIGHTS[method.index, :_STAGES[method.index]]
 
 
-@overload(adaptive, inline="always")
-def _adaptive(method):
-    value = _method(method).adaptive
-    return lambda method: value
+@nb.njit(cache=True, inline="always")
+def adaptive(method):
+    """The method controls its step."""
+    return method.adaptive

@@ -19,9 +19,9 @@ class KernelParams(_Fields):
     nu            loading velocity of the driver plate
     law           the friction law's parameters, a namedtuple of that law's class (model/laws/): the
                   kernels are compiled once per law, and each call of a law function resolves to it
-    method        the integrator's record, of that method's own class (model/methods.py): the kernels are
-                  compiled once per method, each with its stepper and tableau; its field
-                  control_exponent is -1 / (q + 1), q the embedded order (0 for rk4)
+    method        the integrator's record (model/methods.py, MethodRecord: index, adaptive,
+                  control_exponent), one type for every method: the kernels are compiled once per
+                  law with every method's stepper, and take_step calls the one of p.method.index
     dt, rtol, atol, max_step, max_duration, creep_tol
                   the [integrator] keys of the same names, as declared (meaning, unit, the methods
                   that read them) in ensemble.integrators.KEYS; here max_step and max_duration may
