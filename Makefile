@@ -18,7 +18,7 @@ export OMP_NUM_THREADS := 1
 export NUMBA_NUM_THREADS := 1
 export OPENBLAS_NUM_THREADS := 1
 
-.PHONY: setup run test quick test-all mutations loaded
+.PHONY: setup run test quick test-all mutations loaded lint
 
 setup:
 	STACK=$(STACK) bash scripts/setup.sh
@@ -37,6 +37,11 @@ quick: setup
 test-all:
 	STACK=$(TEST_STACK) bash scripts/setup.sh
 	ENSEMBLE_TEST_STACK=$(TEST_STACK) $(PY) -m pytest -q
+
+# ruff over the repository (pyproject.toml [tool.ruff]: the rules, and why each ignore): unused imports and
+# variables, undefined names, layout, blind excepts, stale noqa; `make setup` installs ruff with the test tools
+lint: setup
+	$(PY) -m ruff check .
 
 # plausible bugs applied one at a time to a copy of the repository; every one must be caught (tests/mutations.py)
 mutations: setup
