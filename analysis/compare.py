@@ -46,6 +46,7 @@ from . import merge
 from .reduce import PARAMS, point_statistics
 from .reduce import Options as ReduceOptions
 from .statistics import Layout, of
+# F401: the comparison's estimators, reached as compare.<name> too (tests/test_compare.py)
 from .statistics.regularity import POISSON_SHARPNESS, SHARPNESS_BIN, recurrence_numbers  # noqa: F401
 from .statistics.rupture import (LOG_BIN, TAU_RANGE, dip, log_bins, power_law_ks, power_law_tau,  # noqa: F401
                                  size_density)

@@ -5,11 +5,11 @@ import os
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
 
-from .drawing import band  # noqa: E402
-from .stats import centers  # noqa: E402
+from .drawing import band
+from .stats import centers
 
 TNU_BINS = np.linspace(0.0, 5.0, 101)      # T / median(T)
 

@@ -6,9 +6,9 @@ import math
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.transforms import Bbox  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.transforms import Bbox
 
 FONT = 8            # the smallest text of a figure, points
 INSET = (0.36, 0.34)    # an inset's width and height, fractions of its panel's axes

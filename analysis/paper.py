@@ -137,8 +137,13 @@ def _peak_and_dip(s, rows):
     return "; ".join(one(i) + (f" ({point_label(s, i)})" if len(rows) > 1 else "") for i in rows)
 
 
+def _flat_spread(s):
+    """Point i -> its max / min of R(mu) over FLAT, as text (a column of `listing`)."""
+    return lambda i: ratio(shape_statistics(s, i)["flat_spread"], "the lowest bin")
+
+
 def _flat(s, rows):
-    spread = lambda i: ratio(shape_statistics(s, i)["flat_spread"], "the lowest bin")  # noqa: E731
+    spread = _flat_spread(s)
     text = (f"max / min of R over {FLAT[0]:g} <= mu <= {FLAT[1]:g}: " + listing(s, rows, spread, "b"))
     twenty = [i for i in range(len(s["points/b"])) if s["points/b"][i] == 20.0]
     if len(twenty) == 1:
@@ -173,7 +178,7 @@ def _recurrence(s, rows):
 
 
 def _large_b(s, rows):
-    spread = lambda i: ratio(shape_statistics(s, i)["flat_spread"], "the lowest bin")  # noqa: E731
+    spread = _flat_spread(s)
     return (_large("b")(s, rows) + "; KS distance to GR: " + listing(s, rows, lambda i: number(s, i, "ks_gr"), "b")
             + f"; max / min of R over {FLAT[0]:g}..{FLAT[1]:g}: " + listing(s, rows, spread, "b"))
 

@@ -15,17 +15,17 @@ import math
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.lines import Line2D  # noqa: E402
-from matplotlib.ticker import MaxNLocator  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.lines import Line2D
+from matplotlib.ticker import MaxNLocator
 
-from . import summary as summary_file  # noqa: E402
-from .drawing import (DPI, FONT, OPEN, OPEN_NOTE, band, grid, layout, legend_columns, palette,  # noqa: E402,F401
+from . import summary as summary_file
+from .drawing import (DPI, FONT, OPEN, OPEN_NOTE, band, grid, layout, legend_columns, palette,
                       place_inset)
-from .figure_labels import legend_labels, points_of, summary_name, title_text  # noqa: E402,F401
-from .report import count_text  # noqa: E402
-from .stats import centers  # noqa: E402
+from .figure_labels import legend_labels, points_of, summary_name, title_text
+from .report import count_text
+from .stats import centers
 
 
 def fault_densities(s, i):

@@ -311,7 +311,7 @@ def table(points, args, command):
                  f"averaged over windows of {args.window} events; decorrelated from the first window after which every "
                  f"window is beyond the edge (half the independent pairs' extreme distance from identity); late D / "
                  f"independent: medians over the second half of the run")
-    lines.append(f"events/s (reference and branches, all trajectories of a point): "
+    lines.append("events/s (reference and branches, all trajectories of a point): "
                  + ", ".join(f"N = {pt['N']}, b = {pt['b']:g}: {pt['events_per_second']:.0f}" for pt in points))
     s = suggestion(points, args.safety)
     lines.append("suggested decorrelation stretch: " + (

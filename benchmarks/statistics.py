@@ -54,7 +54,7 @@ from ensemble.store.errors import CatalogError
 
 from .common import Clock, minutes, parse_setting, rough_events_per_second, trajectory, write_outputs
 # the measure (statistics_distances.py) and the catalog mode (statistics_catalogs.py); the names tests and
-# readers reach through this module stay importable from it
+# readers reach through this module stay importable from it (F401: imported for them, not used here)
 from .statistics_catalogs import Refused, compare_catalogs, integrator_label, short  # noqa: F401
 from .statistics_distances import (DISTANCES, SAMPLES, distances, noise_floor, plot, pooled, rerun_rows,  # noqa: F401
                                    seed_samples, summarize, table, with_rerun, within_noise)

@@ -128,7 +128,7 @@ def _first_onset_bound(b, nu, init_stress):
 # free"). Each term that can overflow is largest at a corner of the sweep (smallest or largest
 # b, nu, l), so only the corners are checked.
 OVERFLOW_RULES = (
-    (("model.l",), lambda l: l * l,   # noqa: E741 - the model's name
+    (("model.l",), lambda l: l * l,
      "l^2 (the stiffness between blocks, integrators.kernel_params)"),
     (("model.b", "model.nu", "run.init_stress"), _first_onset_bound,
      "the time of the first onset, up to 2 b/nu (ln(b/nu) + init_stress/b + nu/b) (model/onset.py)"),

@@ -19,7 +19,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
-
+# E402 below: `python tests/attack.py` finds the packages only once the repository is on sys.path (above)
 import h5py  # noqa: E402
 import numpy as np  # noqa: E402
 

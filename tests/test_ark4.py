@@ -55,7 +55,8 @@ def order_residuals(b, c, tableaux, order):
             for q, B in tableaux.items():
                 out[f"b.{p}{q}c"] = dot(b, mul(A, mul(B, c))) - Fraction(1, 24)
     if order >= 5:
-        times = lambda u, w: [x * y for x, y in zip(u, w)]   # noqa: E731
+        def times(u, w):
+            return [x * y for x, y in zip(u, w)]
         out["b.c4"] = dot(b, power(c, 4)) - Fraction(1, 5)
         for p, A in tableaux.items():
             out[f"b.(c2*{p}c)"] = dot(b, times(power(c, 2), mul(A, c))) - Fraction(1, 10)

@@ -90,7 +90,6 @@ def test_the_new_state_is_exact_for_a_remainder_of_degree_2_at_any_z(z):
     from ensemble.model.exponential import _stage_theta
     from ensemble.model.workspace import ARK_G, NCOLS, X_EH, X_P1, X_P1H, X_P2, X_P2H, X_P3, X_THETA0
     h, theta0 = 0.37, 2.5
-    r0 = z / h
     W = np.zeros((1, NCOLS))
     em1h = math.expm1(-z / 2)
     W[0, X_THETA0] = theta0

@@ -26,7 +26,7 @@ from .conftest import write_config
 from .processes import ROOT, child_env, run_bounded
 
 sys.path.insert(0, str(ROOT / "scripts"))
-import stack  # noqa: E402  (scripts/ is not a package: setup.sh runs it before .venv exists)
+import stack  # (scripts/ is not a package: setup.sh runs it before .venv exists)
 
 PARALLEL_HEADER = "#define H5_HAVE_PARALLEL 1\n#define H5_VERSION \"1.14.5\"\n"
 SERIAL_HEADER = "/* #undef H5_HAVE_PARALLEL */\n#define H5_VERSION \"1.14.5\"\n"

@@ -8,7 +8,7 @@ import sys
 from dataclasses import fields
 
 from analysis.export_tables import INTEGRATOR_MEANINGS
-from ensemble.config import Integrator, Model, loads
+from ensemble.config import Integrator, Model
 from ensemble.config_rules import RULES
 from ensemble.integrators import INTEGRATORS, KEYS, kernel_params
 from ensemble.model.params import KernelParams

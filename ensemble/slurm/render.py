@@ -47,8 +47,6 @@ PLACEHOLDERS = {
     "RESULT_NAME": "name of the summary, figures and report (catalog stem; the config's for an array)",
     "REGION": "1 for a run with a [population]: the reduction job also writes the regional summary (reduce --region)",
 }
-PATH_PLACEHOLDERS = ("WORK_DIR", "LOG_DIR", "PYTHON", "CONFIG", "CATALOG", "SCRIPT", "POINTS_DIR",
-                     "SUMMARY_DIR")
 
 
 @dataclass(frozen=True)

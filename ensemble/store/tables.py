@@ -32,7 +32,6 @@ FIXED_ATTRS = ("config", "version", "format", "events_per_task", "transient", "s
 # /tasks columns of a task's record, in the order of its CRC
 RECORD = ("status", "error", "integrator", "rank", "wall_time", "events_per_second", "seed_entropy",
           "spawn_key")
-PROVENANCE = ("rank", "wall_time", "events_per_second", "seed_entropy", "spawn_key")
 
 
 def _bytes_of(value):
