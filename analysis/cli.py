@@ -256,7 +256,8 @@ def _prepare(args):
     out = check_summary_output(args.output or _default_output(args.catalogs), args.catalogs, args.force)
     for given in ("region_span", "region_skip"):
         if getattr(args, given) is not None and not args.region:
-            raise checks.UsageError(f"--{given.replace('_', '-')} sets the window of a regional reduction: give --region too")
+            raise checks.UsageError(f"--{given.replace('_', '-')} sets the window of a regional reduction: "
+                                    f"give --region too")
     # (checks each file's kind first)
     inputs = merge.read(args.catalogs, allow_partial=args.partial, region=args.region, span=args.region_span,
                         skip=args.region_skip or 0.0)

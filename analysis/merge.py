@@ -187,7 +187,8 @@ def reduce_share(inputs, rows, opt, layout=LAYOUT):
     for c, path in enumerate(inputs.paths):
         mine = [g for g in rows if inputs.tasks["catalog"][g] == c]
         if mine:
-            windows = ({int(inputs.tasks["catalog_task"][g]): (inputs.tasks["window_start"][g], inputs.tasks["window_end"][g])
+            windows = ({int(inputs.tasks["catalog_task"][g]):
+                        (inputs.tasks["window_start"][g], inputs.tasks["window_end"][g])
                         for g in mine} if "window_start" in inputs.tasks else None)
             local = reduce_tasks(path, [int(inputs.tasks["catalog_task"][g]) for g in mine], opt, layout, windows)
             out.update({g: local[int(inputs.tasks["catalog_task"][g])] for g in mine})

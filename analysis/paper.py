@@ -88,7 +88,8 @@ def shape_statistics(s, i, level=None, merge=1):
     level = s["attrs"]["level"] if level is None else level
     edges, counts, events = summary.point_units(s, i, merge)
     c = stats.centers(edges)
-    if s["points/method"][i] in ("seeds", "faults"):   # the summary's own units: seeds (a region's faults), else every stretch
+    # the summary's own units: seeds (a region's faults), else every stretch
+    if s["points/method"][i] in ("seeds", "faults"):
         counts, events = counts.sum(axis=1, keepdims=True), events.sum(axis=1, keepdims=True)
     rows = np.concatenate([counts.reshape(-1, len(c)), events.reshape(-1, 1)], axis=1)
     est = _shape(rows.sum(axis=0), edges, c)

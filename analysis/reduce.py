@@ -190,7 +190,8 @@ def reduce_tasks(path, task_indices, opt, layout=LAYOUT, windows=None):
                 out[k] = reduce_task(reader.rows_where(cat.task_events(k, opt.chunk),
                                                        lambda part: _inside(part["t"], start, end)),
                                      int(np.count_nonzero(inside & (kind == schema.KIND_EVENT))),
-                                     float(tasks["nu"][k]), int(tasks["N"][k]), opt, int(np.count_nonzero(inside)), layout)
+                                     float(tasks["nu"][k]), int(tasks["N"][k]), opt, int(np.count_nonzero(inside)),
+                                     layout)
             out[k].rows = rows
     return out
 
@@ -219,9 +220,9 @@ def unreliable(units, method):
 
 
 def _units(per_task, task_ids, whole="seeds"):
-    """Resampling units of a point: its tasks (`whole`: seeds, or a region's faults) if it has at least MIN_UNITS, else the stretches
-    of all its tasks (task by task, in task order). pack(name): the units of an additive table stacked
-    (units, width); of a sample, a list of one array per unit (a task's stretches one after the other)."""
+    """Resampling units of a point: its tasks (`whole`: seeds, or a region's faults) if it has at least MIN_UNITS,
+    else the stretches of all its tasks (task by task, in task order). pack(name): the units of an additive table
+    stacked (units, width); of a sample, a list of one array per unit (a task's stretches one after the other)."""
     stack = [per_task[k] for k in task_ids]
     if len(stack) >= MIN_UNITS:
         def pack(name):

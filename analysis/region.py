@@ -107,7 +107,8 @@ def group(paths, configs, discarded, tasks, span=None, skip=0.0, partial=False):
         spans[r] = own[shortest] if span is None else span
         tasks["window_start"][rows] = start[rows] + skip / tasks["nu"][rows]
         tasks["window_end"][rows] = tasks["window_start"][rows] + spans[r] / tasks["nu"][rows]
-        shared = {p: (float(tasks[p][rows[0]]) if np.all(tasks[p][rows] == tasks[p][rows[0]]) else np.nan) for p in PARAMS}
+        shared = {p: (float(tasks[p][rows[0]]) if np.all(tasks[p][rows] == tasks[p][rows[0]]) else np.nan)
+                  for p in PARAMS}
         points.append(({**shared, "region": name, "region_label": short, "law": str(tasks["law"][rows[0]])}, rows))
         warnings += _transient_warnings(paths, discarded, tasks, rows, r)
     return points, spans, warnings

@@ -110,8 +110,8 @@ def table(s):
     for i in range(len(s["points/N"])):
         if "points/region" in s:    # a regional reduction (analysis/region.py)
             lines.append(f"region {i}: {s['points/region_label'][i]}; {point_label(s, i, list(PARAMS))}  (resampling "
-                         f"{s['points/method'][i]}, {s['points/units'][i]} units; window {s['points/region_span'][i]:.6g} "
-                         "T*nu per fault)")
+                         f"{s['points/method'][i]}, {s['points/units'][i]} units; "
+                         f"window {s['points/region_span'][i]:.6g} T*nu per fault)")
         else:
             lines.append(f"point {i}: " + point_label(s, i, list(PARAMS)) +
                          f"  (resampling {s['points/method'][i]}, {s['points/units'][i]} units)")

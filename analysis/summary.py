@@ -131,7 +131,8 @@ DATASETS = {
     "points/units": ("count", _POINTS, "resampling units of the point"),
     # a regional reduction's (reduce --region, analysis/region.py): each point a region, its parameters those its
     # faults share (NaN where drawn); method 'faults' resamples the region's faults
-    "points/region": ("text", _POINTS, "the region: its law, its [model] values not drawn, each drawn key's distribution"),
+    "points/region": ("text", _POINTS,
+                      "the region: its law, its [model] values not drawn, each drawn key's distribution"),
     "points/region_label": ("text", _POINTS, "its drawn keys in a few words (legends, the report)"),
     "points/region_span": ("model length", _POINTS, "the span W of the region's window (T nu): every fault's rows "
                                                     "with t0 <= t < t0 + W / nu, t0 its first recorded onset"),

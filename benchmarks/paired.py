@@ -37,7 +37,8 @@ def command(setting, args):
             cmd += [f"--{key}", repr(kw[key])]
     unknown = set(kw) - {"dt", "rtol"}
     if unknown:
-        raise ValueError(f"setting {setting.label!r}: throughput takes dt and rtol only, not {', '.join(sorted(unknown))}")
+        raise ValueError(f"setting {setting.label!r}: throughput takes dt and rtol only, "
+                         f"not {', '.join(sorted(unknown))}")
     if args.cpu >= 0 and shutil.which("taskset"):
         cmd = ["taskset", "-c", str(args.cpu)] + cmd
     return cmd

@@ -5,8 +5,8 @@
                                     [--law carlson-langer --alpha 2 --sigma 0.01 | --law slip --a 0] [--per-row]
 
 Runs the transient (not timed, includes compilation), then times `events`
-recorded events and prints events/s (wall clock, and per second of the process's cpu time), cost per block-step, the magnitude range
-and the largest relative energy residual. Below the block stiffness the rows are inertial events and
+recorded events and prints events/s (wall clock, and per second of the process's cpu time), cost per block-step,
+the magnitude range and the largest relative energy residual. Below the block stiffness the rows are inertial events and
 creep episodes: it prints the rate of each, the event statistics of the inertial events alone, and the
 energy balance of the timed stretch of the run, events and creep together (ensemble/energy.py: a creep
 episode has no residual of its own).
@@ -35,7 +35,8 @@ def main():
     p.add_argument("--sigma", type=float, default=0.01, help="carlson-langer's sigma")
     p.add_argument("--nu", type=float, default=Model().nu)
     p.add_argument("--dt", type=float, default=1e-3)
-    p.add_argument("--method", default="rk4", help="rk4, ark3, ark4, ark5 or exp4 (the registry, ensemble/model/methods.py)")
+    p.add_argument("--method", default="rk4",
+                   help="rk4, ark3, ark4, ark5 or exp4 (the registry, ensemble/model/methods.py)")
     p.add_argument("--rtol", type=float, default=Integrator().rtol,
                    help="tolerance of the adaptive methods (default: the config default)")
     p.add_argument("--transient", type=int, default=1000)
@@ -82,7 +83,8 @@ def main():
               f"({len(creep) / elapsed:.1f}/s; median slip {np.median(creep[:, D_SLIP]):.3g}, median duration "
               f"{np.median(creep[:, D_DURATION]):.3g}, {creep[:, D_BLOCK_STEPS].mean():.0f} block-steps each); "
               f"aseismic slip fraction {creep[:, D_SLIP].sum() / (creep[:, D_SLIP].sum() + diag[:, D_SLIP].sum()):.2e}")
-        print(f"  energy balance of the run, events and creep: residual {abs(balance.residual / balance.load_work):.1e} "
+        print(f"  energy balance of the run, events and creep: "
+              f"residual {abs(balance.residual / balance.load_work):.1e} "
               f"of the driver's work (friction work of the creep episodes {balance.creep_work:.3g}, of the events "
               f"{balance.friction_work - balance.creep_work:.3g}, c-free frame)")
     if args.per_row:

@@ -86,7 +86,8 @@ def main(argv=None):
             rows = np.flatnonzero(tasks["point"] == point)
             law = str(tasks["law"][rows[0]])
             mu_c = laws.get(law).scales.mu_c
-            mu = [events["mu"][(events["task"] == g) & (events["kind"] == KIND_EVENT)] for g in rows]   # events, not creep
+            # events, not creep
+            mu = [events["mu"][(events["task"] == g) & (events["kind"] == KIND_EVENT)] for g in rows]
             keys = [k for k in laws.get(law).keys]
             label = f"N = {int(tasks['N'][rows[0]])}, " + ", ".join(f"{k} = {tasks[k][rows[0]]:g}" for k in keys)
             curves = point_curves(mu, args.window, mu_c, rng)

@@ -153,7 +153,8 @@ def speedups(rows, target):
 
 def table(rows, costs, ratios, title, target):
     lines = [f"work-precision, single events, {title}",
-             f"{'event':6s} {'mu':>5s} {'setting':34s} {'slip err':>9s} {'prof err':>9s} {'seconds':>9s} {'block RHS':>10s}"]
+             f"{'event':6s} {'mu':>5s} {'setting':34s} {'slip err':>9s} {'prof err':>9s} {'seconds':>9s} "
+             f"{'block RHS':>10s}"]
     for r in rows:
         if r["status"] == "ok":
             rhs = f"{r['block_rhs']:10.3g}" if r["block_rhs"] else f"{'?':>10s}"

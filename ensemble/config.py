@@ -20,9 +20,8 @@ from .model import laws
 from .sections import POPULATION, SECTION_NAMES, SWEEP
 
 __all__ = ["Config", "ConfigError", "DECORRELATION_PER_BLOCK", "Integrator", "LAW_KEYS", "MEASURED_TRANSIENT_PER_BLOCK",
-           "Model", "Output", "Run",
-           "SECTIONS", "TRANSIENT_PER_BLOCK", "from_dict", "load", "loads", "parse_override", "parse_section", "replace",
-           "section_lines"]
+           "Model", "Output", "Run", "SECTIONS", "TRANSIENT_PER_BLOCK", "from_dict", "load", "loads", "parse_override",
+           "parse_section", "replace", "section_lines"]
 
 
 @dataclass(frozen=True)
@@ -80,7 +79,8 @@ DECORRELATION_PER_BLOCK = 1
 class Run:
     seeds: int = 1             # realisations per parameter point
     events: int = 200000       # events recorded per task
-    transient: int = None      # events discarded at the start of each task, or of each spin-up (default TRANSIENT_PER_BLOCK N)
+    transient: int = None      # events discarded at the start of each task, or of each spin-up
+    #                            (default TRANSIENT_PER_BLOCK N)
     seed: int = 0              # root seed: task k uses SeedSequence(seed, spawn_key=(k,))
     init_stress: float = 1.0   # initial forces are uniformly spread this far below threshold
     poll_seconds: float = 0.25  # kernel calls last about this long between MPI polls
@@ -212,7 +212,8 @@ def _sweep(raw, overridden, law_keys):
                 drawn = key.partition(".")[2]
                 if not isinstance(values, list) or not values:
                     raise ConfigError(f"sweep.{key} must be a non-empty list of distributions, e.g. "
-                                      f'{key} = [{{distribution = "uniform", min = 20, max = 30}}, [40]], got {values!r}')
+                                      f'{key} = [{{distribution = "uniform", min = 20, max = 30}}, [40]], '
+                                      f'got {values!r}')
                 out.append((key, _distinct(key, tuple(populations.parse_draw(drawn, v, types, law_keys, f"sweep.{key}")
                                                       for v in values))))
                 continue

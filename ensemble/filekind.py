@@ -5,7 +5,8 @@ attribute `format` starts with "bk-catalog-", ensemble/store/) and reduction sum
 `format` "bk-summary-N", analysis/summary.py). A catalog and its summary sit side by side, both
 *.h5, so giving one for the other is an easy slip; `require` says what was given and what to give:
 
-    my.summary.h5 is a reduction summary (HDF5, reduced from my.h5), not an event catalog (give the catalog it was reduced from)
+    my.summary.h5 is a reduction summary (HDF5, reduced from my.h5), not an event catalog (give the catalog it
+    was reduced from)
 
 Exit codes (README table) follow the role of the argument, not what was found in its place:
 where a config is expected, anything else is a bad config (ConfigError, exit 2, as a missing

@@ -145,7 +145,8 @@ def build(entries):
 def drawable(key, types, law_keys, where):
     """Refuse a key that cannot be drawn, naming it as `where`."""
     if key in NOT_DRAWN:
-        raise ConfigError(f"{where}: model.{key} is not drawn ({'one law per run' if key == 'law' else 'the faults of a region share the plate velocity'})")
+        why = "one law per run" if key == "law" else "the faults of a region share the plate velocity"
+        raise ConfigError(f"{where}: model.{key} is not drawn ({why})")
     if key not in types:
         raise ConfigError(f"unknown key {where} (known: faults, seed, and the drawn [model] keys: "
                           f"{', '.join(k for k in types if k not in NOT_DRAWN)})")

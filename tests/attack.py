@@ -474,7 +474,8 @@ ATTACKS = {
     "ulimit -f, mpi, parallel writer": file_size_limit(2, "parallel"),
     "ulimit -f, mpi, rank0 writer": file_size_limit(2, "rank0"),
     **{f"flip /tasks/{name}": flipped_table(name) for name in TASK_DATASETS},
-    **{f"flip /tasks/{name}, every command": flipped_table_every_command(name) for name in ("b", "status", "wall_time")},
+    **{f"flip /tasks/{name}, every command": flipped_table_every_command(name)
+       for name in ("b", "status", "wall_time")},
     "changed stored config, finished": changed_config("full"),
     "changed stored config, partial": changed_config("crashed"),
     "status of an unknown status code": status_of_an_unknown_code,

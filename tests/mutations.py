@@ -116,7 +116,8 @@ MUTATIONS = (
              "EV_SLIP_TIME = 11   #", "EV_SLIP_TIME = 10   #",
              ("tests/test_budget.py::test_the_event_state_slots_are_one_each_and_contiguous",
               "tests/test_budget.py::test_the_paused_event_is_saved_and_restored_by_name"),
-             "two loop variables of a paused event kept in one slot: the friction work comes back as the slip's integral"),
+             "two loop variables of a paused event kept in one slot: the friction work comes back as the slip's "
+             "integral"),
     Mutation("paused-event-fields-crossed", "ensemble/model/event.py",
              "    event[EV_WORK] = s.work\n    event[EV_SLIP_TIME] = s.slip_time\n",
              "    event[EV_WORK] = s.slip_time\n    event[EV_SLIP_TIME] = s.work\n",
@@ -274,7 +275,8 @@ MUTATIONS = (
              ("tests/test_seismicity.py",),
              "a mainshock's window counted whole where the task's start or end cuts it: rates biased low there"),
     Mutation("seismicity-resample-misses-a-region", "analysis/statistics/seismicity.py",
-             'return {"seis_pairs": cells, "seis_exposure": cells}', 'return {"seis_pairs": cells[1:], "seis_exposure": cells}',
+             'return {"seis_pairs": cells, "seis_exposure": cells}',
+             'return {"seis_pairs": cells[1:], "seis_exposure": cells}',
              ("tests/test_seismicity.py",),
              "a resample leaves out a cell the numbers read: their intervals come from NaN"),
     Mutation("region-window-closed-at-its-end", "analysis/reduce.py",
@@ -300,7 +302,8 @@ MUTATIONS = (
              "a resumed chain forgets which blocks were creeping: the resumed catalog is another trajectory"),
     Mutation("space-unchecked", "ensemble/run/decision.py",
              "_fits(partial, lambda: space.check_fits(partial, estimate_bytes(cfg, tasks)))", "pass",
-             ("tests/test_attacks.py", "tests/test_faults.py::test_a_full_disk_stops_the_run_with_one_line_and_nothing_lost"),
+             ("tests/test_attacks.py",
+              "tests/test_faults.py::test_a_full_disk_stops_the_run_with_one_line_and_nothing_lost"),
              "a disk too small under MPI hangs every rank in HDF5's collective calls"),
     Mutation("export-overwrites", "analysis/export.py",
              "checks.output(path, inputs=[source], force=force, what=\"table\")",
@@ -326,7 +329,8 @@ MUTATIONS = (
              ("tests/test_export.py::test_peaks_table_of_several_peaks_per_point",),
              "the exported peaks' interval ends swapped"),
     Mutation("export-curve-left-out", "analysis/export_tables.py",
-             'if f"points/{curve}_density" not in s:', 'if curve == "tnu_interior" or f"points/{curve}_density" not in s:',
+             'if f"points/{curve}_density" not in s:',
+             'if curve == "tnu_interior" or f"points/{curve}_density" not in s:',
              ("tests/test_export.py::test_every_summary_dataset_per_point_is_exported",),
              "a density of the summary missing from curves.csv"),
     Mutation("export-summary-taken-for-a-catalog", "analysis/export.py",
@@ -367,7 +371,9 @@ def copy_repository(dest):
         if src.is_file():
             (dest / name.decode()).parent.mkdir(parents=True, exist_ok=True)
             shutil.copy2(src, dest / name.decode())
-    (dest / ".git").write_text(f"gitdir: {subprocess.run(['git', 'rev-parse', '--absolute-git-dir'], cwd=ROOT, check=True, capture_output=True, text=True, timeout=60).stdout.strip()}\n")
+    git_dir = subprocess.run(["git", "rev-parse", "--absolute-git-dir"], cwd=ROOT, check=True, capture_output=True,
+                             text=True, timeout=60).stdout.strip()
+    (dest / ".git").write_text(f"gitdir: {git_dir}\n")
 
 
 def run_tests(copy, tests, cache, timeout):

@@ -24,7 +24,8 @@ here the slow and obvious way, from the raw events:
   its index) where nothing is recorded (-1: not finished); the tasks of a point are its
   resampling units in the order of their streams;
 - resampling units: the tasks of a point if it has at least MIN_SEEDS, else the stretches of
-  every task (task by task, in the order above); bootstrap resamples drawn as rng.integers(0, units, (bootstrap, units)) from
+  every task (task by task, in the order above); bootstrap resamples drawn as
+  rng.integers(0, units, (bootstrap, units)) from
   default_rng(SeedSequence(seed, spawn_key=(N, bits(l), bits(nu), bits(a), bits(b), bits(c))))
   with bits(x) the binary64 pattern of x as an unsigned integer, first for the numbers and
   curves, then (with >= 2 units and recurrences) for the peaks; intervals are the
@@ -596,7 +597,8 @@ def expected_summary(catalogs, opt):
     exp = {"bins/mu": opt["mu_edges"], "bins/tnu": opt["tnu_edges"],
            "bins/creep_mu": edges_of(opt, "creep_mu_edges"),
            "bins/creep_duration": edges_of(opt, "creep_duration_edges"),
-           "bins/seis_time": edges_of(opt, "seis_time_edges"), "bins/seis_distance": edges_of(opt, "seis_distance_edges")}
+           "bins/seis_time": edges_of(opt, "seis_time_edges"),
+           "bins/seis_distance": edges_of(opt, "seis_distance_edges")}
     stacks = [t.per_stretch(opt) for t in per_task]
     for j, name in enumerate(("mu", "tnu", "tnu_interior", "numbers", "creep_mu", "creep_duration", "creep",
                               "intervals", "seis_pairs", "seis_exposure", "seismicity")):

@@ -305,7 +305,8 @@ def test_legend_labels_name_what_differs_between_the_plotted_points():
     # two friction laws: each point is named by its law and its own law's keys (the other law's are NaN)
     cl = fake_summary(a=[np.nan], b=[np.nan], c=[np.nan], alpha=[2.0], sigma=[0.01])
     assert legend_labels([fake_summary(b=[20.0]), cl]) == (
-        ["a", "b", "c", "alpha", "sigma"], ["aging: a = 0, b = 20, c = 1000", "carlson-langer: alpha = 2, sigma = 0.01"])
+        ["a", "b", "c", "alpha", "sigma"],
+        ["aging: a = 0, b = 20, c = 1000", "carlson-langer: alpha = 2, sigma = 0.01"])
     # two laws with the same keys (aging and slip): only the law tells the points apart
     slip = fake_summary(b=[20.0])
     slip["points/law"] = np.array(["slip"])

@@ -238,8 +238,9 @@ def test_slip_error_follows_the_tolerance(events, method):
         for rtol in (1e-5, 1e-7):
             ev = check(run_event(f, p, epicenter, model, Integrator(method=method, rtol=rtol)))
             errors.append(abs(ev.slip - ref.slip) / ref.slip)
-            print(f"  rtol {rtol:.0e}: profile error {np.linalg.norm(ev.profile - ref.profile) / np.linalg.norm(ref.profile) / rtol:.2f} "
-                  f"rtol, energy residual {ev.relative_energy_residual / rtol:.2e} rtol")
+            profile_error = np.linalg.norm(ev.profile - ref.profile) / np.linalg.norm(ref.profile)
+            print(f"  rtol {rtol:.0e}: profile error {profile_error / rtol:.2f} rtol, "
+                  f"energy residual {ev.relative_energy_residual / rtol:.2e} rtol")
             # measured: profile error at most 0.10 rtol, energy residual 0.046 rtol
             assert np.linalg.norm(ev.profile - ref.profile) <= rtol * np.linalg.norm(ref.profile)
             assert ev.relative_energy_residual < rtol
@@ -293,7 +294,8 @@ def test_step_trace_accounts_for_every_step(events, method):
             own = rows[accepted, T_OWN]
             sliding = rows[accepted, T_SLIDING]
             print(f"  own-step block-steps: largest excess over the sliding blocks "
-                  f"{np.max(own - sliding):.1e}, over the lower bound {np.min(own - np.maximum(1.0, 0.1 * sliding)):.1e}")
+                  f"{np.max(own - sliding):.1e}, "
+                  f"over the lower bound {np.min(own - np.maximum(1.0, 0.1 * sliding)):.1e}")
             # (1e-12: round-off slack of the sum; measured: both bounds reached exactly, never passed)
             assert np.all(own <= sliding + 1e-12) and np.all(own >= np.maximum(1.0, 0.1 * sliding) - 1e-12)
 

@@ -271,7 +271,8 @@ def test_revisions_tiny(tmp_path):
     from .test_summary_identity import CATALOG, gunzip
     cat = gunzip(CATALOG, tmp_path / "catalog.h5")
     data = revisions.main(["--before", "HEAD", "--rounds", "1", "--cpu", "-1", "--name", "t", "--out", str(tmp_path),
-                           "--", "python", "-m", "analysis", "reduce", str(cat), "-o", str(tmp_path / "{side}.h5"), "--force"])
+                           "--", "python", "-m", "analysis", "reduce", str(cat), "-o", str(tmp_path / "{side}.h5"),
+                           "--force"])
     (now, _), (before, _) = data["cost"]["now"][0], data["cost"]["before"][0]
     assert now > 0 and before > 0 and data["cpu_ratios"] == [now / before]
     assert (tmp_path / "before.h5").is_file() and (tmp_path / "now.h5").is_file()

@@ -176,5 +176,6 @@ def test_the_paused_event_is_saved_and_restored_by_name():
     assert {f: type(getattr(back, f)) for f in counts} == {f: int for f in counts}
     # the record is built by keyword wherever the kernel builds it, so no call depends on the fields' order
     tree = ast.parse(inspect.getsource(event))
-    calls = [node for node in ast.walk(tree) if isinstance(node, ast.Call) and getattr(node.func, "id", "") == "PausedEvent"]
+    calls = [node for node in ast.walk(tree)
+             if isinstance(node, ast.Call) and getattr(node.func, "id", "") == "PausedEvent"]
     assert calls and all(not call.args and {k.arg for k in call.keywords} == set(PausedEvent._fields) for call in calls)

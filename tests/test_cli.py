@@ -144,7 +144,8 @@ def test_validate_without_parallel_hdf5(small_run, monkeypatch, capsys):
 def test_run_refuses_the_parallel_writer_without_parallel_hdf5(tmp_path):
     """The run itself refuses, as a config error (exit 2, one line), before creating anything."""
     cfg = write_config(tmp_path / "c.toml")
-    code = ("import sys; from ensemble import cli; from ensemble.store import writers; writers.has_parallel_hdf5 = lambda: False; "
+    code = ("import sys; from ensemble import cli; from ensemble.store import writers; "
+            "writers.has_parallel_hdf5 = lambda: False; "
             f"sys.exit(cli.main(['run', {str(cfg)!r}, '--set', 'output.writer=\"parallel\"']))")
     res = run_bounded([sys.executable, "-c", code], 600, cwd=ROOT, env=child_env())
     assert res.returncode == 2, res.stderr

@@ -121,11 +121,11 @@ def test_a_run_of_creep_and_events_keeps_the_energy_balance(method):
     four of them creep episodes) the driver's whole work equals the chain's elastic energy change plus the
     friction work of every row (ensemble/energy.py), to the events' own residuals: each within 5e-6 of its
     energy turnover at rtol = 1e-4 (ark4, and exp4, the aging law's default), together 3e-7 to 5e-7 of the
-    driver's work (measured). The creep's share of the residual is rounding: a creep step's trapezoidal friction work is exactly the driver's work less
-    the elastic change along its linear path (measured 2e-12 of the creep's friction work; the step end's
-    friction times the slip instead, backward Euler's own balance, would leave 5e-5 at creep_tol = 1e-6,
-    falling as sqrt(creep_tol)). The creep rows carry their work: at the friction b psi of a creeping block
-    per unit slip, and the driver's work on a slip made within the episode."""
+    driver's work (measured). The creep's share of the residual is rounding: a creep step's trapezoidal friction
+    work is exactly the driver's work less the elastic change along its linear path (measured 2e-12 of the creep's
+    friction work; the step end's friction times the slip instead, backward Euler's own balance, would leave 5e-5
+    at creep_tol = 1e-6, falling as sqrt(creep_tol)). The creep rows carry their work: at the friction b psi of a
+    creeping block per unit slip, and the driver's work on a slip made within the episode."""
     n, b, nu, count = 40, 15.0, 1e-3, 300
     p = kernel_params(Model(N=n, l=L, b=b, nu=nu), Integrator(method=method))
     ws = Workspace(n)

@@ -125,7 +125,8 @@ def test_carlson_langer_has_no_state_and_runs_as_adaptive_rk4():
     f[epicenter] = 1.0
     ref = check(run_event(f, p, epicenter, model, Integrator(method="rk4", dt=1e-4)))
     ev = check(run_event(f, p, epicenter, model, Integrator(method="exp4", rtol=1e-6)))
-    print(f"carlson-langer event: slip {ev.slip:.6g} against RK4's {ref.slip:.6g}, {ev.steps} steps against {ref.steps}")
+    print(f"carlson-langer event: slip {ev.slip:.6g} against RK4's {ref.slip:.6g}, "
+          f"{ev.steps} steps against {ref.steps}")
     assert ev.slip == pytest.approx(ref.slip, rel=1e-5)
     assert np.all(ev.psi == 0.0)
 

@@ -319,7 +319,8 @@ def test_export_refuses_to_overwrite(files, tmp_path):
     (out / "tasks.csv").write_text("mine\n")
     res = analysis("export", files / "cat.h5", "-o", out, "--partial")
     assert res.returncode == 2   # a usage error, as `ensemble run` says of an existing catalog
-    assert res.stderr.strip().splitlines() == [f"error: {out / 'tasks.csv'}: table exists (use --force to overwrite it)"]
+    assert res.stderr.strip().splitlines() == [
+        f"error: {out / 'tasks.csv'}: table exists (use --force to overwrite it)"]
     assert sorted(os.listdir(out)) == ["tasks.csv"] and (out / "tasks.csv").read_text() == "mine\n"
     ok(analysis("export", files / "cat.h5", "-o", out, "--force", "--partial"))
     assert (out / "tasks.csv").read_text() == (files / "cat_csv" / "tasks.csv").read_text()

@@ -32,7 +32,8 @@ TIMEOUT = 120     # seconds for any one command or wait: what they take is a few
 
 def injected(setup, *argv, timeout=TIMEOUT):
     """Run `python -m ensemble argv` in a subprocess after `setup` (code using tests.inject)."""
-    code = f"import sys; sys.path.insert(0, {str(ROOT)!r}); from tests import inject; {setup}; inject.main({list(map(str, argv))!r})"
+    code = (f"import sys; sys.path.insert(0, {str(ROOT)!r}); from tests import inject; {setup}; "
+            f"inject.main({list(map(str, argv))!r})")
     return run_bounded([sys.executable, "-c", code], timeout, env=child_env())
 
 
@@ -320,8 +321,8 @@ def test_a_full_disk_stops_the_run_with_one_line_and_nothing_lost(small, small_d
     assert len(res.stderr.strip().splitlines()) == 1 and not any(small_disk.iterdir())
     # in the middle (a file system without fallocate, whose space another process takes while the run
     # goes on: nothing reserved, the check before creation passed): one line, a readable catalog
-    res = injected("from ensemble import space; from ensemble.store import files; files.reserve_space = lambda path: None; "
-                   "space.check_fits = lambda path, nbytes: None",
+    res = injected("from ensemble import space; from ensemble.store import files; "
+                   "files.reserve_space = lambda path: None; space.check_fits = lambda path, nbytes: None",
                    "run", cfg, "-o", small_disk / "b.h5", *big)
     assert res.returncode == 1 and "No space left on device" in res.stderr, res.stderr
     assert len(res.stderr.strip().splitlines()) == 1

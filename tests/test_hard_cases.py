@@ -21,7 +21,8 @@ from ensemble.model.workspace import D_ENERGY_SCALE, D_RESIDUAL, D_SLIP, D_VMAX
 from ensemble.run.trajectory import Trajectory
 from ensemble.sweep import task_list
 
-ADAPTIVE = ["ark3", "ark4", "exp4"]           # adaptive methods, run at Integrator()'s defaults (a new one is one word here)
+# adaptive methods, run at Integrator()'s defaults (a new one is one word here)
+ADAPTIVE = ["ark3", "ark4", "exp4"]
 METHODS = ["rk4", *ADAPTIVE]
 
 # name: (model, RK4 step, events recorded after as many transient events)

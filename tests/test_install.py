@@ -211,7 +211,8 @@ def test_auto_gives_a_new_venv_the_wheels_and_names_the_parallel_stack_it_could_
     text = "\n".join(lines)
     assert f"a parallel HDF5 stack is on this machine ({mpicc}, HDF5_DIR={prefix})" in text
     assert "make setup STACK=parallel" in text and "building" not in text
-    assert lines[-1].startswith("setup: ok: stack wheels") and (repo / ".venv" / "ensemble-stack").read_text() == "wheels\n"
+    assert lines[-1].startswith("setup: ok: stack wheels")
+    assert (repo / ".venv" / "ensemble-stack").read_text() == "wheels\n"
     # a parallel .venv that no longer imports (here: its h5py has no MPI) is rebuilt, falling back to wheels
     (repo / ".venv" / "ensemble-stack").write_text("parallel\n")
     _, lines = fake_setup(tmp_path, mpicc.parent, HDF5_DIR=prefix)

@@ -140,7 +140,8 @@ SLOW = pytest.mark.slow
     pytest.param(signal.SIGINT, "all", "auto", marks=SLOW),
     # the rank-0 writer: rank 0 must serve the other rank's last rows and its "done", wherever they arrive
     pytest.param(signal.SIGTERM, "one", "rank0", marks=SLOW), (signal.SIGTERM, "other", "rank0"),
-    pytest.param(signal.SIGTERM, "all", "rank0", marks=SLOW), pytest.param(signal.SIGUSR1, "other", "rank0", marks=SLOW)])
+    pytest.param(signal.SIGTERM, "all", "rank0", marks=SLOW),
+    pytest.param(signal.SIGUSR1, "other", "rank0", marks=SLOW)])
 def test_resume_after_signal_equals_uninterrupted(four_tasks, sig, which, writer):
     """Every rank checkpoints and exits 75 (also when only one rank got the signal); resume completes."""
     d, cfg = four_tasks

@@ -96,10 +96,12 @@ def test_a_list_draws_each_value_alike():
 BAD = [  # (the [population] lines beyond faults and seed, the [run] lines, the [sweep] lines), what the error names
     ('b = {distribution = "uniform", min = 50, max = 20}', "", "", "population.b: the range is empty"),
     ('b = {distribution = "uniform", min = 20, max = 20}', "", "", "population.b: the range is empty"),
-    ('N = {distribution = "power", exponent = -1, min = 100, max = 1600}', "", "", "population.N.exponent must be >= 0"),
+    ('N = {distribution = "power", exponent = -1, min = 100, max = 1600}', "", "",
+     "population.N.exponent must be >= 0"),
     ('N = {distribution = "power", exponent = 2, min = 1, max = 1600}', "", "", "population.N.min must be at least 2"),
     ("N = [1, 40]", "", "", "population.N must be at least 2"),
-    ('N = {distribution = "power", exponent = 2, min = 10.5, max = 1600}', "", "", "population.N.min must be an integer"),
+    ('N = {distribution = "power", exponent = 2, min = 10.5, max = 1600}', "", "",
+     "population.N.min must be an integer"),
     ('b = {distribution = "normal", min = 20, max = 50}', "", "", "population.b.distribution must be one of"),
     ('b = {min = 20, max = 50}', "", "", "population.b.distribution must be one of"),
     ('b = {distribution = "uniform", min = 20}', "", "", "population.b.max is missing"),
@@ -170,7 +172,8 @@ def test_the_stored_config_reads_back_as_itself():
 def _events(task, t, mu, n_chain=40):
     n = len(t)
     epi = (np.arange(n) * 7) % n_chain
-    return {"task": np.full(n, task, dtype=np.int64), "t": np.asarray(t, dtype=float), "epicenter": epi.astype(np.int64),
+    return {"task": np.full(n, task, dtype=np.int64), "t": np.asarray(t, dtype=float),
+            "epicenter": epi.astype(np.int64),
             "mu": np.full(n, mu), "slip": np.full(n, 10.0 ** mu), "first": epi.astype(np.int64),
             "last": epi.astype(np.int64), "n_slipped": np.ones(n, dtype=np.int64), "boundary": np.zeros(n, bool),
             "duration": np.full(n, 0.5), "kind": np.zeros(n, np.int8), "ending": np.zeros(n, np.int8)}

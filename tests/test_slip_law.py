@@ -15,7 +15,8 @@ import pytest
 from ensemble.config import Model, Integrator
 from ensemble.integrators import kernel_params
 from ensemble.model.chain import simulate
-from ensemble.model.workspace import D_DURATION, D_ENDING, D_KIND, D_SLIP, KIND_CREEP, KIND_EVENT, NDIAG, OK, UNLIMITED, Workspace
+from ensemble.model.workspace import (D_DURATION, D_ENDING, D_KIND, D_SLIP, KIND_CREEP, KIND_EVENT, NDIAG, OK,
+                                      UNLIMITED, Workspace)
 
 from .creep_reference import inertial_events, single_block_cycles, slip_law_chain
 

@@ -171,7 +171,8 @@ class Layout:
         """Zeroed tables of one task: {table: (blocks, width)} (histograms int64, columns float64; a sample:
         a list per stretch of the arrays fed to it)."""
         return Tables(self, {name: [[] for _ in range(blocks)] if t.sample else
-                             np.zeros((blocks, self.width(name, edges)), np.int64 if t.bins and not t.weights else np.float64)
+                             np.zeros((blocks, self.width(name, edges)),
+                                      np.int64 if t.bins and not t.weights else np.float64)
                              for name, t in self.tables.items()})
 
 

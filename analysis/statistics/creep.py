@@ -31,11 +31,13 @@ def estimate(u, opt):
 
 STATISTIC = Statistic(
     "creep", 40,
-    tables=(Table("creep_mu", "count", "creep episodes per mu bin, per task and stretch (of the inertial events before them)",
+    tables=(Table("creep_mu", "count",
+                  "creep episodes per mu bin, per task and stretch (of the inertial events before them)",
                   bins="creep_mu"),
             Table("creep_duration", "count", "creep episodes per log10(duration nu) bin, per task and stretch",
                   bins="creep_duration"),
-            Table("creep", "count or sum", "counts and sums of the slow side (sum_slip_events: the inertial events' slip)",
+            Table("creep", "count or sum",
+                  "counts and sums of the slow side (sum_slip_events: the inertial events' slip)",
                   columns=("n_creep", "n_creep_taken_over", "sum_slip_creep", "sum_slip_events"))),
     numbers=(Number("n_creep", "count", "creep episodes (/events/kind 1, below the block stiffness 1 + 2 l^2)"),
              Number("creep_share", "1", "share of the rows that are creep episodes: n_creep / (n_creep + n_events)"),

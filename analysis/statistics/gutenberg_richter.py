@@ -17,7 +17,8 @@ def feed(acc, rows):
 def estimate(u, opt):
     n, s1, s2 = (u.column("numbers", c) for c in ("n_gr", "sum_mu_gr", "sum_mu2_gr"))
     b = stats.gr_b(n, s1, opt.b_cut)
-    return [b, stats.gr_b_standard_error(n, s1, s2, opt.b_cut), stats.gr_ks_distance(u["mu"], opt.mu_edges, opt.b_cut, b)]
+    return [b, stats.gr_b_standard_error(n, s1, s2, opt.b_cut),
+            stats.gr_ks_distance(u["mu"], opt.mu_edges, opt.b_cut, b)]
 
 
 STATISTIC = Statistic(
@@ -25,6 +26,7 @@ STATISTIC = Statistic(
     tables=(Table("numbers", "count or sum", "counts and sums of the magnitudes above b_cut",
                   columns=("n_gr", "sum_mu_gr", "sum_mu2_gr")),),
     numbers=(Number("gr_b", "1", "Aki's maximum-likelihood Gutenberg-Richter b (not the model's b) above mu = b_cut"),
-             Number("gr_b_se", "1", "Shi & Bolt standard error of gr_b (assumes independent events; trust the interval)"),
+             Number("gr_b_se", "1",
+                    "Shi & Bolt standard error of gr_b (assumes independent events; trust the interval)"),
              Number("ks_gr", "1", "Kolmogorov-Smirnov distance of the binned mu >= b_cut from the fitted GR law")),
     feed=feed, estimate=estimate)

@@ -42,7 +42,8 @@ def estimate(u, opt):
 STATISTIC = Statistic(
     "intervals", 25, needs=("recurrences",),
     tables=(Table("intervals", "sum or count", "sums of the recurrence times' squares and of the whole chain's "
-                                               "inter-event times", columns=("sum_tnu2", "n_gaps", "sum_gap", "sum_gap2")),),
+                                               "inter-event times",
+                  columns=("sum_tnu2", "n_gaps", "sum_gap", "sum_gap2")),),
     numbers=(Number("cv_tnu", "1", "coefficient of variation of the local recurrence times T nu "
                                    "(< 1 quasi-periodic, 1 Poisson, > 1 clustered)", "CV of T*nu"),
              Number("mean_gap", "model length", "mean inter-event time of the whole chain, times nu "

@@ -22,8 +22,10 @@ def estimate(u, opt):
 STATISTIC = Statistic(
     "magnitude", 10,
     tables=(Table("mu", "count", "events per magnitude bin, per task and stretch", bins="mu"),
-            Table("numbers", "count or sum", "counts and sums of the inertial events", columns=("n_events", "n_large"))),
-    numbers=(Number("n_events", "count", "inertial events (/events/kind 0: creep episodes are in none of these numbers)"),
+            Table("numbers", "count or sum", "counts and sums of the inertial events",
+                  columns=("n_events", "n_large"))),
+    numbers=(Number("n_events", "count",
+                    "inertial events (/events/kind 0: creep episodes are in none of these numbers)"),
              Number("n_large", "count", "large events (mu >= mu_c)"),
              Number("fraction_large", "1", "fraction of the events with mu >= mu_c")),
     curves=(Curve("mu", "mu", ("numbers", "n_events"), "mu", "all events", "1/mu"),),

@@ -75,8 +75,9 @@ def prepare(ctx):
             raise ConfigError(f"{partial}: no failed task to rerun (a changed [integrator] applies to "
                               f"failed tasks only)")
         _fits(partial, lambda: space.reserve_file(partial))
-        kept = (f"resuming {partial}: keeps {int(tasks['events_written'].sum())} of {len(tasks['point']) * cfg.run.events} "
-                f"events recorded, {int(np.sum(tasks['status'] == FINISHED))} of {len(tasks['point'])} tasks finished"
+        kept = (f"resuming {partial}: keeps {int(tasks['events_written'].sum())} of "
+                f"{len(tasks['point']) * cfg.run.events} events recorded, "
+                f"{int(np.sum(tasks['status'] == FINISHED))} of {len(tasks['point'])} tasks finished"
                 + (f", {int(np.sum(tasks['status'] == FAILED))} failed" if np.any(tasks["status"] == FAILED) else ""))
         return "resume", kept, spins_needed(cfg, task_list(cfg), tasks, rerun)
     if os.path.exists(final) and not ctx.force:

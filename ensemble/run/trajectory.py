@@ -99,7 +99,8 @@ def parse_integrator(text, where):
     try:
         section = parse_section("integrator", tomllib.loads(text))
         if section.method not in INTEGRATORS:
-            raise ConfigError(f"integrator.method must be one of {', '.join(sorted(INTEGRATORS))}, got {section.method!r}")
+            raise ConfigError(f"integrator.method must be one of {', '.join(sorted(INTEGRATORS))}, "
+                              f"got {section.method!r}")
         return section
     except (tomllib.TOMLDecodeError, ConfigError) as err:
         raise CatalogError(f"{where}: stored integrator cannot be read ({err})") from None

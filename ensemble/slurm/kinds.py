@@ -50,7 +50,8 @@ def _array_configs(cfg, directory):
         catalog = points_dir / f"point-{i:04d}.h5"
         path = points_dir / f"point-{i:04d}.toml"
         values = ", ".join(f"{key}={getattr(sub.model, key)!r}" if not key.startswith("population.") else
-                           f"{key}={dict(sub.population.draws)[key.partition('.')[2]].to_toml()}" for key, _ in cfg.sweep)
+                           f"{key}={dict(sub.population.draws)[key.partition('.')[2]].to_toml()}"
+                           for key, _ in cfg.sweep)
         path.write_text(f"# array element {i}: point {i} of the sweep ({values or 'no sweep'}); "
                         f"run.seed from SeedSequence({cfg.run.seed}, spawn_key=({i},))\n"
                         + replace(sub, "output", path=str(catalog)).to_toml())

@@ -113,9 +113,11 @@ DATASETS = {
                                 "recorded events per second of kernel time (NaN until finished)"),
     "tasks/seed_entropy": ("1", _TASK_ROWS, "run.seed: the task drew from SeedSequence(seed_entropy, "
                                             "spawn_key=(spawn_key,)) (-1 until finished)"),
-    "tasks/spawn_key": ("index", _TASK_ROWS, "spawn key of the task's SeedSequence, its task index (-1 until finished)"),
+    "tasks/spawn_key": ("index", _TASK_ROWS,
+                        "spawn key of the task's SeedSequence, its task index (-1 until finished)"),
     "tasks/status": ("code", _TASK_ROWS, "0 open (not started, running or interrupted), 1 finished, 2 failed"),
-    "tasks/error": ("text", _TASK_ROWS, f"why a failed task failed, empty otherwise (UTF-8, {TEXT_BYTES} bytes at most)"),
+    "tasks/error": ("text", _TASK_ROWS,
+                    f"why a failed task failed, empty otherwise (UTF-8, {TEXT_BYTES} bytes at most)"),
     "tasks/integrator": ("text", _TASK_ROWS, "the task's [integrator] as TOML (a failed task may be rerun "
                                              f"with another; UTF-8, {TEXT_BYTES} bytes at most)"),
     "tasks/record_crc": ("CRC-32", _TASK_ROWS, "CRC of the task's record (status, error, integrator, provenance; "

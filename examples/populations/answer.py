@@ -9,8 +9,8 @@ catalog (each fault a point of its own). For each region it gives, with 95% inte
   (the summary's numbers);
 - the best two decades: for every stretch [lo, lo + 2) of mu (lo on the bins' edges, at least MIN_EVENTS events
   in it), the KS distance of the binned magnitudes from a Gutenberg-Richter law truncated to the stretch (b by
-  maximum likelihood on the bins, within B_RANGE: a law that falls); the smallest of them and its lo, and its b. A region "looks critical" where
-  that KS is below 0.05 (the working definition of the issue);
+  maximum likelihood on the bins, within B_RANGE: a law that falls); the smallest of them and its lo, and its b.
+  A region "looks critical" where that KS is below 0.05 (the working definition of the issue);
 - the fraction of large events (mu >= mu_c) and the hump: R at the large-magnitude peak over R at the dip below
   it (analysis/paper.py's shape statistics, in bins of 0.1);
 - the CV of the local recurrence times;
@@ -165,7 +165,8 @@ def table(rows):
         single = " / ".join(spread(r[f"single_faults_{n}"]) for n in ("ks_gr", "best_two_decades", "top_two_decades")
                             if f"single_faults_{n}" in r) or "-"
         lines.append(f"| {r['region']} | {r['faults']} | {r['n_events'][0]:.0f} | {iv(r['gr_b'])} | {iv(r['ks_gr'])} | "
-                     f"{decades(r['best_two_decades'])} | {decades(r['top_two_decades'])} | {iv(r['fraction_large'])} | "
+                     f"{decades(r['best_two_decades'])} | {decades(r['top_two_decades'])} | "
+                     f"{iv(r['fraction_large'])} | "
                      f"{iv(r['hump'])} | {iv(r['cv_tnu']) if 'cv_tnu' in r else '-'} | {single} |")
     return "\n".join(lines)
 

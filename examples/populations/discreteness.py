@@ -5,9 +5,10 @@ length, from one summary per l:
 
 Each summary is `analysis reduce` of one catalog of examples/populations/discrete_l*.toml (N = 400 l / 3 blocks),
 reduced with the large-event threshold and the recurrence window scaled with the blocks per unit length
-(--mu-c 4 + log10(N / 400), --b-cut 3 + log10(N / 400), --window 10 N / 400), so that both mean the same physical size at every l. A block's
-slip is a physical length at every l (the units are those of one block's plate spring and friction, both
-proportional to its length), so mu' = mu - log10(N / 400) is the magnitude of the same physical moment; R(mu)'s
+(--mu-c 4 + log10(N / 400), --b-cut 3 + log10(N / 400), --window 10 N / 400), so that both mean the same physical
+size at every l. A block's slip is a physical length at every l (the units are those of one block's plate spring
+and friction, both proportional to its length), so mu' = mu - log10(N / 400) is the magnitude of the same physical
+moment; R(mu)'s
 shape (its peak over the dip below it) is read on mu'. Each number with its 95% interval (over the summary's
 units: seeds, or stretches of every trajectory with fewer than 10).
 """
@@ -42,7 +43,8 @@ def row(path):
     def num(name):
         return with_interval(s[f"points/numbers/{name}"][0]) if f"points/numbers/{name}" in s else "-"
     return (f"| {l:g} | {n:.0f} | {float(s['attrs']['mu_c']):.2f} | {num('n_events')} | {num('creep_share')} | "
-            f"{num('fraction_large')} | {with_interval(shape['peak_mu'][:3])} | {dip(shape['peak_over_dip'], s['bins/mu'])} | "
+            f"{num('fraction_large')} | {with_interval(shape['peak_mu'][:3])} | "
+            f"{dip(shape['peak_over_dip'], s['bins/mu'])} | "
             f"{num('cv_tnu')} | {num('ks_gr')} |")
 
 

@@ -4,9 +4,10 @@
         [--columns 3] -o docs/populations/regions.png
 
 REGIONS: `analysis reduce CATALOG --region --mu-bins 0:7:700`; ANSWER.json: what examples/populations/answer.py
-wrote from it. One panel per region: its R(mu) in bins of 0.1 with its 95% band (a bootstrap over its faults), the 5-95% range of its single faults' own R(mu) (each in its window) in grey, the
-Gutenberg-Richter law fitted to its best two decades (answer.py) over them, and a law of slope b = 2/3 (a real
-catalog's, in mu = log10 of the slip) through the same point. A last panel: the KS distance of the best and of
+wrote from it. One panel per region: its R(mu) in bins of 0.1 with its 95% band (a bootstrap over its faults), the
+5-95% range of its single faults' own R(mu) (each in its window) in grey, the Gutenberg-Richter law fitted to its
+best two decades (answer.py) over them, and a law of slope b = 2/3 (a real catalog's, in mu = log10 of the slip)
+through the same point. A last panel: the KS distance of the best and of
 the top two decades, each region's with its interval over faults beside its single faults' 5-95% range, and the
 working definition of critical, KS < 0.05.
 """

@@ -51,7 +51,8 @@ def main(argv=None):
         for b in np.unique(table[whole, 1]):
             sel = whole & (table[:, 1] == b)
             slope, intercept = np.polyfit(np.log10(table[sel, 0]), table[sel, 3], 1)
-            print(f"b = {b:g}: faults ruptured whole in every event: N = {', '.join(f'{n:.0f}' for n in table[sel, 0])}; "
+            print(f"b = {b:g}: faults ruptured whole in every event: "
+                  f"N = {', '.join(f'{n:.0f}' for n in table[sel, 0])}; "
                   f"median mu = {slope:.3f} log10 N + {intercept:.3f}")
     long = (table[:, 0] >= 100) & np.isfinite(table[:, 7])
     if long.sum() >= 3:
