@@ -239,14 +239,16 @@ def check_summary_output(out, catalogs, force):
 
 def _memory(opt, n_tasks):
     """Refuse options whose arrays this machine cannot hold: rank 0 gathers every task's
-    (stretches, bins) counts and stacks them for the summary; a point's bootstrap keeps every
-    resample's curves and T nu counts."""
+    (stretches, bins) counts and stacks them for the summary; a point's bootstrap keeps, per resample, its picks
+    of units (at most tasks x blocks), its numbers and its curves: R(mu) (n_mu bins), three arrays on the T nu bins
+    (the curves of all recurrences and of the interior ones, and the recurrence peaks' resampled counts: 3 x n_tnu)
+    and the two creep curves (n_creep bins)."""
     n_mu, n_tnu = len(opt.mu_edges) - 1, len(opt.tnu_edges) - 1
     n_creep = len(opt.creep_mu_edges) + len(opt.creep_duration_edges) - 2
     edges = bin_edges(opt)
     per_task = opt.blocks * sum(LAYOUT.width(name, edges) for name in LAYOUT.tables)
     resamples = opt.bootstrap * (n_mu + 3 * n_tnu + n_creep + len(NUMBERS) + n_tasks * opt.blocks)
-    checks.memory(f"--blocks {opt.blocks}, --bootstrap {opt.bootstrap} and {n_mu} + 2 x {n_tnu} + {n_creep} bins "
+    checks.memory(f"--blocks {opt.blocks}, --bootstrap {opt.bootstrap} and {n_mu} + 3 x {n_tnu} + {n_creep} bins "
                   f"over {n_tasks} tasks", 8 * (2 * n_tasks * per_task + resamples))
 
 

@@ -35,6 +35,17 @@ A statistic (a module of this package that defines STATISTIC) declares
 The engine (analysis/reduce.py) streams each task once, hands every statistic the same rows, stacks the
 tables of a point's units, bootstraps them all alike, and the summary stores and describes what the
 statistics declare. Adding a statistic is one module here and its test.
+
+The statistics today (the registry finds a module by its STATISTIC; this list is for the reader):
+
+    magnitude.py          R(mu) of the inertial events, and the share of large ones
+    recurrence.py         local recurrence times T nu of large events: their distribution, its peaks
+    intervals.py          how regular the events come: the coefficient of variation of the recurrence times
+    gutenberg_richter.py  the Gutenberg-Richter exponent above mu = b_cut, its standard error and KS distance
+    creep.py              the slow side: the creep episodes' size and duration, the aseismic slip fraction
+    seismicity.py         seismicity around large events: foreshocks, aftershocks, quiescence, the rate map
+    rupture.py            rupture lengths n (the comparison's size axis): R(log10 n), the dip, the power law
+    regularity.py         how periodic the large events by rupture length recur (the comparison's)
 """
 import importlib
 import pkgutil

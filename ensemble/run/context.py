@@ -21,7 +21,7 @@ class RunContext:
     cfg: Any                        # the resolved config (config.Config)
     path: str                       # the finished catalog's path; the run writes `partial` until the end
     comm: Any                       # the MPI communicator of the run's ranks
-    log: Callable = print           # the run's log, a print (every rank's own log is `say`)
+    log: Callable = print           # the run's log, a print, on every rank (`say`: rank 0's log, silence elsewhere)
     resume: bool = False            # continue an interrupted run from its checkpoints (--resume, resume)
     force: bool = False             # overwrite an existing catalog (--force)
     rerun: Any = None               # an [integrator] (config.Integrator) to rerun the failed tasks with, or None
