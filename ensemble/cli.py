@@ -1,4 +1,4 @@
-"""Command line: python -m ensemble run|resume|validate|status|slurm ...
+"""Command line: python -m ensemble run|resume|validate|status|compile|slurm ...
 
 Under mpirun every rank runs the same command. An exception on any rank is
 printed with the rank (and the task, where there is one) and aborts all ranks
@@ -41,6 +41,10 @@ def _parser():
                           "goes on (repeatable)")
     st = sub.add_parser("status", help="summarise a catalog (finished, or being written)")
     st.add_argument("catalog", help="catalog path (PATH.partial is found automatically)")
+    comp = sub.add_parser("compile", help="compile the kernels of every friction law (or those named) into the "
+                                          "numba cache ahead of the first run (make setup does)")
+    comp.add_argument("--law", action="append", default=[], help="only this model.law (repeatable)")
+    comp.add_argument("--jobs", type=int, default=None, help="laws compiled at once (default: the cores)")
     from .slurm.command import add_arguments
     add_arguments(sub.add_parser("slurm", help="write (and submit) Slurm job scripts for a config"))
     return p
@@ -166,6 +170,21 @@ def _run(args):
         return 1
 
 
+def _compile(args):
+    from . import compiled
+    from .model import laws
+    unknown = [name for name in args.law if name not in laws.LAWS]
+    if unknown:
+        raise ConfigError(f"--law {unknown[0]!r}: not a friction law (one of {', '.join(sorted(laws.LAWS))})")
+    if args.jobs is not None and args.jobs < 1:
+        raise ConfigError(f"--jobs {args.jobs}: must be at least 1")
+    names = args.law or sorted(laws.LAWS)
+    jobs = args.jobs or compiled.default_jobs()
+    print(f"compiling the kernels of {', '.join(names)} ({len(names)} law(s), {jobs} at once; about "
+          f"{compiled.SECONDS_PER_LAW} s a law where not yet compiled) into {compiled.cache_directory()}", flush=True)
+    return compiled.compile_laws(names, jobs, say=lambda line: print(line, flush=True))
+
+
 def _slurm(args):
     from .slurm.command import command
     return command(args)
@@ -175,7 +194,7 @@ def main(argv=None):
     args = _parser().parse_args(argv)
     try:
         return {"run": _run, "resume": _run, "validate": _validate, "status": _status,
-                "slurm": _slurm}[args.command](args)
+                "compile": _compile, "slurm": _slurm}[args.command](args)
     except (ConfigError, CatalogError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2 if isinstance(err, ConfigError) else 1

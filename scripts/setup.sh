@@ -16,7 +16,9 @@
 # root when none is found; STACK=wheels does not look. PYTHON picks the interpreter (default
 # python3, >= 3.11). .venv/ensemble-stack names the stack once it is complete and checked; until
 # then a rerun starts over, so an interrupted or failed setup leaves nothing that a run would use.
-# A second run only checks (about a second). Every stage prints a line with the time since setup
+# Last, every friction law's kernels are compiled into the package's numba cache (`python -m ensemble
+# compile`: about a minute a law, as many at once as there are cores), so that no first run compiles.
+# A second run only checks (a few seconds). Every stage prints a line with the time since setup
 # started, and long steps a "still ..." line every SETUP_HEARTBEAT seconds (default 30).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -91,6 +93,16 @@ install_project() {
   fi
 }
 
+compile_kernels() {   # every friction law's kernels into the package's numba cache (ensemble/compiled.py)
+  local out rc=0
+  stage "compiling the kernels of every friction law (about a minute a law where not yet compiled, as many at once as there are cores; seconds when cached)"
+  out=$(mktemp)
+  STEP_LOG=$out step "compiling the kernels" $VPY -m ensemble compile || rc=$?
+  grep '^model.law' "$out" | sed 's/^/  /' || true
+  rm -f "$out"
+  [ "$rc" = 0 ] || die "compiling the kernels failed (above); runs would compile them themselves"
+}
+
 report() {   # in validate's words (ensemble/environment.py): the MPI, the HDF5, the writer runs take
   echo "setup: ok: stack $1 ($(elapsed))"
   $VPY -c "from ensemble import environment; print('\n'.join('  ' + line for line in environment.describe('auto')))"
@@ -100,6 +112,7 @@ report() {   # in validate's words (ensemble/environment.py): the MPI, the HDF5,
 current=$(cat "$STATE" 2>/dev/null || true)
 if [ -n "$current" ] && { [ "$STACK" = auto ] || [ "$STACK" = "$current" ]; } && stack_works "$current"; then
   install_project
+  compile_kernels
   report "$current"
   exit 0
 fi
@@ -153,9 +166,9 @@ if [ "$STACK" != wheels ]; then
   apt=0
   [ "$STACK_FOUND" = 0 ] && [ "$STACK" = parallel ] && debian_root && apt=1
   if [ "$want" = parallel ]; then   # venv and pip, [Debian], mpi4py, h5py, the MPI-IO check, the project
-    STAGES=$((5 + apt))
+    STAGES=$((6 + apt))
   else
-    STAGES=3                        # venv and pip, the wheels, the project
+    STAGES=4                        # venv and pip, the wheels, the project, the kernels
   fi
   if [ "$apt" = 1 ]; then
     say "no parallel HDF5 stack found (missing $STACK_MISSING); as root on Debian: installing MPICH and parallel HDF5"
@@ -177,7 +190,7 @@ if [ "$STACK" != wheels ]; then
   elif [ "$want" = parallel ]; then
     say "$why"
     say "falling back to the wheel stack: runs work on any number of ranks, rank 0 writing the catalog"
-    STAGES=3
+    STAGES=4
   elif [ "$STACK_FOUND" = 1 ]; then
     say "the wheel stack (about a minute): runs work on any number of ranks, rank 0 writing the catalog"
     say "a parallel HDF5 stack is on this machine ($STACK_MPICC, $STACK_HDF5): for the MPI-IO writer"
@@ -187,7 +200,7 @@ if [ "$STACK" != wheels ]; then
     say "falling back to the wheel stack: runs work on any number of ranks, rank 0 writing the catalog"
   fi
 else
-  STAGES=3
+  STAGES=4
 fi
 
 stage "creating .venv and updating pip"
@@ -204,10 +217,11 @@ if [ "$kind" = parallel ] && ! build_parallel; then
   say "falling back to the wheel stack"
   kind=wheels
   STAGE=1
-  STAGES=3
+  STAGES=4
 fi
 [ "$kind" = wheels ] && install_wheels
 install_project
 stack_works "$kind" || die "the $kind stack does not import (.venv is left incomplete; rerun setup)"
 echo "$kind" >"$STATE"
+compile_kernels
 report "$kind"

@@ -106,6 +106,8 @@ QUICK = {
     "test_layers.py": ["test_the_kernels_import_only_each_other_numpy_numba_and_the_standard_library",
                        "test_the_store_does_not_import_the_run",
                        "test_analysis_imports_of_the_run_only_the_abort_guard", "test_every_rule_fails_when_broken"],
+    "test_compiled.py": ["test_a_compilation_is_said_in_one_line_with_its_time_and_its_end",
+                         "test_compile_refuses_a_bad_argument_in_one_line"],
     "test_mutation_targets.py": ["test_every_mutant_applies_once_and_names_existing_tests"],
     "test_quick_tier.py": ["test_every_test_named_in_the_quick_tier_exists",
                            "test_every_test_file_is_in_the_quick_tier_or_says_why_not"],

@@ -4,11 +4,11 @@ The same code runs serially (one rank, no mpirun) and under MPI. Each task is on
 rank (worker.py); its seed comes from its index, so results do not depend on the number of ranks or
 on which rank ran a task. Every step takes the run's context (context.py).
 """
-import glob
 import os
 import time
 
 from .. import environment
+from ..compiled import announced
 from ..store import writers
 from ..sweep import task_list
 from .decision import check_output, prepare
@@ -132,23 +132,11 @@ def _serve(ctx, tasks, spins, t_start):
     return EXIT_INTERRUPTED if stopped else (EXIT_FAILED if failed else 0)
 
 
-def _kernels_cached():
-    """True if the event kernels' compiled code is in numba's cache (see ensemble.model)."""
-    import numba
-    return bool(glob.glob(os.path.join(numba.config.CACHE_DIR, "**", "chain.simulate-*.nbi"), recursive=True))
-
-
 def _compile_kernels(ctx, task):
-    """Compile (or load from the cache) the kernels before any timing starts.
+    """Compile (or load from the cache) the kernels before any timing starts, saying so if they compile.
 
     A signal in the meantime is acknowledged at once (Coordinator) and served when this returns.
     """
-    cached = _kernels_cached()
-    start = time.perf_counter()
     tiny = type(task)(task.index, task.point, task.seed_index, type(task.model)(**{**vars(task.model), "N": 2}))
-    with ctx.coord.acknowledging("compiling kernels"):
-        if not cached:
-            ctx.say("compiling kernels (first run only, about a minute; cached for the next runs)")
+    with ctx.coord.acknowledging("compiling kernels"), announced(ctx.say, task.model.law):
         Trajectory(ctx.cfg, tiny).advance(0)
-    if not cached:
-        ctx.say(f"kernels ready in {time.perf_counter() - start:.0f} s")

@@ -57,7 +57,7 @@ def onset_delay(law, force, psi, nu):
     return gap / nu
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)     # not inlined: inlined twice (here and by the law's call) it made numba warn
 def creep_weakening(law, v, psi):
     """-b d(psi')/dv = b (psi + ln v + 1): strengthening (negative) while v theta < 1/e, -inf from rest,
     so every block starts by creeping; it has no bound, so no stiffness keeps a loaded cluster

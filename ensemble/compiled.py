@@ -1,0 +1,134 @@
+"""The compiled kernels: compiling them ahead for every friction law, and saying so when a run must compile.
+
+The kernels are compiled once per friction law (the integration method is chosen inside them at run time,
+model/methods.py) into the package's numba cache (kernel_cache.py), in about a minute per law. `make setup`
+runs `python -m ensemble compile`, which compiles every law of the registry, each in a process of its own
+(as many at once as there are cores), so that the first run of any law, method and regime loads them
+instead; a law already in the cache takes about a second to check.
+
+`warm(law)` calls every kernel entry point that a run, a checkpoint and the single-event API
+(ensemble.events) reach from Python, on a chain of a few blocks, with the types a run gives them.
+`announced(say, law)` is the run's guard: if numba starts compiling inside it, `say` gets one line saying
+so and how long it takes, and another when the kernels are ready.
+"""
+import contextlib
+import os
+import subprocess
+import sys
+import time
+
+from numba.core import event as numba_event
+
+
+# what a law's kernels take to compile on one core of the machine this project is developed on
+# (python -m ensemble compile, docs/tests.md); said to a user who has to wait for it
+SECONDS_PER_LAW = 60
+
+
+def warm(law):
+    """Compile (or load from the cache) every kernel entry point for the friction law `law` (its name)."""
+    import numpy as np
+
+    from . import events
+    from .config import from_dict
+    from .run.trajectory import Trajectory
+    from .sweep import task_list
+
+    # the law's own method; one compilation serves every method (model/methods.py)
+    cfg = from_dict({"model": {"N": 4, "law": law}, "run": {"events": 2, "transient": 0, "seeds": 1}})
+    task = task_list(cfg)[0]
+    trajectory = Trajectory(cfg, task)
+    trajectory.advance(2)
+    trajectory.checkpoint()
+    force, psi = trajectory.state()
+    epicenter, _, force, psi = events.advance_to_onset(force, psi, task.model)
+    events.run_event(force, psi, epicenter, task.model, cfg.integrator, trace=np.zeros((4, events.NTRACE)))
+
+
+class _Compiles(numba_event.Listener):
+    """Listens to numba's compilations: `start`, the time the first began (None: none has), and
+    `first()` called then."""
+
+    def __init__(self, first=lambda: None):
+        self.start = None
+        self.first = first
+
+    def on_start(self, event):
+        if self.start is None:
+            self.start = time.perf_counter()
+            self.first()
+
+    def on_end(self, event):
+        pass
+
+
+@contextlib.contextmanager
+def announced(say, law):
+    """Within: the first compilation numba starts is said in one line (with its expected time), and its end."""
+    listener = _Compiles(lambda: say(f"compiling kernels for model.law = {law!r} (about {SECONDS_PER_LAW} s, "
+                                     f"once per checkout; `python -m ensemble compile` compiles every law "
+                                     f"ahead, and `make setup` runs it)"))
+    numba_event.register("numba:compile", listener)
+    try:
+        yield
+    finally:
+        numba_event.unregister("numba:compile", listener)
+    if listener.start is not None:
+        say(f"kernels ready in {time.perf_counter() - listener.start:.0f} s")
+
+
+def compile_laws(names, jobs, say=print):
+    """Compile the kernels of the laws `names`, each in a process of its own, `jobs` at once; returns 0, or
+    1 if any failed (its output said)."""
+    pending = list(names)
+    running = {}
+    failed = []
+    while pending or running:
+        while pending and len(running) < jobs:
+            name = pending.pop(0)
+            proc = subprocess.Popen([sys.executable, "-m", "ensemble.compiled", name], stdout=subprocess.PIPE,
+                                    stderr=subprocess.STDOUT, text=True)
+            running[proc] = (name, time.perf_counter())
+        proc = _wait_any(running)
+        name, start = running.pop(proc)
+        out = proc.stdout.read()
+        proc.stdout.close()
+        seconds = time.perf_counter() - start
+        if proc.returncode:
+            failed.append(name)
+            say(f"model.law = {name!r}: compiling failed (exit {proc.returncode}):\n{out.rstrip()}")
+        else:
+            say(f"model.law = {name!r}: {out.strip() or 'kernels compiled'} ({seconds:.0f} s)")
+    return 1 if failed else 0
+
+
+def _wait_any(running):
+    """The first of the running processes to end (polled: a few of them, for a minute each)."""
+    while True:
+        for proc in running:
+            if proc.poll() is not None:
+                return proc
+        time.sleep(0.2)
+
+
+def cache_directory():
+    """Where the kernels are cached (kernel_cache.directory of ensemble/model/)."""
+    import numba
+    return numba.config.CACHE_DIR
+
+
+def default_jobs():
+    """Processes at once: the cores this process may use."""
+    return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1))
+
+
+def _one(law):
+    """A child of compile_laws: compile one law, print what happened (compiled, or already in the cache)."""
+    listener = _Compiles()
+    numba_event.register("numba:compile", listener)
+    warm(law)
+    print("kernels compiled" if listener.start is not None else "kernels already compiled (loaded from the cache)")
+
+
+if __name__ == "__main__":
+    _one(sys.argv[1])
