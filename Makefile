@@ -18,7 +18,7 @@ export OMP_NUM_THREADS := 1
 export NUMBA_NUM_THREADS := 1
 export OPENBLAS_NUM_THREADS := 1
 
-.PHONY: setup run test quick test-all mutations loaded lint
+.PHONY: setup run test quick slow test-all lint mutations loaded
 
 setup:
 	STACK=$(STACK) bash scripts/setup.sh
@@ -33,6 +33,12 @@ test:
 # a tier of about two minutes that touches every module (the `quick` marker: tests/conftest.py)
 quick: setup
 	$(PY) -m pytest -q -m "quick and not slow"
+
+# the slower tier: the tests marked slow (the Slurm cluster, the longest runs, compiling into empty caches),
+# which CI runs after `make test` (docs/tests.md)
+slow:
+	STACK=$(TEST_STACK) bash scripts/setup.sh
+	ENSEMBLE_TEST_STACK=$(TEST_STACK) $(PY) -m pytest -q -m slow $(XDIST) -rs --durations=20
 
 test-all:
 	STACK=$(TEST_STACK) bash scripts/setup.sh

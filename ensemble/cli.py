@@ -179,7 +179,7 @@ def _compile(args):
     if args.jobs is not None and args.jobs < 1:
         raise ConfigError(f"--jobs {args.jobs}: must be at least 1")
     names = args.law or sorted(laws.LAWS)
-    jobs = args.jobs or compiled.default_jobs()
+    jobs = min(args.jobs or compiled.default_jobs(), len(names))
     print(f"compiling the kernels of {', '.join(names)} ({len(names)} law(s), {jobs} at once; about "
           f"{compiled.SECONDS_PER_LAW} s a law where not yet compiled) into {compiled.cache_directory()}", flush=True)
     return compiled.compile_laws(names, jobs, say=lambda line: print(line, flush=True))

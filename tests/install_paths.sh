@@ -7,7 +7,9 @@
 #                                         # `make setup` still takes the wheels, naming the stack found
 #   bash tests/install_paths.sh modules   # the same machine, STACK=parallel: built against them
 #
-# Run as root (it creates the user ensemble-user); CI runs both (.ci/run). Each case sets up
+# Run as root (it creates the user ensemble-user); CI runs both (.ci/run). SHARED_NUMBA_CACHE=DIR (CI sets
+# it) gives every case the one kernel cache DIR (made writable for the user): the clones are of one commit,
+# so the first case's `make setup` compiles the kernels and the others' load them. Each case sets up
 # (`wheels`: `make setup`, the default a new .venv gets; `modules`: `make setup STACK=parallel`),
 # runs the README's run command (`make run`), the Quick start's first run (which must compile
 # nothing: one numba cache), then the same config on 2 ranks with the environment activated
@@ -77,6 +79,10 @@ case $CASE in
 esac
 git clone -q "$ROOT" "$work/repo"
 chown -R "$USER_NAME": "$work"
+if [ -n "${SHARED_NUMBA_CACHE:-}" ]; then
+  mkdir -p "$SHARED_NUMBA_CACHE" && chmod 1777 "$SHARED_NUMBA_CACHE"
+  extra+=(NUMBA_CACHE_DIR="$SHARED_NUMBA_CACHE")
+fi
 
 # a pip cache of its own: every run downloads (and builds) as on a new account, so the times it prints
 # are those of a fresh machine however often it runs here

@@ -187,8 +187,8 @@ def fake_setup(tmp_path, *path, timeout=120, **variables):
 def test_setup_numbers_its_stages_with_the_time_and_beats_during_a_long_step(tmp_path):
     _, lines = fake_setup(tmp_path, STACK="wheels", SETUP_HEARTBEAT="1", FAKE_PIP_SECONDS="4")
     stages = [line for line in lines if re.fullmatch(r"setup: \[\d/\d\] .* \(elapsed \d+:\d\d\)", line)]
-    assert [line[:12] for line in stages] == ["setup: [1/3]", "setup: [2/3]", "setup: [3/3]"], lines
-    assert "installing the project" in stages[2]
+    assert [line[:12] for line in stages] == ["setup: [1/4]", "setup: [2/4]", "setup: [3/4]", "setup: [4/4]"], lines
+    assert "installing the project" in stages[2] and "compiling the kernels of every friction law" in stages[3]
     # the 4 s step is not silent: a line every second, after its stage line
     beats = [i for i, line in enumerate(lines)
              if re.fullmatch(r"setup:   \.\.\. still installing the project, \d+:\d\d elapsed", line)]
@@ -217,7 +217,7 @@ def test_auto_gives_a_new_venv_the_wheels_and_names_the_parallel_stack_it_could_
     (repo / ".venv" / "ensemble-stack").write_text("parallel\n")
     _, lines = fake_setup(tmp_path, mpicc.parent, HDF5_DIR=prefix)
     text = "\n".join(lines)
-    assert re.search(r"setup: \[2/5\] building mpi4py against .*mpicc \(elapsed", text), text
+    assert re.search(r"setup: \[2/6\] building mpi4py against .*mpicc \(elapsed", text), text
     assert "h5py was built but has no MPI support" in text and lines[-1].startswith("setup: ok: stack wheels")
     # STACK=parallel builds it (make test)
     _, lines = fake_setup(tmp_path, mpicc.parent, HDF5_DIR=prefix, STACK="parallel", FAKE_MPI_H5PY="1")
@@ -265,9 +265,12 @@ def test_every_entry_point_takes_the_packages_kernel_cache(tmp_path, monkeypatch
         assert "export NUMBA_CACHE_DIR" not in script.read_text(), script
 
 
+@pytest.mark.slow
 def test_after_make_run_the_quick_start_run_compiles_nothing(tmp_path):
     """In a copy of the checkout with an empty cache: `make run` compiles the kernels; the Quick
-    start's `python -m ensemble run` after it must find them (one cache, not two)."""
+    start's `python -m ensemble run` after it must find them (one cache, not two). Slow (a minute of
+    compiling): `make test` checks that both take the same cache (above) and the install paths of CI run
+    the Quick start after `make run` on a fresh clone."""
     repo = tmp_path / "checkout"
     for name in ("ensemble", "analysis"):
         shutil.copytree(ROOT / name, repo / name, ignore=shutil.ignore_patterns("__pycache__"))

@@ -134,29 +134,23 @@ def _stepper(method):
     return _STEPPERS[type(method.tableau)][0](method.tableau)
 
 
-def _branch(steppers, k):
-    """A numba function (index, step's arguments) that calls steppers[index], for index >= k: one
-    comparison per method, once a step (not per block); the steppers themselves are not inlined."""
-    here = steppers[k]
-    if k == len(steppers) - 1:
-        @nb.njit
-        def last(index, W, act, na, n, tau, h, p, yrest, first, at_first):
-            return here(W, act, na, n, tau, h, p, yrest, first, at_first)
-        return last
-    rest = _branch(steppers, k + 1)
-
-    @nb.njit
-    def branch(index, W, act, na, n, tau, h, p, yrest, first, at_first):
-        if index == k:
-            return here(W, act, na, n, tau, h, p, yrest, first, at_first)
-        return rest(index, W, act, na, n, tau, h, p, yrest, first, at_first)
-    return branch
+_STEP_ARGS = "W, act, na, n, tau, h, p, yrest, first, at_first"
 
 
 @functools.cache
 def _dispatch():
-    """take_step's body: the stepper of the method whose index (MethodRecord.index) the kernel is given."""
-    return _branch([_stepper(m) for m in METHODS.values()], 0)
+    """take_step's body: `if p.method.index == k: return stepper_k(...)` for every method k of the
+    registry, in one function that numba inlines into the event loop, so that the step costs one
+    comparison per method (once a step, not per block) and a direct call of the method's own stepper,
+    as when the kernels were compiled once per method. Written out for the registry's methods."""
+    steppers = {f"step_{k}": _stepper(m) for k, m in enumerate(METHODS.values())}
+    lines = [f"def dispatch({_STEP_ARGS}):", "    index = p.method.index"]
+    for k in range(len(steppers) - 1):
+        lines += [f"    if index == {k}:", f"        return step_{k}({_STEP_ARGS})"]
+    lines.append(f"    return step_{len(steppers) - 1}({_STEP_ARGS})")
+    namespace = dict(steppers)
+    exec("\n".join(lines), namespace)      # our own text: one branch per entry of the registry
+    return namespace["dispatch"]
 
 
 def _error_weight_rows():
@@ -184,9 +178,7 @@ def take_step(W, act, na, n, tau, h, p, yrest, first, at_first):
 
 @overload(take_step, inline="always")
 def _take_step(W, act, na, n, tau, h, p, yrest, first, at_first):
-    dispatch = _dispatch()
-    return lambda W, act, na, n, tau, h, p, yrest, first, at_first: dispatch(p.method.index, W, act, na, n, tau,
-                                                                             h, p, yrest, first, at_first)
+    return _dispatch()
 
 
 @nb.njit(cache=True, inline="always")
