@@ -335,8 +335,10 @@ def test_a_full_disk_stops_the_run_with_one_line_and_nothing_lost(small, small_d
     assert res.returncode == 0, res.stderr
 
 
+@pytest.mark.slow
 def test_signal_during_kernel_compilation_is_acknowledged_at_once(small, tmp_path):
-    """An empty numba cache: rank 0 says it compiles; SIGINT is acknowledged within seconds, exit 75."""
+    """An empty numba cache: rank 0 says it compiles; SIGINT is acknowledged within seconds, exit 75.
+    Slow by nature (the slower tier, `make slow`): it needs a real compilation, about a minute and a half."""
     d, cfg = small
     with Started([sys.executable, "-m", "ensemble", "run", cfg, "-o", tmp_path / "c.h5"],
                  env=child_env(NUMBA_CACHE_DIR=str(tmp_path / "cache"))) as proc:

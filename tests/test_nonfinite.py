@@ -14,6 +14,7 @@ import os
 import sys
 
 import numpy as np
+import pytest
 
 from ensemble.config import Integrator, Model
 from ensemble.integrators import INTEGRATORS, kernel_params
@@ -124,10 +125,11 @@ print(json.dumps({"hard": hard, "bad": bad}))
 """
 
 
+@pytest.mark.slow
 def test_bounds_checked_hard_cases_and_bad_inputs(tmp_path):
     """Hard cases (small N, with and without pauses) run; NaN/inf inputs give NONFINITE, with every method.
     Most of the time is the bounds-checked compilation of the aging law's kernels, about a minute here: one
-    compilation holds every method (model/methods.py)."""
+    compilation holds every method (model/methods.py). Slow by nature: the slower tier, `make slow`."""
     methods = tuple(INTEGRATORS)
     env = dict(os.environ, NUMBA_BOUNDSCHECK="1", NUMBA_CACHE_DIR=str(tmp_path / "numba"),
                PYTHONPATH=str(ROOT), OMP_NUM_THREADS="1", NUMBA_NUM_THREADS="1",

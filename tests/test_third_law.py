@@ -5,6 +5,9 @@ constant dynamic friction 1 - drop, no state, the loader still during events. No
 edited; the copy then validates, runs, records and reports the law. The law has an exact answer:
 a block that slides alone from its threshold oscillates about its new equilibrium and stops after
 half a period, having slipped 2 drop / k (k = 1 + 2 l^2 inside the chain, 1 + l^2 at an end).
+
+Slow by nature (the slower tier, `make slow`, which CI runs): the copy's kernels compile for the new law,
+about a minute and a half.
 """
 import shutil
 import sys
@@ -94,6 +97,7 @@ def ensemble(root, env, *args):
     return run_bounded([sys.executable, "-m", "ensemble", *map(str, args)], 600, cwd=root, env=env)
 
 
+@pytest.mark.slow
 def test_a_law_in_one_new_module_validates_runs_and_is_recorded(copy_with_a_third_law):
     root, env = copy_with_a_third_law
     res = run_bounded([sys.executable, "-c", "import ensemble; print(ensemble.__file__)"], 60, cwd="/", env=env)
