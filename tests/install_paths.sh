@@ -108,7 +108,7 @@ runuser -u "$USER_NAME" -- env -i HOME="$home" PATH="$path" LANG=C.UTF-8 PIP_CAC
   [ $CASE = found ] && { say 'the wheel stack, as make run takes it: its runs are those of the wheels case'; exit 0; }
   t1=\$(now)
   make run 2>&1 | tee run.log
-  say \"the serial run (make run; numba compiles the kernels first): \$(since \$t1)\"
+  say \"the serial run (make run; the kernels compiled by make setup): \$(since \$t1)\"
   say \"fresh clone to the end of make run: \$(since \$t0)\"
   t3=\$(now)
   .venv/bin/python -m ensemble run examples/small.toml -o my.h5 2>&1 | tee quick.log
