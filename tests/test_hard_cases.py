@@ -102,10 +102,10 @@ def check_long_run(method, N, t_end, compare=5):
 
     Both continue from the same physical state (the restart has it brought to one time, which
     changes round-off only), so their first events agree up to chaotic growth of round-off:
-    measured at most 9e-15 past 1e15 (every method), 1e-8 past 1e16 (ark3; rk4 and ark4
-    2e-13). A dependence on the absolute time (e.g. a time since rest of ~1e-3 taken as a
-    difference of two times near 1e15 in single float64, resolution 0.125) would show here as
-    errors of order 1.
+    measured at most 9e-15 past 1e15 (every method), 7e-6 past 1e16 (ark4 at its default rtol 1e-4,
+    2026-11-29; an earlier measurement gave 1e-8 for ark3). A dependence on the absolute time (e.g. a
+    time since rest of ~1e-3 taken as a difference of two times near 1e15 in single float64, resolution
+    0.125) would show here as errors of order 1.
     """
     model = Model(N=N, nu=1e-10)        # ~ 5e12 time units per event: 1e15 after ~200 events
     traj = trajectory(model, integrator(method))
@@ -126,8 +126,10 @@ def check_long_run(method, N, t_end, compare=5):
     np.testing.assert_array_equal(epi_late, epi_reset)
     # A dependence on the absolute time would show as differences of order 1; what remains is
     # round-off of the restarted state, amplified by the chaotic dynamics (more so with adaptive
-    # steps, whose sequence changes discretely): measured at most 1e-8 (above), bound 100x that.
-    assert rel_t.max() < 1e-6 and rel_slip.max() < 1e-6
+    # steps, whose sequence changes discretely, and the more the looser their tolerance): measured
+    # at most 7e-6 (ark4 at its default rtol 1e-4, past 1e16, the fifth event; 2026-11-29, the same
+    # before and after the kernels were compiled once per law), bound 10x that, 1e4 below order 1.
+    assert rel_t.max() < 1e-4 and rel_slip.max() < 1e-4
 
 
 @pytest.mark.parametrize("method", METHODS)
