@@ -1,10 +1,10 @@
 """The compiled kernels: compiling them ahead for every friction law, and saying so when a run must compile.
 
 The kernels are compiled once per friction law (the integration method is chosen inside them at run time,
-model/methods.py) into the package's numba cache (kernel_cache.py), in about a minute per law. `make setup`
+model/methods.py) into the package's numba cache (kernel_cache.py), in a minute or two per law. `make setup`
 runs `python -m ensemble compile`, which compiles every law of the registry, each in a process of its own
 (as many at once as there are cores), so that the first run of any law, method and regime loads them
-instead; a law already in the cache takes about a second to check.
+instead; a law already in the cache takes about 2 s to check.
 
 `warm(law)` calls every kernel entry point that a run, a checkpoint and the single-event API
 (ensemble.events) reach from Python, on a chain of a few blocks, with the types a run gives them.
@@ -20,9 +20,9 @@ import time
 from numba.core import event as numba_event
 
 
-# what a law's kernels take to compile on one core of the machine this project is developed on
-# (python -m ensemble compile, docs/tests.md); said to a user who has to wait for it
-SECONDS_PER_LAW = 60
+# what a law's kernels take to compile on the machine this project is developed on: 72-99 s, two laws at
+# once on its 2 cores (python -m ensemble compile, docs/benchmarks.md); said to a user who has to wait for it
+SECONDS_PER_LAW = 90
 
 
 def warm(law):

@@ -44,7 +44,7 @@ def test_a_compilation_is_said_in_one_line_with_its_time_and_its_end():
     with compiled.announced(said.append, "aging"):
         assert fresh(1) == 2
     assert len(said) == 2, said
-    assert said[0].startswith("compiling kernels for model.law = 'aging' (about 60 s"), said
+    assert said[0].startswith(f"compiling kernels for model.law = 'aging' (about {compiled.SECONDS_PER_LAW} s"), said
     assert "python -m ensemble compile" in said[0]
     assert said[1].startswith("kernels ready in "), said
     said.clear()
