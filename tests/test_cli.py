@@ -200,7 +200,7 @@ def test_unstable_step_stops_with_task_and_event_and_keeps_old_catalog(small_run
     """dt beyond the RK4 stability limit: a clear error naming task and event, nothing overwritten."""
     d, cfg = small_run
     before = (d / "cfg.h5").read_bytes()
-    res = run_cli("run", cfg, "--force", "--set", "integrator.dt=0.02")
+    res = run_cli("run", cfg, "--force", "--set", "integrator.method=rk4", "--set", "integrator.dt=0.02")
     assert res.returncode == 1
     line = res.stderr.strip().splitlines()[0]
     assert "task 0" in line and "event" in line and "stability" in line
