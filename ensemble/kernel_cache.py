@@ -12,6 +12,13 @@ starting them. The place, in order:
 The kernels themselves live in a subdirectory named after a hash of their sources (directory()):
 numba's own check notices a change only in the file of the cached function, not in the kernels it
 calls from other files, so a stale cache would otherwise run old physics silently.
+
+Inside it, numba would file each source directory's kernels under a hash of that directory's absolute
+path, so two clones of one commit (CI's install paths, a checkout moved or copied to a cluster's nodes)
+could not share a cache. relocatable() files them under the directory's path inside the package root
+instead (`ensemble_model`): the bk-<hash> above already names the sources, and numba checks each file's
+content (its stamp is a hash of the file in numba 0.62 and later), so a cache built in one clone serves
+every clone of the same sources.
 """
 import hashlib
 import os
@@ -31,8 +38,38 @@ def base(environ=None):
     return str(USER_CACHE.expanduser())
 
 
+def relocatable():
+    """Numba's cache locator for a given CACHE_DIR, filing kernels by their path under CHECKOUT (see the
+    module docstring); installed once, first in numba's list. False where this numba has no such locator
+    (its own then applies: one cache per clone)."""
+    try:
+        from numba.core import caching
+        impl = getattr(caching, "CacheImpl", None) or caching._CacheImpl
+        located = getattr(caching, "UserProvidedCacheLocator", None) or caching._UserProvidedCacheLocator
+        classes = impl._locator_classes
+    except (ImportError, AttributeError):
+        return False
+    if any(getattr(c, "checkout_relative", False) for c in classes):
+        return True
+
+    class CheckoutRelative(located):
+        checkout_relative = True
+
+        @classmethod
+        def get_suitable_cache_subpath(cls, py_file):
+            folder = Path(py_file).resolve().parent
+            if not folder.is_relative_to(CHECKOUT):
+                return super().get_suitable_cache_subpath(py_file)
+            return "_".join(folder.relative_to(CHECKOUT).parts)
+
+    classes.insert(0, CheckoutRelative)
+    return True
+
+
 def directory(sources, environ=None):
-    """base()/bk-<hash of every .py file under `sources`>: the cache of the kernels defined there."""
+    """base()/bk-<hash of every .py file under `sources`>: the cache of the kernels defined there, filed by
+    their path in the package (relocatable())."""
+    relocatable()
     sources = Path(sources)
     digest = hashlib.sha256()
     for src in sorted(sources.rglob("*.py")):

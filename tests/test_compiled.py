@@ -6,7 +6,9 @@ method and regime (benchmarks/first_run.py): none may compile. The fast ones che
 refusals and the line a compiling run says.
 """
 import json
+import shutil
 import sys
+from pathlib import Path
 
 import numba
 import pytest
@@ -69,3 +71,24 @@ def test_compile_of_a_cached_law_says_so():
     lines = res.stdout.strip().splitlines()
     assert lines[0].startswith("compiling the kernels of carlson-langer (1 law(s)"), lines
     assert lines[-1].startswith("model.law = 'carlson-langer': kernels "), lines
+
+
+def test_a_cache_built_in_one_checkout_serves_a_copy_elsewhere(tmp_path):
+    """The kernels compiled in this checkout (make setup) load, uncompiled, in a copy of the package at
+    another path: numba files them by their path in the package (kernel_cache.relocatable), so clones of
+    one commit (CI's install paths, a checkout copied to a cluster) share one cache."""
+    from ensemble import kernel_cache
+    here = Path(compiled.cache_directory())
+    res = run_bounded([sys.executable, "-m", "ensemble", "compile", "--law", "carlson-langer"], 600, cwd=ROOT,
+                      env=child_env())      # compiled here (by make setup: loaded in seconds)
+    assert res.returncode == 0, res.stdout + res.stderr
+    copy = tmp_path / "elsewhere"
+    shutil.copytree(ROOT / "ensemble", copy / "ensemble", ignore=shutil.ignore_patterns("__pycache__"))
+    cache = tmp_path / "cache"
+    shutil.copytree(here, cache / here.name)
+    assert kernel_cache.directory(copy / "ensemble" / "model", {"NUMBA_CACHE_DIR": str(cache)}) == str(cache / here.name)
+    res = run_bounded([sys.executable, "-m", "ensemble", "compile", "--law", "carlson-langer"], 600, cwd=copy,
+                      env=child_env(NUMBA_CACHE_DIR=str(cache), PYTHONPATH=str(copy)))
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert "carlson-langer': kernels already compiled (loaded from the cache)" in res.stdout, res.stdout
+    assert (cache / here.name / "ensemble_model").is_dir()
