@@ -1,5 +1,5 @@
 # Two entry points: `make run` (set up, run the example) and `make test` (set up, run the tests),
-# and a quick tier, `make quick` (about two minutes of tests touching every module; docs/tests.md).
+# and a quick tier, `make quick` (about a minute of tests touching every module; docs/tests.md).
 # STACK (scripts/setup.sh): auto (default: the stack .venv has, else the wheel stack, ready in
 # about a minute), parallel (build mpi4py and h5py against the machine's MPI and parallel HDF5:
 # minutes) or wheels. `make test` tests the parallel writer, so it sets up the parallel stack
@@ -30,9 +30,9 @@ test:
 	STACK=$(TEST_STACK) bash scripts/setup.sh
 	ENSEMBLE_TEST_STACK=$(TEST_STACK) $(PY) -m pytest -q -m "not slow" $(XDIST) --durations=30
 
-# a tier of about two minutes that touches every module (the `quick` marker: tests/conftest.py)
+# a tier of about a minute that touches every module (the `quick` marker: tests/conftest.py), on TEST_WORKERS
 quick: setup
-	$(PY) -m pytest -q -m "quick and not slow"
+	$(PY) -m pytest -q -m "quick and not slow" $(XDIST)
 
 # the slower tier: the tests marked slow (the Slurm cluster, the longest runs, compiling into empty caches),
 # which CI runs after `make test` (docs/tests.md)
