@@ -7,6 +7,9 @@
   blocks on a read; it waits on conditions (`wait_for`) and for the exit (`wait`), each with a
   deadline, and leaving its `with` block kills whatever is left.
 - `wait_for`: poll a condition until a deadline, instead of sleeping a guessed length.
+- `ensemble_here`: `python -m ensemble ...` in this process, for a command that needs no process of
+  its own (no signal, kill or crash, no mpiexec): a process costs ~2.5 s of imports and kernel
+  loading, more than a test's small run.
 
 Every command gets no standard input (CI has none; a read must not wait for a terminal).
 """
@@ -135,6 +138,27 @@ def run_bounded(cmd, timeout, **kwargs):
         kill_tree(proc)
         raise
     return subprocess.CompletedProcess(cmd, proc.returncode, out, err)
+
+
+def ensemble_here(*args):
+    """`python -m ensemble ARGS` run by ensemble.cli.main in this process (one rank): a CompletedProcess
+    with its exit code and what it printed. The handlers of the stop signals are put back afterwards
+    (a run leaves its own, which acknowledge a late signal instead of obeying it)."""
+    import contextlib
+    import io
+
+    from ensemble import cli
+    from ensemble.run.parallel import INTERRUPT_SIGNALS
+    argv = [str(a) for a in args]
+    handlers = {sig: signal.getsignal(sig) for sig in INTERRUPT_SIGNALS}
+    stdout, stderr = io.StringIO(), io.StringIO()
+    try:
+        with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
+            code = cli.main(argv)
+    finally:
+        for sig, handler in handlers.items():
+            signal.signal(sig, handler)
+    return subprocess.CompletedProcess(["python -m ensemble", *argv], code, stdout.getvalue(), stderr.getvalue())
 
 
 def poll_until(condition, timeout):
