@@ -53,7 +53,7 @@ case $CASE in
     stack_arg=
     # the wheel stack's MPI and its rank-0 writer: the same catalog on 1 and 2 ranks, a signal to the rank that
     # does not write, kill -9, an error on one rank (`make test` runs the rest on the parallel stack, rank0 too)
-    tests="ENSEMBLE_TEST_STACK=wheels OMP_NUM_THREADS=1 python -m pytest -q -rs tests/test_mpi.py -k 'writer[1-auto] or writer[2-rank0] or uninterrupted[15-other-rank0] or kill9 or genuine_error'"
+    tests="ENSEMBLE_TEST_STACK=wheels OMP_NUM_THREADS=1 python -m pytest -q -rs tests/test_mpi.py -k 'writer[1-auto] or writer[3-rank0] or uninterrupted[15-other-rank0] or kill9 or genuine_error'"
     ;;
   modules|found)
     hdf5=/usr/lib/x86_64-linux-gnu/hdf5/mpich
