@@ -133,7 +133,7 @@ MUTATIONS = (
              "resume continues from the older of the two checkpoints"),
     Mutation("catalog-one-checkpoint-slot", "ensemble/store/layout.py",
              "slot = 0 if head is None else 1 - head.slot", "slot = 0",
-             ("tests/test_faults.py::test_crash_at_every_write_of_a_batch_resumes_to_the_uninterrupted_catalog",),
+             ("tests/test_faults.py::test_crash_at_each_kind_of_write_of_a_batch_resumes_to_the_uninterrupted_catalog",),
              "every checkpoint overwrites the only valid one, so a crash while writing it loses the task"),
     Mutation("catalog-state-crc-unchecked", "ensemble/store/layout.py",
              "if crc(flat) != head.state_crc:", "if False:",

@@ -28,8 +28,12 @@ from .processes import ROOT, child_env, run_bounded
 from .same_catalogs import assert_same_events
 
 TIMEOUT = 300
-SEEDS, EVENTS, TRANSIENT = 2, 300, 20
+SEEDS, EVENTS, TRANSIENT = 2, 200, 20
 CREEPING, STIFF = 15.0, 25.0      # model.b of the two points: below and above the block stiffness 19
+# ark4, with creep phases integrated at a looser tolerance than the default 1e-6 (creep_tol 1e-4: a creeping
+# task in a third of the time, still three rows in four creep): what is tested here is how the catalog keeps
+# both kinds and the creep state, not the accuracy of the creep
+INTEGRATOR = {"method": "ark4", "creep_tol": 1e-4}
 
 
 def injected(setup, *argv, ranks=None):
@@ -44,11 +48,12 @@ def injected(setup, *argv, ranks=None):
 
 @pytest.fixture(scope="module")
 def creeping(tmp_path_factory):
-    """The config (b = 15 and 25, two seeds each, defaults otherwise) and its uninterrupted serial catalog."""
+    """The config (b = 15 and 25, two seeds each, INTEGRATOR, defaults otherwise) and its uninterrupted
+    serial catalog."""
     d = tmp_path_factory.mktemp("creep_catalog")
     cfg = write_config(d / "cfg.toml", model={"N": 50}, sweep={"b": [CREEPING, STIFF]},
                        run={"seeds": SEEDS, "events": EVENTS, "transient": TRANSIENT},
-                       integrator={"method": "ark4"}, output={"batch": 50, "flush_seconds": 1000.0})
+                       integrator=INTEGRATOR, output={"batch": 50, "flush_seconds": 1000.0})
     res = run_cli("run", cfg, "-o", d / "full.h5", timeout=TIMEOUT)
     assert res.returncode == 0, res.stdout + res.stderr
     return d, cfg
@@ -99,15 +104,14 @@ def test_a_creeping_chain_writes_both_kinds_and_keeps_its_creep_state(creeping):
 def test_reduce_counts_the_inertial_events_alone(creeping):
     """The summary of the catalog equals the reference reduction of its kind-0 rows alone (every dataset:
     R(mu), recurrence times, GR b, fraction large, per-task stretches and their bootstrap)."""
+    from analysis import cli
     d, _ = creeping
     out = d / "sum.h5"
-    res = run_bounded([sys.executable, "-m", "analysis", "reduce", d / "full.h5", "-o", out, "--bootstrap", "200",
-                       "--mu-c", "3.5"], TIMEOUT, env=child_env())
-    assert res.returncode == 0, res.stderr
+    assert cli.main(["reduce", str(d / "full.h5"), "-o", str(out), "--bootstrap", "50", "--mu-c", "3.5"]) == 0
     events, tasks, _ = reader.read(d / "full.h5")
     inertial = {name: column[events["kind"] == schema.KIND_EVENT] for name, column in events.items()}
     opt = {"mu_edges": np.linspace(0, 7, 71), "tnu_edges": np.linspace(0, 2000, 81), "mu_c": 3.5,
-           "window": 10, "b_cut": 3.0, "bootstrap": 200, "level": 0.95, "blocks": 20, "seed": 0}
+           "window": 10, "b_cut": 3.0, "bootstrap": 50, "level": 0.95, "blocks": 20, "seed": 0}
     expected = ref.expected_summary([(d / "full.h5", events, tasks)], opt)   # the reference keeps kind 0 apart
     ref.check_summary(ref.read_summary(out), expected, opt)
     # (what that covers: creep rows that would change every statistic of the creeping point)
@@ -154,7 +158,8 @@ def test_resume_with_creep_in_flight_gives_the_uninterrupted_catalog(creeping, t
     # the stop came with blocks creeping: some task's checkpoint holds them
     assert any(s.creep[-NCSTATE + CS_NCREEP] > 0 for s in states), "no checkpoint with creep in flight"
     assert stopped, "every task had finished or not begun"
-    res = run_cli("resume", out, timeout=TIMEOUT)
+    # the rest in kernel calls sized as usual (as in the uninterrupted run): the catalog does not depend on them
+    res = run_cli("resume", out, "--set", "run.poll_seconds=0.25", timeout=TIMEOUT)
     assert res.returncode == 0, res.stdout + res.stderr
     assert_same_events(d / "full.h5", out)
     a, _, _ = reader.read(d / "full.h5")
@@ -216,28 +221,27 @@ def test_a_checkpoint_packs_its_creep_state_and_a_slot_of_another_size_is_refuse
 def test_unperturbed_branches_carry_the_spun_up_creep_state(tmp_path):
     """run.branch with perturbation 0: every seed records what its seed 0 records without branching. The
     spin-up is made to end with a block creeping (the first such row count, found by running the chain
-    here), so the branches need its creep state, not only its forces and states."""
+    here), so the branches need its creep state, not only its forces and states. Seed 0 without branching
+    is that same chain run on here (as a run's task does: a Trajectory, event_rows), past the branches'
+    decorrelation."""
     from ensemble.config import loads
-    from ensemble.run.trajectory import Trajectory
+    from ensemble.run.trajectory import Trajectory, event_rows
     from ensemble.sweep import task_list
-    run = {"seeds": 2, "events": 100, "transient": 40, "branch": True, "decorrelation": 20, "perturbation": 0.0}
-    cfg = write_config(tmp_path / "branch.toml", model={"N": 50, "b": CREEPING}, run=run,
-                       integrator={"method": "ark4"})
-    chain = Trajectory(loads(cfg.read_text()), task_list(loads(cfg.read_text()))[0])
+    run = {"seeds": 2, "events": 60, "transient": 40, "branch": True, "decorrelation": 20, "perturbation": 0.0}
+    cfg = write_config(tmp_path / "branch.toml", model={"N": 50, "b": CREEPING}, run=run, integrator=INTEGRATOR)
+    seed0 = task_list(loads(cfg.read_text()))[0]
+    chain = Trajectory(loads(cfg.read_text()), seed0)
     while chain.ws.cstate[CS_NCREEP] == 0 or chain.done < 20:
         chain.advance(1)
         assert chain.done < 1000, "no row count after which a block creeps"
     cfg = write_config(tmp_path / "branch.toml", model={"N": 50, "b": CREEPING}, run={**run, "transient": chain.done},
-                       integrator={"method": "ark4"})
+                       integrator=INTEGRATOR)
     res = run_cli("run", cfg, "-o", tmp_path / "zero.h5", timeout=TIMEOUT)
     assert res.returncode == 0, res.stdout + res.stderr
-    res = run_cli("run", cfg, "-o", tmp_path / "plain.h5", "--set", "run.branch=false",
-                  "--set", f"run.transient={chain.done + 20}", timeout=TIMEOUT)
-    assert res.returncode == 0, res.stdout + res.stderr
+    chain.advance(run["decorrelation"])
+    plain = event_rows(seed0, *chain.advance(run["events"]))
+    assert len(plain["t"]) == run["events"] and np.count_nonzero(plain["kind"] == schema.KIND_CREEP) > 10
     zero, _, _ = reader.read(tmp_path / "zero.h5")
-    plain, _, _ = reader.read(tmp_path / "plain.h5")
-    seed0 = plain["task"] == 0
-    assert np.count_nonzero(plain["kind"][seed0] == schema.KIND_CREEP) > 10
     with reader.Reader(tmp_path / "zero.h5") as cat:     # the spin-up (record 2) ended with a block creeping
         spun = cat.layout.read_state(2, cat.layout.head(2))
     assert spun.creep is not None and spun.creep[-NCSTATE + CS_NCREEP] > 0
@@ -245,7 +249,7 @@ def test_unperturbed_branches_carry_the_spun_up_creep_state(tmp_path):
         mine = zero["task"] == k
         for name in schema.EVENT_FIELDS:
             if name != "task":
-                np.testing.assert_array_equal(zero[name][mine], plain[name][seed0], err_msg=f"task {k} {name}")
+                np.testing.assert_array_equal(zero[name][mine], plain[name], err_msg=f"task {k} {name}")
 
 
 def test_a_record_laid_out_for_another_kernel_is_not_continued(tmp_path, monkeypatch):
