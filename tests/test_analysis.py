@@ -1,13 +1,20 @@
 """Reduction: merged histograms, recurrence times, bootstrap coverage, GR b, serial vs MPI;
-several catalogs reduced together; figures of several summaries."""
+several catalogs reduced together; figures of several summaries.
+
+The real catalog is reduced once by `python -m analysis reduce` and once under `mpiexec -n 2`; the
+other commands run in this process (analysis.cli.main, which `python -m analysis` calls): a process
+of its own costs about 2.5 s of imports, more than the command's work on these catalogs."""
+import contextlib
 import dataclasses
+import io
 import shutil
+import subprocess
 import sys
 
 import numpy as np
 import pytest
 
-from analysis import stats, summary
+from analysis import cli, stats, summary
 from analysis.recurrence import RecurrenceScanner
 from ensemble.store import reader
 from ensemble.config import loads
@@ -18,18 +25,34 @@ from .conftest import run_cli, write_config
 from .processes import run_bounded
 
 
+# bootstrap resamples of the real catalog's reductions: the comparisons with the reference are exact
+# (the same resamples), so a hundred see as much as more would
+BOOTSTRAP = "100"
+
+
 def run_analysis(*args):
     return run_bounded([sys.executable, "-m", "analysis", *args], 300)
 
 
+def analysis_here(*args):
+    """`python -m analysis ARGS` run by analysis.cli.main in this process (argparse's own errors exit)."""
+    stdout, stderr = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
+        try:
+            code = cli.main([str(a) for a in args])
+        except SystemExit as done:
+            code = done.code
+    return subprocess.CompletedProcess(["python -m analysis", *args], code, stdout.getvalue(), stderr.getvalue())
+
+
 @pytest.fixture(scope="module")
 def reduced(tmp_path_factory):
-    """A real catalog (2 points x 2 seeds, N = 60) and its summary."""
+    """A real catalog (2 points x 2 seeds x 150 events, N = 60) and its summary."""
     d = tmp_path_factory.mktemp("analysis")
-    cfg = write_config(d / "cfg.toml", sweep={"b": [20.0, 30.0]}, run={"seeds": 2, "events": 300, "transient": 50},
+    cfg = write_config(d / "cfg.toml", sweep={"b": [20.0, 30.0]}, run={"seeds": 2, "events": 150, "transient": 50},
                        integrator={"dt": 5e-4})
     assert run_cli("run", cfg, "-o", d / "cat.h5").returncode == 0
-    res = run_analysis("reduce", d / "cat.h5", "-o", d / "sum.h5", "--bootstrap", "200", "--mu-c", "3.5")
+    res = run_analysis("reduce", d / "cat.h5", "-o", d / "sum.h5", "--bootstrap", BOOTSTRAP, "--mu-c", "3.5")
     assert res.returncode == 0, res.stderr
     # two seeds per point, fewer than ten: 20 stretches of each are the units, enough for no warning
     assert "warning" not in res.stderr, res.stderr
@@ -76,7 +99,7 @@ def test_real_summary_equals_brute_force(reduced):
     test_serial_and_mpi_reduction_agree finds identical) against the plain reference."""
     events, tasks, _ = reader.read(reduced / "cat.h5")
     opt = {"mu_edges": np.linspace(0, 7, 71), "tnu_edges": np.linspace(0, 2000, 81), "mu_c": 3.5,
-           "window": 10, "b_cut": 3.0, "bootstrap": 200, "level": 0.95, "blocks": 20, "seed": 0}
+           "window": 10, "b_cut": 3.0, "bootstrap": int(BOOTSTRAP), "level": 0.95, "blocks": 20, "seed": 0}
     expected = ref.expected_summary([(reduced / "cat.h5", events, tasks)], opt)
     assert expected["points/numbers/n_recurrences"][:, 0].min() > 10
     ref.check_summary(ref.read_summary(reduced / "sum.h5"), expected, opt)
@@ -157,7 +180,7 @@ def test_gr_b_standard_error_is_the_spread_of_gr_b_over_independent_catalogs():
 def test_single_seed_uses_block_bootstrap_and_says_so(tmp_path):
     cfg = write_config(tmp_path / "c.toml", run={"seeds": 1, "events": 200, "transient": 20})
     assert run_cli("run", cfg, "-o", tmp_path / "one.h5").returncode == 0
-    res = run_analysis("reduce", tmp_path / "one.h5", "--bootstrap", "50", "--blocks", "10")
+    res = analysis_here("reduce", tmp_path / "one.h5", "--bootstrap", "50", "--blocks", "10")
     assert res.returncode == 0, res.stderr
     assert "block bootstrap" in res.stdout
     s = summary.read(tmp_path / "one.summary.h5")
@@ -167,16 +190,17 @@ def test_single_seed_uses_block_bootstrap_and_says_so(tmp_path):
 
 
 def test_report_and_figures(reduced):
-    res = run_analysis("report", reduced / "sum.h5")
+    res = analysis_here("report", reduced / "sum.h5")
     assert res.returncode == 0 and "b = 20" in res.stdout and "GR b" in res.stdout
     for fig in ("magnitude", "recurrence"):
         out = reduced / f"{fig}.png"
-        res = run_analysis("plot", reduced / "sum.h5", "--figure", fig, "-o", out)
+        res = analysis_here("plot", reduced / "sum.h5", "--figure", fig, "-o", out)
         assert res.returncode == 0, res.stderr
         assert out.stat().st_size > 10000
+    # the exit code and message of the command itself, in a process of its own
     res = run_analysis("reduce", reduced / "cat.h5", "-o", reduced / "sum.h5")
     assert res.returncode == 2 and "--force" in res.stderr   # a usage error, as in `ensemble run`
-    res = run_analysis("reduce", reduced / "cat.h5", "--mu-bins", "3:1:5", "-o", reduced / "x.h5")
+    res = analysis_here("reduce", reduced / "cat.h5", "--mu-bins", "3:1:5", "-o", reduced / "x.h5")
     assert res.returncode == 2 and "bins" in res.stderr
 
 
@@ -184,7 +208,7 @@ def test_report_and_figures(reduced):
 @pytest.mark.skipif(shutil.which("mpiexec") is None, reason="mpiexec not found")
 def test_serial_and_mpi_reduction_agree(reduced):
     res = run_bounded(["mpiexec", "-n", "2", sys.executable, "-m", "analysis", "reduce", reduced / "cat.h5",
-                       "-o", reduced / "sum_mpi.h5", "--bootstrap", "200", "--mu-c", "3.5"], 300)
+                       "-o", reduced / "sum_mpi.h5", "--bootstrap", BOOTSTRAP, "--mu-c", "3.5"], 300)
     assert res.returncode == 0, res.stderr
     a, b = summary.read(reduced / "sum.h5"), summary.read(reduced / "sum_mpi.h5")
     assert set(a) == set(b)
@@ -204,7 +228,7 @@ def test_serial_and_mpi_reduction_agree(reduced):
 SPLIT = {"A": ((20.0, 30.0), (0, 3)), "B": ((30.0, 20.0), (2, 1))}
 # level 0.5: quartiles of the resamples are less settled than 95% bounds, so the comparisons see
 # the order of the units (20 stretches of each of a point's two tasks) and the bootstrap's stream
-REDUCE_OPTIONS = ("--bootstrap", "200", "--mu-c", "3.5", "--level", "0.5")
+REDUCE_OPTIONS = ("--bootstrap", BOOTSTRAP, "--mu-c", "3.5", "--level", "0.5")
 
 
 @pytest.fixture(scope="module")
@@ -221,8 +245,8 @@ def merged(reduced):
             parts.append({c: np.full(mine.sum(), k) if c == "task" else events[c][mine] for c in events})
         write_events(reduced / f"{name}.h5", text, parts, [(0, task) for task in source])
     for names, paths in (("whole", ["cat.h5"]), ("AB", ["A.h5", "B.h5"]), ("BA", ["B.h5", "A.h5"])):
-        res = run_analysis("reduce", *(reduced / p for p in paths), "-o", reduced / f"{names}.summary.h5",
-                           *REDUCE_OPTIONS)
+        res = analysis_here("reduce", *(reduced / p for p in paths), "-o", reduced / f"{names}.summary.h5",
+                            *REDUCE_OPTIONS)
         assert res.returncode == 0, res.stderr
     return reduced
 
@@ -260,7 +284,7 @@ def test_merged_summary_equals_brute_force(merged):
     documented), from the catalogs' own events."""
     inputs = [(merged / f"{n}.h5", *reader.read(merged / f"{n}.h5")[:2]) for n in "AB"]
     opt = {"mu_edges": np.linspace(0, 7, 71), "tnu_edges": np.linspace(0, 2000, 81), "mu_c": 3.5,
-           "window": 10, "b_cut": 3.0, "bootstrap": 200, "level": 0.5, "blocks": 20, "seed": 0}
+           "window": 10, "b_cut": 3.0, "bootstrap": int(BOOTSTRAP), "level": 0.5, "blocks": 20, "seed": 0}
     expected = ref.expected_summary(inputs, opt)
     assert list(expected["points/units"]) == [40, 40]     # 20 stretches of each of two tasks
     ref.check_summary(ref.read_summary(merged / "AB.summary.h5"), expected, opt)
@@ -272,11 +296,11 @@ def test_merging_a_catalog_with_itself_or_its_trajectories_is_refused(merged):
                          ((merged / "cat.h5", merged / "B.h5"),
                           f"{merged / 'cat.h5'} task 1 and {merged / 'B.h5'} task 1 are the same trajectory"),
                          ((merged / "A.h5", merged / "A.h5"), f"{merged / 'A.h5'} is given twice")):
-        res = run_analysis("reduce", *paths, "-o", merged / "dup.summary.h5")
+        res = analysis_here("reduce", *paths, "-o", merged / "dup.summary.h5")
         assert res.returncode == 2 and len(res.stderr.strip().splitlines()) == 1, res.stderr
         assert res.stderr.startswith(f"error: {words}")
         assert not (merged / "dup.summary.h5").exists()
-    res = run_analysis("reduce", merged / "A.h5", merged / "B.h5")
+    res = analysis_here("reduce", merged / "A.h5", merged / "B.h5")
     assert res.returncode == 2 and "give its path with -o" in res.stderr
 
 
@@ -316,6 +340,6 @@ def test_legend_labels_name_what_differs_between_the_plotted_points():
 def test_plot_overlays_several_summaries(merged):
     for fig in ("magnitude", "recurrence"):
         out = merged / f"overlay-{fig}.png"
-        res = run_analysis("plot", merged / "sum.h5", merged / "BA.summary.h5", "--figure", fig, "-o", out)
+        res = analysis_here("plot", merged / "sum.h5", merged / "BA.summary.h5", "--figure", fig, "-o", out)
         assert res.returncode == 0, res.stderr
         assert out.stat().st_size > 10000

@@ -1,6 +1,7 @@
 """The benchmark scripts at tiny sizes: their helpers against known answers, their outputs sane."""
 import json
 import subprocess
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -57,11 +58,12 @@ def test_baseline_timeout_is_recorded():
 def test_work_precision_tiny(tmp_path):
     # no wall-time cap on the baselines ("inf"): every row must be "ok", which a cap would make
     # depend on the machine's load; the per-test timeout stands guard against a hang
-    work_precision.main(["--N", "40", "--b", "20", "--transient", "60", "--max-seconds", "inf", "--out",
+    # N = 20: the full-chain baselines' cost grows with N; the orders and agreements checked hold as at N = 40
+    work_precision.main(["--N", "20", "--b", "20", "--transient", "60", "--max-seconds", "inf", "--out",
                          str(tmp_path), "--runs", "rk4:dt=1e-3", "rk4:dt=5e-4", "ark3:rtol=1e-4", "ark3:rtol=1e-7",
                          "scipy:method=LSODA,rtol=1e-5", "scipy:method=LSODA,rtol=1e-8"])
-    data = json.loads((tmp_path / "work_precision_N40_b20.json").read_text())
-    assert (tmp_path / "work_precision_N40_b20.png").stat().st_size > 0
+    data = json.loads((tmp_path / "work_precision_N20_b20.json").read_text())
+    assert (tmp_path / "work_precision_N20_b20.png").stat().st_size > 0
     rows = data["rows"]
     assert {r["event"] for r in rows} == {"small", "large"} and all(r["status"] == "ok" for r in rows)
     for event in ("small", "large"):
@@ -78,11 +80,11 @@ def test_work_precision_tiny(tmp_path):
 
 
 def test_statistics_tiny(tmp_path):
-    data = statistics.main(["--N", "40", "--seeds", "2", "--events", "120", "--transient", "40",
+    data = statistics.main(["--N", "40", "--seeds", "2", "--events", "60", "--transient", "20",
                             "--reference", "rk4:dt=1e-3", "--runs", "ark3:rtol=1e-3", "--out", str(tmp_path)])
     assert json.loads((tmp_path / "statistics_N40_b20.json").read_text())["rows"][1]["setting"] == "ark3:rtol=1e-3"
     ref, cand = data["rows"]
-    assert ref["events"] == cand["events"] == 240 and cand["recurrences"] > 0
+    assert ref["events"] == cand["events"] == 120 and cand["recurrences"] > 0
     assert cand["events_per_second"] > 0
     for key in ("ks_mu", "ks_tnu"):
         assert 0 < cand[key] <= 1
@@ -106,13 +108,20 @@ def brute_recurrences(t, epicenter, mu, mu_c=4.0, window=10):
 
 def test_statistics_from_catalogs(tmp_path, capsys):
     from ensemble.store import reader
+    from .catalog_writer import write_events
     from .conftest import run_cli, write_config
     cfg = write_config(tmp_path / "c.toml", model={"N": 30}, sweep={"b": [20.0, 50.0]},
-                       run={"events": 300, "transient": 50, "seeds": 2}, integrator={"method": "ark4"})
+                       run={"events": 150, "transient": 20, "seeds": 2}, integrator={"method": "ark4"})
     ref, cand, other = tmp_path / "ref.h5", tmp_path / "cand.h5", tmp_path / "other.h5"
-    for out, sets in ((ref, ["integrator.rtol=1e-6", "run.seed=1"]), (cand, ["integrator.rtol=1e-3"]),
-                      (other, ["model.N=20", "run.events=30", "run.transient=10"])):
+    for out, sets in ((ref, ["integrator.rtol=1e-5", "run.seed=1"]), (cand, ["integrator.rtol=1e-3"])):
         assert run_cli("run", cfg, "-o", out, *[a for s in sets for a in ("--set", s)]).returncode == 0
+    # a catalog of another chain (N = 20), through the project's writer: the candidate's events that lie on
+    # its first 20 blocks
+    events, _, _ = reader.read(cand)
+    small = write_config(tmp_path / "o.toml", model={"N": 20}, sweep={"b": [20.0, 50.0]},
+                         run={"events": 5, "transient": 20, "seeds": 2}, integrator={"method": "ark4"})
+    write_events(other, small.read_text(), [{c: v[(events["task"] == k) & (events["last"] < 20)][:5]
+                                             for c, v in events.items()} for k in range(4)])
     # the reference is also a candidate: its distance to itself is 0
     data = statistics.main(["--catalogs", str(ref), str(cand), str(ref), "--name", "tol", "--out", str(tmp_path)])
     assert sorted(data) == ["tol_N30_b20", "tol_N30_b50"]
@@ -123,8 +132,8 @@ def test_statistics_from_catalogs(tmp_path, capsys):
         assert json.loads((tmp_path / f"{stem}.json").read_text())["rows"] == json.loads(json.dumps(d["rows"]))
         assert (tmp_path / f"{stem}.png").stat().st_size > 10_000
         r, c, self_ = d["rows"]
-        assert [x["setting"] for x in d["rows"]] == ["ark4:rtol=1e-6", "ark4:rtol=1e-3", "ark4:rtol=1e-6"]
-        assert r["events"] == c["events"] == self_["events"] == 600
+        assert [x["setting"] for x in d["rows"]] == ["ark4:rtol=1e-5", "ark4:rtol=1e-3", "ark4:rtol=1e-5"]
+        assert r["events"] == c["events"] == self_["events"] == 300
         # the reference's samples are its catalog's: mu and the recurrence times by their definition
         rows = np.flatnonzero(tasks["b"] == b)
         mine = np.isin(events["task"], rows)
@@ -138,7 +147,7 @@ def test_statistics_from_catalogs(tmp_path, capsys):
             assert 0 <= c[key] and (c[key] <= 1 if key.startswith("ks") else np.isfinite(c[key]))
         assert c["ks_mu"] > 0 and c["w1_tnu"] > 0
         text = (tmp_path / f"{stem}.txt").read_text()
-        assert f"b = {b}," in text and "ark4:rtol=1e-3" in text and "600 / 600" in text
+        assert f"b = {b}," in text and "ark4:rtol=1e-3" in text and "300 / 300" in text
         assert "the reference's root seed" not in text.split("ark4:rtol=1e-3")[-1].splitlines()[0]
     labelled = statistics.main(["--catalogs", str(ref), str(cand), "--label", "tight", "loose",
                                 "--out", str(tmp_path)])
@@ -158,7 +167,8 @@ def test_catalog_labels():
 
 
 def test_cost_scaling_tiny(tmp_path):
-    data = cost_scaling.main(["--runs", "rk4:dt=1e-3", "--Ns", "40", "80", "--bs", "20", "30", "--N-at", "40",
+    # the aging law's own method (exp4), a fraction of rk4's time: the cost classes are the same
+    data = cost_scaling.main(["--runs", "exp4:rtol=1e-4", "--Ns", "40", "80", "--bs", "20", "30", "--N-at", "40",
                               "--events", "60", "--min-transient", "40", "--out", str(tmp_path)])
     assert (tmp_path / "cost_scaling.png").stat().st_size > 0
     points = data["points"]
@@ -268,14 +278,17 @@ def test_paired_tiny(tmp_path):
 
 
 def test_revisions_tiny(tmp_path):
-    from .test_summary_identity import CATALOG, gunzip
-    cat = gunzip(CATALOG, tmp_path / "catalog.h5")
+    # a command that writes which package it ran: the same check as a reduction (as in docs/benchmarks.md), which
+    # took 13 s here (four of them, and the revision's fresh checkout compiles its analysis kernels first)
+    which = "import sys, ensemble; open(sys.argv[1], 'w').write(ensemble.__file__)"
     data = revisions.main(["--before", "HEAD", "--rounds", "1", "--cpu", "-1", "--name", "t", "--out", str(tmp_path),
-                           "--", "python", "-m", "analysis", "reduce", str(cat), "-o", str(tmp_path / "{side}.h5"),
-                           "--force"])
+                           "--", "python", "-c", which, str(tmp_path / "{side}.txt")])
     (now, _), (before, _) = data["cost"]["now"][0], data["cost"]["before"][0]
     assert now > 0 and before > 0 and data["cpu_ratios"] == [now / before]
-    assert (tmp_path / "before.h5").is_file() and (tmp_path / "now.h5").is_file()
+    # each side ran its own checkout's code: this one's, and that of the revision's worktree
+    ran = {side: Path((tmp_path / f"{side}.txt").read_text()) for side in ("before", "now")}
+    assert ran["now"] == revisions.ROOT / "ensemble" / "__init__.py"
+    assert ran["before"].parts[-2:] == ("ensemble", "__init__.py") and revisions.ROOT not in ran["before"].parents
     assert "cpu ratio now / before" in (tmp_path / "revisions_t.txt").read_text()
     assert str(tmp_path) not in subprocess.run(["git", "worktree", "list"], capture_output=True, text=True,
                                                cwd=revisions.ROOT).stdout   # its checkout of HEAD removed
@@ -318,16 +331,21 @@ def test_transient_finds_a_known_drift():
 
 def test_transient_tiny(tmp_path):
     from benchmarks import transient
+    from ensemble.store import reader
+    from .catalog_writer import write_events
     from .conftest import run_cli, write_config
     cfg = write_config(tmp_path / "t.toml", model={"N": 30, "b": 50.0},
-                       run={"events": 2000, "transient": 0, "seeds": 2}, integrator={"method": "ark4"})
+                       run={"events": 500, "transient": 0, "seeds": 2})
     assert run_cli("run", cfg, "-o", tmp_path / "t.h5").returncode == 0
-    transient.main([str(tmp_path / "t.h5"), "--window", "200", "--out", str(tmp_path)])
+    transient.main([str(tmp_path / "t.h5"), "--window", "50", "--out", str(tmp_path)])
     rows = json.loads((tmp_path / "transient.json").read_text())
-    assert len(rows) == 1 and len(rows[0]["ks"]) == 10 and rows[0]["end_events"] % 200 == 0
+    assert len(rows) == 1 and len(rows[0]["ks"]) == 10 and rows[0]["end_events"] % 50 == 0
     assert (tmp_path / "transient.png").stat().st_size > 10_000
-    cfg = write_config(tmp_path / "u.toml", model={"N": 30}, run={"events": 50, "transient": 10, "seeds": 2})
-    assert run_cli("run", cfg, "-o", tmp_path / "u.h5").returncode == 0
+    # a catalog of a run with a transient (its first events, through the project's writer): refused
+    events, _, _ = reader.read(tmp_path / "t.h5")
+    cfg = write_config(tmp_path / "u.toml", model={"N": 30, "b": 50.0}, run={"events": 5, "transient": 10, "seeds": 2})
+    write_events(tmp_path / "u.h5", cfg.read_text(),
+                 [{c: v[events["task"] == k][:5] for c, v in events.items()} for k in (0, 1)])
     with pytest.raises(SystemExit, match="run.transient is 10"):
         transient.main([str(tmp_path / "u.h5"), "--out", str(tmp_path)])
 

@@ -1,12 +1,20 @@
 """The friction-law comparison (analysis/compare.py): its estimators on known answers, then the
-command on small runs of both laws, checked against the catalogs' events directly."""
+command on small runs of both laws, checked against the catalogs' events directly.
+
+The runs are processes of their own (`python -m ensemble run`); the analysis commands run in this
+process (analysis.cli.main, which `python -m analysis` calls), but one that checks the exit code and
+message of the command itself: a process costs about 2.5 s of imports, more than the work here."""
+import contextlib
+import io
 import json
 import math
+import subprocess
 import sys
 
 import numpy as np
 import pytest
 
+from analysis import cli
 from analysis import compare as cmp
 from ensemble.store import reader, schema
 
@@ -94,20 +102,32 @@ def test_recurrence_numbers_of_poisson_and_periodic_times():
 
 @pytest.fixture(scope="module")
 def two_laws(tmp_path_factory):
-    """A Carlson-Langer run (N = 50, 2 seeds x 3000 events) and an aging run (N = 50, 2 x 300)."""
+    """A Carlson-Langer run (N = 50, 2 seeds x 3000 events) and an aging run (N = 50, 2 x 300, the law's
+    own method)."""
     d = tmp_path_factory.mktemp("compare")
     cl = write_cl_config(d / "cl.toml")
     aging = write_config(d / "aging.toml", model={"N": 50, "b": 20.0},
-                         run={"events": 300, "transient": 50, "seeds": 2},
-                         integrator={"method": "ark4"})
+                         run={"events": 300, "transient": 50, "seeds": 2})
     for cfg in (cl, aging):
         res = run_cli("run", cfg, "-o", cfg.with_suffix(".h5"))
         assert res.returncode == 0, res.stderr
     return d, [cl.with_suffix(".h5"), aging.with_suffix(".h5")]
 
 
-def analysis(*args):
+def analysis_process(*args):
+    """`python -m analysis ARGS` in a process of its own."""
     return run_bounded([sys.executable, "-m", "analysis", *map(str, args)], 300, env=child_env())
+
+
+def analysis(*args):
+    """`python -m analysis ARGS` run by analysis.cli.main in this process (argparse's own errors exit)."""
+    stdout, stderr = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
+        try:
+            code = cli.main([str(a) for a in args])
+        except SystemExit as done:
+            code = done.code
+    return subprocess.CompletedProcess(["python -m analysis", *args], code, stdout.getvalue(), stderr.getvalue())
 
 
 def brute_force(events, n_large, window):
@@ -155,7 +175,7 @@ def test_compare_refuses_to_overwrite_and_bad_options(two_laws, tmp_path):
     out = tmp_path / "cmp"
     assert analysis("compare", paths[0], "-o", out, "--bootstrap", "5", "--n-large", "5").returncode == 0
     before = (out / "comparison.md").read_text()
-    res = analysis("compare", paths[1], "-o", out, "--bootstrap", "5", "--n-large", "5")
+    res = analysis_process("compare", paths[1], "-o", out, "--bootstrap", "5", "--n-large", "5")
     assert res.returncode == 2 and res.stderr.strip().count("\n") == 0   # a usage error, as in `ensemble run`
     assert "comparison.md: comparison file exists (use --force" in res.stderr
     assert (out / "comparison.md").read_text() == before

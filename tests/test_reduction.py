@@ -9,18 +9,28 @@ boundary ruptures, empty and partly written tasks. The reference (tests/reductio
 shares no code with analysis/. Intervals: the summary's equal the documented percentiles of
 the same bootstrap resamples, and the percentile interval has its nominal coverage, tightly
 enough to tell 95% from 97.5%.
+
+The reductions run in this process (analysis.cli.main, as `python -m analysis reduce` calls it), but
+those under `mpiexec -n 2`: a process of its own costs about 2.5 s of imports, more than the
+reduction of these catalogs. The plain reference costs most of this file's time (it grows with the
+square of a task's events): the catalogs hold 400 events a task where their edges need them, fewer
+where only their count of seeds or tasks matters.
 """
+import contextlib
+import functools
+import io
 import math
 import os
 import re
 import shutil
+import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from analysis import stats
+from analysis import cli, reduce, stats
 from ensemble.store import reader, schema
 from ensemble.config import loads
 from ensemble.sweep import task_list
@@ -30,16 +40,17 @@ from .catalog_writer import write_events
 from .processes import run_bounded
 
 ROOT = Path(__file__).resolve().parents[1]
-TIMEOUT = 300   # seconds for one reduction subprocess (they take a few)
+TIMEOUT = 300   # seconds for one reduction under mpiexec (they take a few)
 LOG10_E = math.log10(math.e)
 
 N_CHAIN = 40
 OPT = {"mu_bins": (-1.0, 7.0, 32),     # width 0.25: magnitudes on the 0.25 grid sit on edges
        "tnu_bins": (0.0, 40.0, 40),    # width 1: grid times give T nu on the edges
-       "mu_c": 4.0, "window": 3, "b_cut": 3.0, "bootstrap": 200, "seed": 11}
+       "mu_c": 4.0, "window": 3, "b_cut": 3.0, "bootstrap": 100, "seed": 11}
 
 # `python -m analysis reduce` with the rows streamed in chunks of argv[1] events (reduce.Options.chunk
-# has no command-line option): small chunks make recurrences straddle them
+# has no command-line option): small chunks make recurrences straddle them (reduce_here: the same in this
+# process)
 REDUCE = ("import sys; from functools import partial; from analysis import cli, reduce; "
           "cli.Options = partial(reduce.Options, chunk=int(sys.argv[1])); sys.exit(cli.main(sys.argv[2:]))")
 
@@ -61,6 +72,26 @@ def run(cmd):
                NUMBA_CACHE_DIR=os.environ.get("NUMBA_CACHE_DIR", str(ROOT / ".numba_cache")))
     res = run_bounded(cmd, TIMEOUT, cwd=ROOT, env=env)
     assert res.returncode == 0, res.stderr
+    return res
+
+
+def reduce_here(chunk, paths, out, level, blocks, partial=True, check=True):
+    """reduce_command's reduction run by analysis.cli.main in this process, as REDUCE runs it (the
+    rows streamed in chunks of `chunk`); without --partial if not `partial`. A CompletedProcess with its
+    exit code (which must be 0 if `check`) and what it printed."""
+    args = reduce_command(chunk, paths, out, level, blocks)[4:]       # past python -c REDUCE chunk
+    if not partial:
+        args.remove("--partial")
+    stdout, stderr = io.StringIO(), io.StringIO()
+    options = cli.Options
+    cli.Options = functools.partial(reduce.Options, chunk=chunk)
+    try:
+        with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
+            code = cli.main(args)
+    finally:
+        cli.Options = options
+    res = subprocess.CompletedProcess(args, code, stdout.getvalue(), stderr.getvalue())
+    assert not check or code == 0, res.stderr
     return res
 
 
@@ -119,22 +150,25 @@ N = {N}
 {sweep}
 [run]
 seeds = {seeds}
-events = 400
+events = {events}
 transient = 5
 seed = {seed}
 """
+# run.events of each catalog: 400 where the edges need them, fewer where only the count of seeds or tasks
+# matters (the reference's time grows with the square of a task's events); below, the events written of each task
+EVENTS = {"seeds": 400, "blocks": 400, "pairs": 400, "ten": 100, "more": 200, "whole": 200}
 # four points x three seeds: an empty task (never committed), a partly written one, a tiny one
 SEEDS_WRITTEN = [400, 400, 400, 400, 0, 250, 400, 400, 3, 400, 137, 400]
 # three points x one seed: block bootstrap over stretches, one task shorter than the stretches, one empty
 BLOCKS_WRITTEN = [400, 5, 0]
 # two points x ten seeds (the fewest that resample seeds), one empty, one short
-TEN_WRITTEN = [400, 400, 0, 400, 400, 400, 400, 400, 400, 400, 400, 400, 400, 400, 60, 400, 400, 400, 400, 400]
+TEN_WRITTEN = [100, 100, 0, 100, 100, 100, 100, 100, 100, 100, 100, 100, 100, 100, 15, 100, 100, 100, 100, 100]
 # two points x two seeds, one of them empty: the stretches of both are resampled
 PAIRS_WRITTEN = [400, 220, 0, 400]
-# merged with "seeds" (another root seed): point nu = 1 pools with the first point of "seeds"
-MORE_WRITTEN = [400, 90, 400, 400]
+# merged with "ten" (another root seed): point nu = 1 pools with the first point of "ten"
+MORE_WRITTEN = [200, 45, 200, 200]
 # every task finished (a complete run)
-WHOLE_WRITTEN = [400, 400]
+WHOLE_WRITTEN = [200, 200]
 
 
 @pytest.fixture(scope="module")
@@ -149,8 +183,8 @@ def catalogs(tmp_path_factory):
             ("more", "nu = [2.0, 1.0]", 2, 5, MORE_WRITTEN),
             ("whole", "nu = [3.0]", 2, 7, WHOLE_WRITTEN)):
         path = d / f"{name}.h5"
-        events = write_catalog(path, CONFIG.format(N=N_CHAIN, sweep=sweep, seeds=seeds, seed=root), written,
-                               seed=len(name) + root)
+        text = CONFIG.format(N=N_CHAIN, sweep=sweep, seeds=seeds, seed=root, events=EVENTS[name])
+        events = write_catalog(path, text, written, seed=len(name) + root)
         made[name] = (path, events)
     return d, made
 
@@ -243,7 +277,7 @@ def summaries(catalogs, references):
         if (case, chunk) not in made:
             path, _, opt, exp = references[case]
             out = catalogs[0] / f"{case}_{chunk}.summary.h5"
-            res = run(reduce_command(chunk, path, out, opt["level"], opt["blocks"]))
+            res = reduce_here(chunk, path, out, opt["level"], opt["blocks"])
             # reduce warns on stderr for exactly the points with fewer than 10 units
             warned = re.findall(r"^warning: point (\d+) \(.*: intervals unreliable: (\d+) resampling units?",
                                 res.stderr, re.M)
@@ -270,7 +304,7 @@ def test_report_states_every_number_and_the_level(references, summaries):
     text = report.table(s)
     # the catalog holds unfinished tasks (reduced with --partial): the first line says so
     assert text.splitlines()[0] == s["attrs"]["partial"] != ""
-    assert "90% intervals from 200 bootstrap resamples" in text.splitlines()[1]
+    assert f"90% intervals from {OPT['bootstrap']} bootstrap resamples" in text.splitlines()[1]
     blocks = text.split("\npoint ")[1:]
     assert len(blocks) == 3
     number = r"-?\d+(?:\.\d*)?(?:e[-+]\d+)?|nan"
@@ -330,12 +364,6 @@ def merged_reference(catalogs, names, level=0.9, blocks=5):
     return [p for p, _, _ in inputs], opt, ref.expected_summary(inputs, opt)
 
 
-def run_status(cmd):
-    env = dict(os.environ, PYTHONPATH=str(ROOT),
-               NUMBA_CACHE_DIR=os.environ.get("NUMBA_CACHE_DIR", str(ROOT / ".numba_cache")))
-    return run_bounded(cmd, TIMEOUT, cwd=ROOT, env=env)
-
-
 @pytest.fixture(scope="module")
 def merges(catalogs):
     """merge_of(names): (path of the summary of the named catalogs reduced together, reduced once
@@ -346,21 +374,25 @@ def merges(catalogs):
         if names not in made:
             paths, opt, exp = merged_reference(catalogs, names)
             out = catalogs[0] / ("-".join(names) + ".summary.h5")
-            run(reduce_command(13, paths, out, opt["level"], opt["blocks"]))
+            reduce_here(13, paths, out, opt["level"], opt["blocks"])
             made[names] = out, opt, exp
         return made[names]
     return merge_of
 
 
-@pytest.mark.parametrize("names", [("seeds", "more"), ("more", "seeds")])
+@pytest.mark.parametrize("names", [("ten", "more"), ("more", "ten")])
 def test_merged_catalogs_equal_brute_force(merges, names):
-    """Two catalogs (root seeds 0 and 5) reduced together: point (nu = 1, b = 20) pools three
+    """Two catalogs (root seeds 3 and 5) reduced together: point (nu = 1, b = 20) pools ten
     tasks of one with two of the other, the other points stand side by side in the order of
-    first appearance; every dataset against the reference, in both orders of the catalogs."""
+    first appearance; every dataset against the reference, in both orders of the catalogs.
+    (Stretches of tasks of two catalogs pooled: test_mpi_merge_equals_brute_force, and
+    test_analysis.py's merged catalogs.)"""
     out, opt, exp = merges(names)
     pooled = [i for i in range(len(exp["points/nu"])) if exp["points/nu"][i] == 1.0 and exp["points/b"][i] == 20.0]
-    # five tasks, fewer than ten: 5 stretches of each
-    assert len(pooled) == 1 and exp["points/units"][pooled[0]] == 25 and len(exp["points/nu"]) == 5
+    # twelve tasks, at least ten: the tasks are the units (in the order of their streams); the point nu = 2
+    # of "more" alone has two: 5 stretches of each
+    assert len(pooled) == 1 and len(exp["points/nu"]) == 3
+    assert exp["points/units"][pooled[0]] == 12 and list(exp["points/method"]).count("blocks") == 1
     ref.check_summary(ref.read_summary(out), exp, opt)
 
 
@@ -368,7 +400,7 @@ def test_a_point_does_not_depend_on_the_order_of_the_catalogs(merges):
     """The pooled point's tasks, streams, numbers, curves, intervals and peaks are the same
     whichever catalog comes first (its units in stream order, its bootstrap keyed on its
     parameters), though it is point 0 in one summary and point 1 in the other."""
-    one, two = (ref.read_summary(merges(names)[0]) for names in (("seeds", "more"), ("more", "seeds")))
+    one, two = (ref.read_summary(merges(names)[0]) for names in (("ten", "more"), ("more", "ten")))
 
     def pooled(s):
         return int(np.flatnonzero((s["points/nu"] == 1.0) & (s["points/b"] == 20.0))[0])
@@ -380,7 +412,7 @@ def test_a_point_does_not_depend_on_the_order_of_the_catalogs(merges):
         np.testing.assert_array_equal(one[key][i], two[key][j], err_msg=key)
     streams = [sorted(zip(s["tasks/seed_entropy"][s["tasks/point"] == p], s["tasks/spawn_key"][s["tasks/point"] == p]))
                for s, p in ((one, i), (two, j))]
-    assert streams[0] == streams[1] == [(0, 0), (0, 1), (0, 2), (5, 2), (5, 3)]
+    assert streams[0] == streams[1] == [(3, k) for k in range(10)] + [(5, 2), (5, 3)]
 
 
 @pytest.mark.mpi
@@ -406,7 +438,7 @@ def test_the_same_trajectory_twice_is_refused(catalogs):
                          ([seeds, f"{d}/./seeds.h5"], f"{d}/./seeds.h5 is given twice (also as {seeds}): "
                                                       "give each catalog once")):
         out = d / "refused.summary.h5"
-        res = run_status(reduce_command(64, paths, out, 0.95, 3))
+        res = reduce_here(64, paths, out, 0.95, 3, check=False)
         lines = res.stderr.strip().splitlines()
         assert res.returncode == 2 and lines == [f"error: {words}"], res.stderr
         assert not out.exists() and not res.stdout
@@ -421,32 +453,32 @@ def test_unfinished_runs_need_partial_and_say_so(catalogs):
     d, made = catalogs
     whole = made["whole"][0]
     named = shutil.copy(whole, d / "whole2.h5.partial")    # every task finished, name unfinished
-    for path, what in ((made["seeds"][0], "4 of 12 tasks unfinished"), (named, "named *.partial")):
-        cmd = [c for c in reduce_command(64, path, d / "x.summary.h5", 0.95, 3) if c != "--partial"]
-        res = run_status(cmd)
+    for path, what in ((made["pairs"][0], "2 of 4 tasks unfinished"), (named, "named *.partial")):
+        res = reduce_here(64, path, d / "x.summary.h5", 0.95, 3, partial=False, check=False)
         assert res.returncode == 1 and res.stderr.strip().splitlines() == [
             f"error: {path} is an unfinished run ({what}); continue it with `python -m ensemble resume "
             f"{str(path).removesuffix('.partial')}`, or reduce what it holds with --partial"], res.stderr
         assert not (d / "x.summary.h5").exists()
     # with --partial: both reduced as far as written; the statement names them
-    paths = [made["seeds"][0], named]
+    paths = [made["pairs"][0], named]
     opt = options(0.9, 5)
     exp = ref.expected_summary([(p, *reader.read(p)[:2]) for p in paths], opt)
-    written, expected = sum(SEEDS_WRITTEN) + 2 * 400, 12 * 400 + 2 * 400
+    written = sum(PAIRS_WRITTEN) + sum(WHOLE_WRITTEN)
+    expected = len(PAIRS_WRITTEN) * EVENTS["pairs"] + len(WHOLE_WRITTEN) * EVENTS["whole"]
     assert exp["partial"] == (written, expected, [str(p) for p in paths])
     out = d / "partial.summary.h5"
-    res = run(reduce_command(64, paths, out, opt["level"], opt["blocks"]))
+    res = reduce_here(64, paths, out, opt["level"], opt["blocks"])
     ref.check_summary(ref.read_summary(out), exp, opt)
     s = summary.read(out)
     statement = s["attrs"]["partial"]
     head = f"PARTIAL reduction of unfinished runs: {written} of {expected} events ({100 * written / expected:.1f}%)"
-    assert statement == f"{head}; {paths[0]} (4 of 12 tasks unfinished), {named} (all tasks finished)"
+    assert statement == f"{head}; {paths[0]} (2 of 4 tasks unfinished), {named} (all tasks finished)"
     assert res.stdout.splitlines()[0] == statement
     assert report.table(s).splitlines()[0] == statement
     assert plot.title_text([s], ["partial"]).splitlines()[1] == head
     # a complete run: no --partial needed, nothing said
     out = d / "whole.summary.h5"
-    res = run_status([c for c in reduce_command(64, whole, out, 0.95, 3) if c != "--partial"])
+    res = reduce_here(64, whole, out, 0.95, 3, partial=False)
     assert res.returncode == 0, res.stderr
     s = summary.read(out)
     assert s["attrs"]["partial"] == "" and not report.table(s).startswith("PARTIAL")
