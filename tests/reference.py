@@ -19,7 +19,7 @@ def displacements_for(force, t, model):
     return np.linalg.solve(A, model.nu * t - model.c - np.asarray(force))
 
 
-@nb.njit
+@nb.njit(cache=True)
 def _rates(t, u, v, psi, moving, nu, l2, a, b, c, du, dv, dpsi):
     n = u.shape[0]
     for i in range(n):
@@ -36,7 +36,7 @@ def _rates(t, u, v, psi, moving, nu, l2, a, b, c, du, dv, dpsi):
             dpsi[i] = np.exp(-psi[i])
 
 
-@nb.njit
+@nb.njit(cache=True)
 def _event(t, u, v, psi, moving, nu, l2, a, b, c, dt, max_steps):
     n = u.shape[0]
     k = [np.zeros((3, n)) for _ in range(4)]

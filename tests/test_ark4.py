@@ -1,4 +1,5 @@
 """The adaptive IMEX integrator ARK4(3): its tableau, error against the tolerance, energy, CLI."""
+import functools
 from fractions import Fraction
 
 import numba as nb
@@ -34,42 +35,61 @@ def power(x, k):
     return [xi ** k for xi in x]
 
 
+def times(u, w):
+    return [x * y for x, y in zip(u, w)]
+
+
 def order_residuals(b, c, tableaux, order):
     """Residuals of the order conditions up to `order` (at most 5) of an additive RK method.
 
     All tableaux share b and c (row sums), so the conditions are those of the
-    trees with every colouring of their inner nodes by a tableau.
+    trees with every colouring of their inner nodes by a tableau. (The vectors A c, A c^2 and
+    A B c are formed once and shared between the trees that contain them: exact fractions with
+    13-digit numerators are slow.)
     """
     out = {"b.1": dot(b, [1] * len(b)) - 1}
     if order >= 2:
         out["b.c"] = dot(b, c) - Fraction(1, 2)
-    if order >= 3:
-        out["b.c2"] = dot(b, power(c, 2)) - Fraction(1, 3)
-        for p, A in tableaux.items():
-            out[f"b.{p}c"] = dot(b, mul(A, c)) - Fraction(1, 6)
-    if order >= 4:
-        out["b.c3"] = dot(b, power(c, 3)) - Fraction(1, 4)
-        for p, A in tableaux.items():
-            out[f"b.(c*{p}c)"] = dot(b, [ci * x for ci, x in zip(c, mul(A, c))]) - Fraction(1, 8)
-            out[f"b.{p}c2"] = dot(b, mul(A, power(c, 2))) - Fraction(1, 12)
-            for q, B in tableaux.items():
-                out[f"b.{p}{q}c"] = dot(b, mul(A, mul(B, c))) - Fraction(1, 24)
-    if order >= 5:
-        def times(u, w):
-            return [x * y for x, y in zip(u, w)]
-        out["b.c4"] = dot(b, power(c, 4)) - Fraction(1, 5)
-        for p, A in tableaux.items():
-            out[f"b.(c2*{p}c)"] = dot(b, times(power(c, 2), mul(A, c))) - Fraction(1, 10)
-            out[f"b.(c*{p}c2)"] = dot(b, times(c, mul(A, power(c, 2)))) - Fraction(1, 15)
-            out[f"b.{p}c3"] = dot(b, mul(A, power(c, 3))) - Fraction(1, 20)
-            for q, B in tableaux.items():
-                out[f"b.(c*{p}{q}c)"] = dot(b, times(c, mul(A, mul(B, c)))) - Fraction(1, 30)
-                out[f"b.({p}c*{q}c)"] = dot(b, times(mul(A, c), mul(B, c))) - Fraction(1, 20)
-                out[f"b.{p}(c*{q}c)"] = dot(b, mul(A, times(c, mul(B, c)))) - Fraction(1, 40)
-                out[f"b.{p}{q}c2"] = dot(b, mul(A, mul(B, power(c, 2)))) - Fraction(1, 60)
-                for r, C in tableaux.items():
-                    out[f"b.{p}{q}{r}c"] = dot(b, mul(A, mul(B, mul(C, c)))) - Fraction(1, 120)
+    if order < 3:
+        return out
+    c2 = power(c, 2)
+    Ac = {p: mul(A, c) for p, A in tableaux.items()}
+    out["b.c2"] = dot(b, c2) - Fraction(1, 3)
+    for p in tableaux:
+        out[f"b.{p}c"] = dot(b, Ac[p]) - Fraction(1, 6)
+    if order < 4:
+        return out
+    Ac2 = {p: mul(A, c2) for p, A in tableaux.items()}
+    ABc = {(p, q): mul(A, Ac[q]) for p, A in tableaux.items() for q in tableaux}
+    out["b.c3"] = dot(b, power(c, 3)) - Fraction(1, 4)
+    for p in tableaux:
+        out[f"b.(c*{p}c)"] = dot(b, times(c, Ac[p])) - Fraction(1, 8)
+        out[f"b.{p}c2"] = dot(b, Ac2[p]) - Fraction(1, 12)
+        for q in tableaux:
+            out[f"b.{p}{q}c"] = dot(b, ABc[p, q]) - Fraction(1, 24)
+    if order < 5:
+        return out
+    out["b.c4"] = dot(b, power(c, 4)) - Fraction(1, 5)
+    for p, A in tableaux.items():
+        out[f"b.(c2*{p}c)"] = dot(b, times(c2, Ac[p])) - Fraction(1, 10)
+        out[f"b.(c*{p}c2)"] = dot(b, times(c, Ac2[p])) - Fraction(1, 15)
+        out[f"b.{p}c3"] = dot(b, mul(A, power(c, 3))) - Fraction(1, 20)
+        for q in tableaux:
+            out[f"b.(c*{p}{q}c)"] = dot(b, times(c, ABc[p, q])) - Fraction(1, 30)
+            out[f"b.({p}c*{q}c)"] = dot(b, times(Ac[p], Ac[q])) - Fraction(1, 20)
+            out[f"b.{p}(c*{q}c)"] = dot(b, mul(A, times(c, Ac[q]))) - Fraction(1, 40)
+            out[f"b.{p}{q}c2"] = dot(b, mul(A, Ac2[q])) - Fraction(1, 60)
+            for r in tableaux:
+                out[f"b.{p}{q}{r}c"] = dot(b, mul(A, ABc[q, r])) - Fraction(1, 120)
     return out
+
+
+@functools.cache
+def residuals(pair, embedded, order):
+    """order_residuals up to `order` of an ArkPair's weights b, or bhat if `embedded`: once per pair, order and
+    weights (the test of mistyped digits reads them twice)."""
+    c, ae, ai, b, bhat = pair.matrices()
+    return order_residuals(bhat if embedded else b, c, {"E": ae, "I": ai}, order)
 
 
 def violations(pair):
@@ -85,12 +105,11 @@ def violations(pair):
         out.append("implicit tableau not ESDIRK")
     if ai[-1] != b:
         out.append("implicit tableau not stiffly accurate")
-    tableaux = {"E": ae, "I": ai}
-    for weights, order in ((b, pair.order), (bhat, pair.embedded_order)):
+    for embedded, order in ((False, pair.order), (True, pair.embedded_order)):
         out += [f"order {order}: {k} = {float(r):.1e}"
-                for k, r in order_residuals(weights, c, tableaux, order).items() if abs(r) > TOL]
+                for k, r in residuals(pair, embedded, order).items() if abs(r) > TOL]
     # the embedded method is of order q, not q + 1 (else the estimate would vanish)
-    if max(abs(r) for r in order_residuals(bhat, c, tableaux, pair.order).values()) < 1e-4:
+    if max(abs(r) for r in residuals(pair, True, pair.order).values()) < 1e-4:
         out.append("embedded method of the same order")
     return out
 
@@ -135,8 +154,8 @@ def test_a_mistyped_digit_is_caught(pair):
     def worst(p):
         c, ae, ai, b, bhat = p.matrices()
         rows = [abs(sum(A[i]) - c[i]) for A in (ae, ai) for i in range(len(c))]
-        rows += [abs(r) for w, o in ((b, p.order), (bhat, p.embedded_order))
-                 for r in order_residuals(w, c, {"E": ae, "I": ai}, o).values()]
+        rows += [abs(r) for embedded, o in ((False, p.order), (True, p.embedded_order))
+                 for r in residuals(p, embedded, o).values()]
         rows += [abs(ai[-1][j] - b[j]) for j in range(len(b))]
         return max(rows)
     print(f"{pair.name}: smallest largest residual of a mutant {float(min(worst(m) for m in mutants)):.1e}")
@@ -172,10 +191,11 @@ def test_kernel_arrays_are_the_tableau():
     np.testing.assert_allclose(bd, np.array(bf, dtype=float) - np.array(bhatf, dtype=float), atol=1e-16)
 
 
-@nb.njit
+@nb.njit(cache=True)
 def step(W, act, na, n, tau, h, p, yrest):
     """One step of the method p.method (the kernels' call, methods.take_step, every stage evaluated):
-    (friction work, slip integral, error norm)."""
+    (friction work, slip integral, error norm). Cached with the kernels (in the directory named after their
+    sources, so a change to them compiles it again): compiling it took about 20 s."""
     return take_step(W, act, na, n, tau, h, p, yrest, FIRST_NEW, (0.0, 0.0))[:3]
 
 

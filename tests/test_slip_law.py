@@ -38,14 +38,15 @@ def engine(n, a, nu, rows, psi0):
     return t, d
 
 
-@pytest.mark.parametrize("nu", [1e-3, 1e-4, 1e-5])
+@pytest.mark.parametrize("nu", [1e-3, 1e-5])
 def test_a_single_block_cycles_as_the_full_equations(nu):
     """N = 1, b = 20, a = 1: every cycle (reload, creep, inertial event) is the same from the second on, in
     both. Period (= slip per cycle / nu: the loader's work), the creep's duration and the event's
     start within 5e-5 relative of the full equations; the creep's slip inside the reference's bracket
-    of the hand-over (measured at 1e-3 .. 1e-5: period 3.8e-5, 2e-7, 5.7e-6; creep duration 1.9e-5,
-    1.0e-5, 1.4e-5)."""
-    log = slip_law_chain(1, L, 1.0, B, nu, np.inf, max_sticks=3, rtol=1e-8, atol=1e-10)
+    of the hand-over (measured at nu = 1e-3 and 1e-5: period 8.2e-6 and 6.2e-6; creep duration -4.1e-5 and
+    1.4e-5; 1e-4, between them, gave 7.0e-6 and 8.1e-6). The reference at rtol 1e-7 moves these by at most
+    2e-9 from rtol 1e-8."""
+    log = slip_law_chain(1, L, 1.0, B, nu, np.inf, max_sticks=3, rtol=1e-7, atol=1e-10)
     lo, hi = single_block_cycles(log, 1e-2), single_block_cycles(log, 1.0)
     ref_period = lo[2, 4] - lo[1, 4]
     ref_slip = log[-1][3][0] - [r for r in log if r[1] == "stick"][-2][3][0]
@@ -81,20 +82,22 @@ def test_two_blocks_first_cycle_as_the_full_equations():
 
 
 def test_three_blocks_cycle_as_the_full_equations():
-    """N = 3, l = 3, a = 1, nu = 1e-3, psi0 = (0, 0.3, 0.6): eight system-wide events, their onsets and slips
+    """N = 3, l = 3, a = 1, nu = 1e-3, psi0 = (0, 0.3, 0.6): five system-wide events, their onsets and slips
     within 1e-4 relative of the full equations (measured: onsets 4.4e-5 at the first, 1.0e-5 after; slips
-    3.6e-5), while the cycle's slip per event alternates about its steady value by up to 12 %. Every event is
-    handed over by a creeping cluster: an epicenter that entered the event from rest instead of its creep
-    velocity put the onsets 1.6 % off (and the steady slip per event 11 % short)."""
+    3.6e-5), while the cycle's slip per event alternates about its steady value (about 1555) by up to 12 %:
+    1678, 1657, 1475, 1607, 1517 (events six to eight, 1582, 1534, 1569, agreed as closely when checked:
+    onsets to 1.1e-5, slips to 2.6e-5). Every event is handed over by a creeping cluster: an epicenter that
+    entered the event from rest instead of its creep velocity put the onsets 1.6 % off (and the steady slip
+    per event 11 % short). The reference at rtol 1e-7 moves the errors by at most 3e-8 from rtol 1e-8."""
     psi0 = [0.0, 0.3, 0.6]
-    log = slip_law_chain(3, L, 1.0, B, 1e-3, np.inf, psi0=psi0, max_sticks=27, rtol=1e-8, atol=1e-10)
-    ref = np.array([r[:2] for r in inertial_events(log, 3)])[:8]
-    assert len(ref) == 8
+    log = slip_law_chain(3, L, 1.0, B, 1e-3, np.inf, psi0=psi0, max_sticks=15, rtol=1e-7, atol=1e-10)
+    ref = np.array([r[:2] for r in inertial_events(log, 3)])[:5]
+    assert len(ref) == 5
     t, d = engine(3, 1.0, 1e-3, 40, psi0)
     ev = d[:, D_KIND] == KIND_EVENT
-    assert ev.sum() >= 8
-    np.testing.assert_allclose(t[ev][:8], ref[:, 0], rtol=1e-4)
-    np.testing.assert_allclose(d[ev, D_SLIP][:8], ref[:, 1], rtol=1e-4)
+    assert ev.sum() >= 5
+    np.testing.assert_allclose(t[ev][:5], ref[:, 0], rtol=1e-4)
+    np.testing.assert_allclose(d[ev, D_SLIP][:5], ref[:, 1], rtol=1e-4)
 
 
 def test_two_blocks_at_the_paper_rate_alternate_without_small_events():
@@ -124,11 +127,12 @@ def test_two_blocks_at_the_paper_rate_alternate_without_small_events():
 
 @pytest.mark.parametrize("a", [0.0, 1.0])
 def test_a_hundred_blocks_at_the_paper_setting_creep_then_rupture_whole(a):
-    """N = 100, b = 20, nu = 1e-8, a = 0 and 1, 1500 rows from a loaded random state: the kernel runs through
+    """N = 100, b = 20, nu = 1e-8, a = 0 and 1, 600 rows from a loaded random state: the kernel runs through
     (no event left creeping inside the inertial integrator until max_duration, no creep-event ping-pong);
     every loaded block creeps before the chain ruptures, so at least 90 % of the rows are creep episodes,
     every episode ends taken over by an event, and every inertial event after the first is large
-    (mu >= 3.9: measured 4.44-4.92 at a = 0, 4.12-4.92 at a = 1; creep share 0.957 and 0.956)."""
+    (mu >= 3.9: measured 4.44-4.92 at a = 0 over 29 events, 4.12-4.92 at a = 1 over 28; creep share 0.952
+    and 0.953; 1500 rows gave the same ranges over 64 and 66 events)."""
     n, b, nu = 100, B, 1e-8
     p = kernel_params(Model(N=n, l=L, b=b, a=a, nu=nu, law="slip"), Integrator())
     rng = np.random.default_rng(1)
@@ -136,7 +140,7 @@ def test_a_hundred_blocks_at_the_paper_setting_creep_then_rupture_whole(a):
     ws = Workspace(n)
     ws.load(b * psi - 5 * rng.uniform(0, 1, n), psi)
     clock = np.zeros(2)
-    rows = 1500
+    rows = 600
     t, e, d = np.empty(rows), np.empty(rows, dtype=np.int64), np.empty((rows, NDIAG))
     status, k = simulate(ws.arrays, clock, p, rows, UNLIMITED, t, e, d)
     assert (status, k) == (OK, rows)

@@ -40,12 +40,13 @@ def test_best_seeds_trades_transients_against_parallelism():
 
 
 def test_a_tiny_run_measures_calibrates_and_writes(tmp_path):
+    """Calibration in this process, then three runs of `python -m ensemble` (the fixed cost, without and with
+    branching), each of a few seconds: mostly the start-up of a process."""
     cfg = write_config(tmp_path / "tiny.toml", model={"N": 30}, sweep={"b": [20.0, 50.0]},
-                       run={"events": 100, "transient": 60, "decorrelation": 20, "seeds": 2},
-                       integrator={"method": "ark4", "rtol": 1e-5})
+                       run={"events": 40, "transient": 20, "decorrelation": 10, "seeds": 2})
     out = tmp_path / "out"
-    assert tts.main(["--config", str(cfg), "--ranks", "1", "--seeds", "2", "--events", "400",
-                     "--project", "1", "4", "--full-events", "2000", "--calibrate", "100", "--out", str(out)]) == 0
+    assert tts.main(["--config", str(cfg), "--ranks", "1", "--seeds", "2", "--events", "80",
+                     "--project", "1", "4", "--full-events", "2000", "--calibrate", "20", "--out", str(out)]) == 0
     data = json.loads((out / "time_to_statistics.json").read_text())
     assert [c["point"] for c in data["costs"]] == [0, 1] and all(c["event"] > 0 for c in data["costs"])
     assert [(m["ranks"], m["branch"]) for m in data["measured"]] == [(1, False), (1, True)]
