@@ -32,9 +32,9 @@ os.environ["PATH"] = os.path.dirname(sys.executable) + os.pathsep + os.environ.g
 
 # -- the quick tier (`make quick`, `pytest -m quick`) -------------------------------------------
 # About a minute here (docs/tests.md) that touch every module of ensemble/ and analysis/: the
-# cheapest test, or few, of each layer (one case of a parametrized test: "test_x[its id]"). Named here rather than marked in each file, so that the tier
-# is one list to read. tests/test_quick_tier.py checks that every name exists and that every test
-# file is here or in NOT_QUICK, with the reason.
+# cheapest test, or few, of each layer (one case of a parametrized test: "test_x[its id]"). Named here
+# rather than marked in each file, so that the tier is one list to read. tests/test_quick_tier.py checks
+# that every name exists and that every test file is here or in NOT_QUICK, with the reason.
 QUICK = {
     "test_creep.py": ["test_a_cluster_too_soft_to_creep_hands_over_to_an_event",
                       "test_above_the_block_stiffness_nothing_creeps"],

@@ -140,25 +140,39 @@ def run_bounded(cmd, timeout, **kwargs):
     return subprocess.CompletedProcess(cmd, proc.returncode, out, err)
 
 
-def ensemble_here(*args):
-    """`python -m ensemble ARGS` run by ensemble.cli.main in this process (one rank): a CompletedProcess
-    with its exit code and what it printed. The handlers of the stop signals are put back afterwards
-    (a run leaves its own, which acknowledge a late signal instead of obeying it)."""
+def _here(package, main, args):
+    """`python -m PACKAGE ARGS` run by its `main` in this process: a CompletedProcess with its exit code
+    (argparse's own errors exit) and what it printed."""
     import contextlib
     import io
+    argv = [str(a) for a in args]
+    stdout, stderr = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
+        try:
+            code = main(argv)
+        except SystemExit as done:
+            code = done.code
+    return subprocess.CompletedProcess([f"python -m {package}", *argv], code, stdout.getvalue(), stderr.getvalue())
 
+
+def ensemble_here(*args):
+    """`python -m ensemble ARGS` run by ensemble.cli.main in this process (one rank). The handlers of the
+    stop signals are put back afterwards (a run leaves its own, which acknowledge a late signal instead of
+    obeying it)."""
     from ensemble import cli
     from ensemble.run.parallel import INTERRUPT_SIGNALS
-    argv = [str(a) for a in args]
     handlers = {sig: signal.getsignal(sig) for sig in INTERRUPT_SIGNALS}
-    stdout, stderr = io.StringIO(), io.StringIO()
     try:
-        with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
-            code = cli.main(argv)
+        return _here("ensemble", cli.main, args)
     finally:
         for sig, handler in handlers.items():
             signal.signal(sig, handler)
-    return subprocess.CompletedProcess(["python -m ensemble", *argv], code, stdout.getvalue(), stderr.getvalue())
+
+
+def analysis_here(*args):
+    """`python -m analysis ARGS` run by analysis.cli.main in this process."""
+    from analysis import cli
+    return _here("analysis", cli.main, args)
 
 
 def poll_until(condition, timeout):

@@ -4,17 +4,14 @@ several catalogs reduced together; figures of several summaries.
 The real catalog is reduced once by `python -m analysis reduce` and once under `mpiexec -n 2`; the
 other commands run in this process (analysis.cli.main, which `python -m analysis` calls): a process
 of its own costs about 2.5 s of imports, more than the command's work on these catalogs."""
-import contextlib
 import dataclasses
-import io
 import shutil
-import subprocess
 import sys
 
 import numpy as np
 import pytest
 
-from analysis import cli, stats, summary
+from analysis import stats, summary
 from analysis.recurrence import RecurrenceScanner
 from ensemble.store import reader
 from ensemble.config import loads
@@ -22,7 +19,7 @@ from ensemble.config import loads
 from . import reduction_reference as ref
 from .catalog_writer import write_events
 from .conftest import run_cli, write_config
-from .processes import run_bounded
+from .processes import analysis_here, run_bounded
 
 
 # bootstrap resamples of the real catalog's reductions: the comparisons with the reference are exact
@@ -32,17 +29,6 @@ BOOTSTRAP = "100"
 
 def run_analysis(*args):
     return run_bounded([sys.executable, "-m", "analysis", *args], 300)
-
-
-def analysis_here(*args):
-    """`python -m analysis ARGS` run by analysis.cli.main in this process (argparse's own errors exit)."""
-    stdout, stderr = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
-        try:
-            code = cli.main([str(a) for a in args])
-        except SystemExit as done:
-            code = done.code
-    return subprocess.CompletedProcess(["python -m analysis", *args], code, stdout.getvalue(), stderr.getvalue())
 
 
 @pytest.fixture(scope="module")

@@ -4,22 +4,18 @@ command on small runs of both laws, checked against the catalogs' events directl
 The runs are processes of their own (`python -m ensemble run`); the analysis commands run in this
 process (analysis.cli.main, which `python -m analysis` calls), but one that checks the exit code and
 message of the command itself: a process costs about 2.5 s of imports, more than the work here."""
-import contextlib
-import io
 import json
 import math
-import subprocess
 import sys
 
 import numpy as np
 import pytest
 
-from analysis import cli
 from analysis import compare as cmp
 from ensemble.store import reader, schema
 
 from .conftest import run_cli, write_config
-from .processes import child_env, run_bounded
+from .processes import analysis_here, child_env, run_bounded
 from .test_laws import write_cl_config
 
 
@@ -119,17 +115,6 @@ def analysis_process(*args):
     return run_bounded([sys.executable, "-m", "analysis", *map(str, args)], 300, env=child_env())
 
 
-def analysis(*args):
-    """`python -m analysis ARGS` run by analysis.cli.main in this process (argparse's own errors exit)."""
-    stdout, stderr = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
-        try:
-            code = cli.main([str(a) for a in args])
-        except SystemExit as done:
-            code = done.code
-    return subprocess.CompletedProcess(["python -m analysis", *args], code, stdout.getvalue(), stderr.getvalue())
-
-
 def brute_force(events, n_large, window):
     """(events, large fraction, recurrence times) of one task, from the definitions."""
     n = events["n_slipped"]
@@ -146,7 +131,7 @@ def test_compare_numbers_are_the_catalogs(two_laws, tmp_path):
     """The table's counts, large fractions, recurrence numbers and CV are what the events give."""
     d, paths = two_laws
     out = tmp_path / "cmp"
-    res = analysis("compare", *paths, "-o", out, "--n-large", "5", "--window", "3", "--bootstrap", "50")
+    res = analysis_here("compare", *paths, "-o", out, "--n-large", "5", "--window", "3", "--bootstrap", "50")
     assert res.returncode == 0, res.stderr
     numbers = json.loads((out / "comparison.json").read_text())
     assert [p["law"] for p in numbers["points"]] == ["carlson-langer", "aging"]
@@ -173,17 +158,17 @@ def test_compare_numbers_are_the_catalogs(two_laws, tmp_path):
 def test_compare_refuses_to_overwrite_and_bad_options(two_laws, tmp_path):
     d, paths = two_laws
     out = tmp_path / "cmp"
-    assert analysis("compare", paths[0], "-o", out, "--bootstrap", "5", "--n-large", "5").returncode == 0
+    assert analysis_here("compare", paths[0], "-o", out, "--bootstrap", "5", "--n-large", "5").returncode == 0
     before = (out / "comparison.md").read_text()
     res = analysis_process("compare", paths[1], "-o", out, "--bootstrap", "5", "--n-large", "5")
     assert res.returncode == 2 and res.stderr.strip().count("\n") == 0   # a usage error, as in `ensemble run`
     assert "comparison.md: comparison file exists (use --force" in res.stderr
     assert (out / "comparison.md").read_text() == before
-    res = analysis("compare", paths[0], "-o", tmp_path / "x", "--n-large", "80")
+    res = analysis_here("compare", paths[0], "-o", tmp_path / "x", "--n-large", "80")
     assert res.returncode == 2 and "--n-large 80 exceeds the chain of 50 blocks" in res.stderr
-    res = analysis("compare", paths[0], "-o", tmp_path / "y", "--n-min", "4", "--n-large", "5")
+    res = analysis_here("compare", paths[0], "-o", tmp_path / "y", "--n-min", "4", "--n-large", "5")
     assert res.returncode == 2 and "--n-min" in res.stderr
-    res = analysis("compare", d / "missing.h5", "-o", tmp_path / "z")
+    res = analysis_here("compare", d / "missing.h5", "-o", tmp_path / "z")
     assert res.returncode == 1 and "missing.h5" in res.stderr
 
 
@@ -214,18 +199,18 @@ def test_reduce_takes_the_scales_of_the_catalogs_law(two_laws, tmp_path):
     d, (cl, aging) = two_laws
     for path, law in ((cl, "carlson-langer"), (aging, "aging")):
         out = tmp_path / f"{law}.summary.h5"
-        res = analysis("reduce", path, "-o", out, "--bootstrap", "5")
+        res = analysis_here("reduce", path, "-o", out, "--bootstrap", "5")
         assert res.returncode == 0, res.stderr
         scales = laws.get(law).scales
         with h5py.File(out) as h5:
             assert h5.attrs["mu_c"] == scales.mu_c and h5.attrs["b_cut"] == scales.b_cut
             lo, hi, n = scales.mu_bins.split(":")
             np.testing.assert_array_equal(h5["bins/mu"][...], np.linspace(float(lo), float(hi), int(n) + 1))
-    res = analysis("reduce", cl, aging, "-o", tmp_path / "both.h5", "--mu-c", "1")
+    res = analysis_here("reduce", cl, aging, "-o", tmp_path / "both.h5", "--mu-c", "1")
     assert res.returncode == 2 and res.stderr.count("\n") == 1
     assert "several friction laws (aging, carlson-langer)" in res.stderr
     assert "give --mu-bins, --b-cut, --tnu-bins" in res.stderr and not (tmp_path / "both.h5").exists()
-    res = analysis("reduce", cl, aging, "-o", tmp_path / "both.h5", "--mu-c", "1", "--mu-bins=-3:7:100",
+    res = analysis_here("reduce", cl, aging, "-o", tmp_path / "both.h5", "--mu-c", "1", "--mu-bins=-3:7:100",
                    "--b-cut", "0", "--tnu-bins", "0:4:40", "--bootstrap", "5")
     assert res.returncode == 0, res.stderr
     with h5py.File(tmp_path / "both.h5") as h5:
@@ -262,14 +247,14 @@ def test_two_laws_with_the_same_keys_are_two_points(two_laws, tmp_path):
         events, _, _ = reader.read(path)
         kinds[name] = int(np.count_nonzero(events["kind"] == schema.KIND_EVENT))
     out = tmp_path / "both.summary.h5"
-    res = analysis("reduce", aging, tmp_path / "slip.h5", "-o", out, "--bootstrap", "5")
+    res = analysis_here("reduce", aging, tmp_path / "slip.h5", "-o", out, "--bootstrap", "5")
     assert res.returncode == 0, res.stderr
     with h5py.File(out) as h5:
         assert [law.decode() for law in h5["points/law"][...]] == ["aging", "slip"]
         assert h5["points/numbers/n_events"][:, 0].tolist() == [kinds["aging"], kinds["slip"]]
-    report = analysis("report", out)
+    report = analysis_here("report", out)
     assert report.returncode == 0 and "aging: " in report.stdout and "slip: " in report.stdout, report.stdout
-    res = analysis("compare", aging, tmp_path / "slip.h5", "-o", tmp_path / "cmp", "--bootstrap", "5")
+    res = analysis_here("compare", aging, tmp_path / "slip.h5", "-o", tmp_path / "cmp", "--bootstrap", "5")
     assert res.returncode == 0, res.stderr
     table = (tmp_path / "cmp" / "comparison.md").read_text()
     assert f"| aging: a = 0, b = 20, c = 1000 | {kinds['aging']} |" in table

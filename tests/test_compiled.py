@@ -86,7 +86,8 @@ def test_a_cache_built_in_one_checkout_serves_a_copy_elsewhere(tmp_path):
     shutil.copytree(ROOT / "ensemble", copy / "ensemble", ignore=shutil.ignore_patterns("__pycache__"))
     cache = tmp_path / "cache"
     shutil.copytree(here, cache / here.name)
-    assert kernel_cache.directory(copy / "ensemble" / "model", {"NUMBA_CACHE_DIR": str(cache)}) == str(cache / here.name)
+    same = kernel_cache.directory(copy / "ensemble" / "model", {"NUMBA_CACHE_DIR": str(cache)})
+    assert same == str(cache / here.name)      # the copy's sources are this checkout's
     res = run_bounded([sys.executable, "-m", "ensemble", "compile", "--law", "carlson-langer"], 600, cwd=copy,
                       env=child_env(NUMBA_CACHE_DIR=str(cache), PYTHONPATH=str(copy)))
     assert res.returncode == 0, res.stdout + res.stderr

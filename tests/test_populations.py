@@ -5,11 +5,8 @@ against a hand computation.
 The commands run in this process (analysis.cli.main and ensemble.cli.main, which `python -m analysis` and
 `python -m ensemble` call): a process of its own costs about 2.5 s of imports, more than the command's work
 here. Only the runs under mpiexec, and the one killed, are processes of their own."""
-import contextlib
 import hashlib
-import io
 import math
-import subprocess
 import sys
 
 import numpy as np
@@ -22,7 +19,7 @@ from ensemble.sweep import task_list
 
 from .catalog_writer import write_events
 from .conftest import write_config
-from .processes import ensemble_here
+from .processes import analysis_here, ensemble_here
 
 POPULATION = """
 [model]
@@ -41,18 +38,6 @@ b = {{distribution = "uniform", min = 20, max = 50}}
 def population(faults=6, extra="", sweep=""):
     return loads(POPULATION.format(faults=faults, extra=extra) + (f"[sweep]\n{sweep}\n" if sweep else ""))
 
-
-def analysis_cli(*args):
-    """`python -m analysis ARGS` run by analysis.cli.main in this process (argparse's own errors exit)."""
-    from analysis import cli
-    argv = [str(a) for a in args]
-    stdout, stderr = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
-        try:
-            code = cli.main(argv)
-        except SystemExit as done:
-            code = done.code
-    return subprocess.CompletedProcess(["python -m analysis", *argv], code, stdout.getvalue(), stderr.getvalue())
 
 
 # -- the draws ---------------------------------------------------------------------------------
@@ -218,7 +203,7 @@ def test_a_region_of_two_faults_is_their_rate_weighted_mixture(two_faults):
     0 <= t < 399 (399 events), fault 1 those with 100 <= t < 499 (57); a single-fault reduction counts 400 each."""
     d, path = two_faults
     out = d / "two.region.h5"
-    res = analysis_cli("reduce", path, "--region", "-o", out, "--bootstrap", 50)
+    res = analysis_here("reduce", path, "--region", "-o", out, "--bootstrap", 50)
     assert res.returncode == 0, res.stderr
     # each fault discarded 5 events, fewer than the 50 its 40 blocks may need: both named
     assert res.stderr.count("discarded 5 events before it recorded") == 2, res.stderr
@@ -242,14 +227,14 @@ def test_a_region_of_two_faults_is_their_rate_weighted_mixture(two_faults):
     assert np.isnan(s["points/b"][0]) and s["points/N"][0] == 40                  # drawn / shared
     # the same catalog point by point: every event of each fault
     plain = d / "two.plain.h5"
-    assert analysis_cli("reduce", path, "-o", plain, "--bootstrap", 50).returncode == 0
+    assert analysis_here("reduce", path, "-o", plain, "--bootstrap", 50).returncode == 0
     p = summary.read(plain)
     assert list(p["points/numbers/n_events"][:, 0]) == [400, 400]
-    res = analysis_cli("report", out)
+    res = analysis_here("report", out)
     assert res.returncode == 0 and "region 0: b: uniform on [20, 50]; N = 40" in res.stdout
     # the later part alone: windows from 100 (T nu / nu) after each first onset, for the 299 left of the shorter span
     later = d / "two.later.h5"
-    res = analysis_cli("reduce", path, "--region", "--region-skip", 100 * nu, "-o", later, "--bootstrap", 20)
+    res = analysis_here("reduce", path, "--region", "--region-skip", 100 * nu, "-o", later, "--bootstrap", 20)
     assert res.returncode == 0, res.stderr
     s = summary.read(later)
     assert np.allclose(s["tasks/window_start"], [100.0, 200.0], rtol=1e-12)
@@ -262,9 +247,9 @@ def test_a_partial_region_leaves_out_the_faults_not_yet_recorded(tmp_path):
     path = tmp_path / "three.h5"
     write_events(path, POPULATION.format(faults=3, extra=""), [
         _events(0, np.arange(400.0), 1.05), _events(1, 100 + 7 * np.arange(400.0), 3.05), _events(2, [], 2.0)])
-    res = analysis_cli("reduce", path, "--region", "-o", tmp_path / "r.h5")
+    res = analysis_here("reduce", path, "--region", "-o", tmp_path / "r.h5")
     assert res.returncode == 1 and "unfinished run" in res.stderr
-    res = analysis_cli("reduce", path, "--region", "--partial", "-o", tmp_path / "r.h5", "--bootstrap", 20)
+    res = analysis_here("reduce", path, "--region", "--partial", "-o", tmp_path / "r.h5", "--bootstrap", 20)
     assert res.returncode == 0, res.stderr
     assert "1 of 3 faults left out: fewer than two inertial events recorded yet" in res.stderr
     s = summary.read(tmp_path / "r.h5")
@@ -273,17 +258,17 @@ def test_a_partial_region_leaves_out_the_faults_not_yet_recorded(tmp_path):
 
 def test_region_errors_are_one_line(two_faults, tmp_path):
     d, path = two_faults
-    res = analysis_cli("reduce", path, "--region", "--region-span", 1.0, "-o", tmp_path / "x.h5")
+    res = analysis_here("reduce", path, "--region", "--region-span", 1.0, "-o", tmp_path / "x.h5")
     assert res.returncode == 2 and "--region-span 1: " in res.stderr and "task 0 spans only 3.99e-06" in res.stderr
     assert res.stderr.strip().count("\n") == 0
-    res = analysis_cli("reduce", path, "--region-span", 1e-6, "-o", tmp_path / "x.h5")
+    res = analysis_here("reduce", path, "--region-span", 1e-6, "-o", tmp_path / "x.h5")
     assert res.returncode == 2 and "give --region too" in res.stderr
-    res = analysis_cli("reduce", path, "--region", "--region-skip", 1.0, "-o", tmp_path / "x.h5")
+    res = analysis_here("reduce", path, "--region", "--region-skip", 1.0, "-o", tmp_path / "x.h5")
     assert res.returncode == 2 and "fewer than two inertial events recorded after --region-skip 1" in res.stderr
     single = tmp_path / "single.h5"
     text = "[model]\nN = 40\n[run]\nevents = 400\ntransient = 5\nseeds = 1\n"
     write_events(single, text, [_events(0, np.arange(400.0), 1.05)])
-    res = analysis_cli("reduce", single, "--region", "-o", tmp_path / "y.h5")
+    res = analysis_here("reduce", single, "--region", "-o", tmp_path / "y.h5")
     assert res.returncode == 2 and "has no [population]" in res.stderr and not (tmp_path / "y.h5").exists()
 
 
@@ -295,7 +280,7 @@ def test_a_region_of_many_faults_resamples_faults(tmp_path):
     parts = [_events(k, np.arange(400.0) / (k + 1), 1.05 + 0.1 * (k % 3)) for k in range(12)]
     write_events(path, text, parts)
     out = tmp_path / "many.region.h5"
-    res = analysis_cli("reduce", path, "--region", "-o", out, "--bootstrap", 300, "--seed", 4)
+    res = analysis_here("reduce", path, "--region", "-o", out, "--bootstrap", 300, "--seed", 4)
     assert res.returncode == 0, res.stderr
     s = summary.read(out)
     assert s["points/method"][0] == "faults" and s["points/units"][0] == 12
@@ -321,7 +306,7 @@ def test_a_region_of_many_faults_resamples_faults(tmp_path):
 def test_a_regions_magnitude_figure_shows_its_faults(two_faults):
     d, path = two_faults
     out = d / "fig.region.h5"
-    assert analysis_cli("reduce", path, "--region", "-o", out, "--bootstrap", 20).returncode == 0
+    assert analysis_here("reduce", path, "--region", "-o", out, "--bootstrap", 20).returncode == 0
     from analysis import plot
     import matplotlib.pyplot as plt
     fig = plot.figure([summary.read(out)], "magnitude")
@@ -451,7 +436,7 @@ def test_the_answer_finds_a_region_of_gr_faults_critical_and_a_characteristic_on
         write_events(path, POPULATION.format(faults=12, extra="").replace("events = 400", "events = 1500"),
                      [_events(f, np.arange(1500.0) / (1 + f % 3), draw(1500)) for f in range(12)])
         out = tmp_path / f"{name}.region.h5"
-        res = analysis_cli("reduce", path, "--region", "--mu-bins", "0:7:700", "-o", out, "--bootstrap", 50)
+        res = analysis_here("reduce", path, "--region", "--mu-bins", "0:7:700", "-o", out, "--bootstrap", 50)
         assert res.returncode == 0, res.stderr
         assert answer.main([str(out), "-o", str(tmp_path / name)]) == 0
         row = __import__("json").loads((tmp_path / f"{name}.json").read_text())[0]

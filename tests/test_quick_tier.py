@@ -1,6 +1,7 @@
 """The quick tier (`make quick`): the tests tests/conftest.py names in QUICK exist, and every test
 file has tests in it or says in NOT_QUICK why not (so that the tier keeps touching every layer as
-files are added); a name with "[case]", one case of a parametrized test, names a case pytest collects. Which source modules it touches, and how long it takes: docs/tests.md."""
+files are added); a name with "[case]", one case of a parametrized test, names a case pytest collects.
+Which source modules it touches, and how long it takes: docs/tests.md."""
 import importlib
 import subprocess
 import sys
