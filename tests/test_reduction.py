@@ -150,12 +150,13 @@ N = {N}
 {sweep}
 [run]
 seeds = {seeds}
-events = {events}
+events = 400
 transient = 5
 seed = {seed}
 """
-# run.events of each catalog: 400 where the edges need them, fewer where only the count of seeds or tasks
-# matters (the reference's time grows with the square of a task's events); below, the events written of each task
+# run.events of each catalog (CONFIG's 400, which test_export and test_options take): 400 where the edges need
+# them, fewer where only the count of seeds or tasks matters (the reference's time grows with the square of a
+# task's events); below, the events written of each task
 EVENTS = {"seeds": 400, "blocks": 400, "pairs": 400, "ten": 100, "more": 200, "whole": 200}
 # four points x three seeds: an empty task (never committed), a partly written one, a tiny one
 SEEDS_WRITTEN = [400, 400, 400, 400, 0, 250, 400, 400, 3, 400, 137, 400]
@@ -183,7 +184,8 @@ def catalogs(tmp_path_factory):
             ("more", "nu = [2.0, 1.0]", 2, 5, MORE_WRITTEN),
             ("whole", "nu = [3.0]", 2, 7, WHOLE_WRITTEN)):
         path = d / f"{name}.h5"
-        text = CONFIG.format(N=N_CHAIN, sweep=sweep, seeds=seeds, seed=root, events=EVENTS[name])
+        text = CONFIG.format(N=N_CHAIN, sweep=sweep, seeds=seeds, seed=root).replace(
+            "events = 400", f"events = {EVENTS[name]}")
         events = write_catalog(path, text, written, seed=len(name) + root)
         made[name] = (path, events)
     return d, made
