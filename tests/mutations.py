@@ -4,7 +4,9 @@ Each entry of MUTATIONS is one plausible bug: a file, a piece of its text and wh
 there instead, with the tests that should notice. For each mutation this script copies the
 repository (the files git knows, as they are in the working tree) to a scratch directory,
 applies the change, runs those tests there and reports whether they failed ("killed") or
-passed ("SURVIVED"). A survivor is a hole in the suite: write the test that kills it.
+passed ("SURVIVED"), and which tier killed it: those of the tests that `make test` runs first,
+the slower tier's (marked slow, run by CI) only when those let it pass. A survivor is a hole in
+the suite: write the test that kills it.
 
     python tests/mutations.py                 # all mutations (make mutations); ~40 minutes on 2 cores
     python tests/mutations.py --list          # the list, nothing run
@@ -19,7 +21,7 @@ loudly when the code changes), `new`, the tests (pytest node ids or files) that 
 fail, and `why` (one line: the bug a user would meet). Run it alone by its name and see it
 killed. Kernel code is compiled by numba, whose cache does not notice a change in another
 module: mutations under ensemble/model/ run with an empty cache (a few minutes of compiling
-each), the others share one warmed by the baseline.
+each), the others share one: a copy of this checkout's, warmed further by the baseline.
 """
 import argparse
 import os
@@ -376,12 +378,14 @@ def copy_repository(dest):
     (dest / ".git").write_text(f"gitdir: {git_dir}\n")
 
 
-def run_tests(copy, tests, cache, timeout):
-    """(outcome, seconds, first failing test or last output line) of pytest on `tests` in `copy`."""
+def run_tests(copy, tests, cache, timeout, marks=None):
+    """(outcome, seconds, first failing test or last output line) of pytest on `tests` in `copy`, only those
+    selected by the marker expression `marks` when given ("no tests" when it selects none)."""
     env = dict(os.environ, PYTHONPATH=str(copy), NUMBA_CACHE_DIR=str(cache), OMP_NUM_THREADS="1",
                NUMBA_NUM_THREADS="1", PYTHONDONTWRITEBYTECODE="1")
     start = time.monotonic()
-    proc = subprocess.Popen([sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", *tests],
+    selection = ["-m", marks] if marks else []
+    proc = subprocess.Popen([sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", *selection, *tests],
                             cwd=copy, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                             start_new_session=True)
     try:
@@ -393,8 +397,20 @@ def run_tests(copy, tests, cache, timeout):
     seconds = time.monotonic() - start
     lines = out.strip().splitlines() or [""]
     failed = next((ln.split(" - ")[0] for ln in lines if ln.startswith(("FAILED", "ERROR"))), lines[-1])
-    outcome = {0: "SURVIVED", 1: "killed"}.get(proc.returncode, f"error (pytest exit {proc.returncode})")
+    outcome = {0: "SURVIVED", 1: "killed", 5: "no tests"}.get(proc.returncode, f"error (pytest exit {proc.returncode})")
     return outcome, seconds, failed
+
+
+def run_tiers(copy, tests, cache, timeout):
+    """(outcome, seconds, detail) of `tests` tier by tier: `make test`'s (not slow) first, then the slower tier
+    only if those did not kill the mutant; a kill's outcome names the tier that made it."""
+    outcome, seconds, detail = run_tests(copy, tests, cache, timeout, "not slow")
+    if outcome.startswith("killed"):
+        return outcome.replace("killed", "killed (make test)", 1), seconds, detail
+    outcome, more, detail = run_tests(copy, tests, cache, timeout, "slow")
+    if outcome == "killed":
+        return "killed (slow tier)", seconds + more, detail
+    return ("SURVIVED" if outcome == "no tests" else outcome), seconds + more, detail
 
 
 def main(argv=None):
@@ -428,6 +444,9 @@ def main(argv=None):
         copy = scratch / "repo"
         copy_repository(copy)
         shared = scratch / "cache"
+        warm = ROOT / ".numba_cache"     # this checkout's kernels: the unmutated sources' are found by their hash
+        if warm.is_dir():
+            shutil.copytree(warm, shared, ignore=shutil.ignore_patterns("reference-*"))
         baseline = sorted({t for m in chosen for t in m.tests if (copy / t.split("::")[0]).exists()})
         print(f"baseline: {len(baseline)} test files/ids unmutated", flush=True)
         outcome, seconds, detail = run_tests(copy, baseline, shared, args.timeout * 2)
@@ -446,15 +465,17 @@ def main(argv=None):
             target.write_text(applied(texts[m.path], m))
             cache = scratch / f"cache-{m.name}" if m.path.startswith("ensemble/model/") else shared
             try:
-                outcome, seconds, detail = run_tests(copy, m.tests, cache, args.timeout)
+                outcome, seconds, detail = run_tiers(copy, m.tests, cache, args.timeout)
             finally:
                 shutil.copy2(ROOT / m.path, target)   # the original text and time stamp
                 if cache != shared:
                     shutil.rmtree(cache, ignore_errors=True)
             results.append((m, outcome, seconds, detail))
-            print(f"{m.name:38s} {outcome:18s} {seconds:6.0f} s  {detail}", flush=True)
+            print(f"{m.name:38s} {outcome:20s} {seconds:6.0f} s  {detail}", flush=True)
     survivors = [r for r in results if not r[1].startswith("killed")]
+    by_tier = {t: sum(r[1] == f"killed ({t})" for r in results) for t in ("make test", "slow tier")}
     print(f"\n{len(results) - len(survivors)} of {len(results)} mutations killed"
+          + f" ({by_tier['make test']} by make test, {by_tier['slow tier']} only by the slower tier)"
           + (f"; not killed: {', '.join(r[0].name for r in survivors)}" if survivors else ""))
     return 0 if not survivors and not problems else 1
 
