@@ -25,7 +25,7 @@ from ensemble.store.integrity import commit_crc
 
 from .conftest import committed, write_config
 from .inject import CRASH_CODE
-from .processes import ROOT, Started, child_env, run_bounded, wait_for
+from .processes import ROOT, Started, child_env, ensemble_here as here, run_bounded, wait_for
 
 TIMEOUT = 120     # seconds for any one command or wait: what they take is a few
 
@@ -38,6 +38,8 @@ def injected(setup, *argv, timeout=TIMEOUT):
 
 
 def cli(*args, timeout=TIMEOUT):
+    """`python -m ensemble args` in a process of its own: for damaged catalogs and full disks, where HDF5 may
+    crash at exit and the run leaves at once (os._exit); the others run in this process (`here`)."""
     return run_bounded([sys.executable, "-m", "ensemble", *args], timeout, env=child_env())
 
 
@@ -87,7 +89,7 @@ def test_crash_at_each_kind_of_write_of_a_batch_resumes_to_the_uninterrupted_cat
         assert res.returncode == CRASH_CODE, res.stderr
         events, tasks, _ = reader.read(partial_path(out))       # consistent after the crash
         assert len(events["t"]) == tasks["events_written"].sum() < 120
-        res = cli("run", cfg, "-o", out, "--resume")
+        res = here("run", cfg, "-o", out, "--resume")
         assert res.returncode == 0, (k, res.stderr)
         same_events(d / "full.h5", out)
 
@@ -188,10 +190,10 @@ def test_a_second_run_on_a_live_output_is_refused_and_the_first_one_is_intact(lo
     with start(long_cfg, out) as first:        # 200000 events: live until stopped
         wait_for(lambda: committed(out), TIMEOUT, "a committed batch", first)
         for extra in (["--force"], ["--resume"], []):
-            res = cli("run", long_cfg, "-o", out, *extra)
+            res = here("run", long_cfg, "-o", out, *extra)
             assert res.returncode == 2 and "in use by another run" in res.stderr, res.stderr
             assert f"pid {first.pid}" in res.stderr
-        status = cli("status", out)
+        status = here("status", out)
         assert status.returncode == 0 and "running" in status.stdout and "progress:" in status.stdout
         code, log = stop(first)
     assert code == 75, log
@@ -204,9 +206,10 @@ def test_status_shows_progress_within_seconds_of_the_start(long_cfg, tmp_path):
     """Before any flush (flush_seconds = 1000 here) the lock carries the live progress line."""
     out = tmp_path / "early.h5"
     with start(long_cfg, out, "--set", "output.flush_seconds=1000") as proc:
-        wait_for(lambda: "events 0/" not in lock.read_info(out).get("progress", "events 0/"), TIMEOUT,
+        # a rate: events done ("starting" and "events 0/..." come before any)
+        wait_for(lambda: "events/s" in lock.read_info(out).get("progress", ""), TIMEOUT,
                  "a progress line in the lock", proc)
-        status = cli("status", out)
+        status = here("status", out)
         assert "running" in status.stdout and "events/s" in status.stdout, status.stdout
         assert "open" in status.stdout         # per task, from the catalog being written
         code, log = stop(proc)
@@ -220,7 +223,7 @@ def test_a_stale_lock_of_a_dead_run_is_taken_over(small, tmp_path):
     dead.wait(timeout=TIMEOUT)
     with open(lock.lock_path(out), "w") as fh:
         fh.write(f"host: {socket.gethostname()}\npid: {dead.pid}\nstarted: x\nheartbeat: {time.time():.1f}\n")
-    res = cli("run", cfg, "-o", out)
+    res = here("run", cfg, "-o", out)
     assert res.returncode == 0, res.stderr
     assert "took over the lock left by a run that died" in res.stdout
     assert not os.path.exists(lock.lock_path(out))
@@ -234,18 +237,18 @@ def test_a_lock_from_another_host_with_a_fresh_heartbeat_is_refused_with_how_to_
     # where `now` would turn stale after lock.STALE_SECONDS
     with open(path, "w") as fh:
         fh.write(f"host: node-elsewhere\npid: 4242\nstarted: x\nheartbeat: {time.time() + 3600:.1f}\n")
-    res = cli("run", cfg, "-o", out)
+    res = here("run", cfg, "-o", out)
     assert res.returncode == 2 and "node-elsewhere" in res.stderr and f"rm {path}" in res.stderr
     assert not os.path.exists(partial_path(out))
     os.remove(path)
-    assert cli("run", cfg, "-o", out).returncode == 0
+    assert here("run", cfg, "-o", out).returncode == 0
 
 
 def test_resume_of_a_finished_catalog_refuses_a_changed_config(small):
     d, cfg = small
-    res = cli("run", cfg, "-o", d / "full.h5", "--resume", "--set", "model.b=30")
+    res = here("run", cfg, "-o", d / "full.h5", "--resume", "--set", "model.b=30")
     assert res.returncode == 2 and "model.b" in res.stderr
-    res = cli("run", cfg, "-o", d / "full.h5", "--resume")
+    res = here("run", cfg, "-o", d / "full.h5", "--resume")
     assert res.returncode == 0 and "complete" in res.stdout
 
 
@@ -253,7 +256,7 @@ def test_output_paths_are_checked_before_any_work(small, tmp_path):
     d, cfg = small
     (tmp_path / "adir").mkdir()
     for target in (tmp_path / "adir", tmp_path / "missing" / "x.h5"):
-        res = cli("run", cfg, "-o", target, "--force")
+        res = here("run", cfg, "-o", target, "--force")
         assert res.returncode == 2 and str(target.parent if "missing" in str(target) else target) in res.stderr
         assert "progress" not in res.stdout and not os.path.exists(partial_path(target))
     assert list((tmp_path / "adir").iterdir()) == []
@@ -271,25 +274,25 @@ def test_resume_continues_from_the_stored_config_without_retyping_overrides(long
     sets = ["--set", "run.events=60", "--set", "model.b=30", "--set", "integrator.dt=5e-4",
             "--set", "output.flush_seconds=0.2"]
     ref = tmp_path / "ref.h5"
-    assert cli("run", long_cfg, "-o", ref, *sets).returncode == 0
+    assert here("run", long_cfg, "-o", ref, *sets).returncode == 0
     out = tmp_path / "cut.h5"
     # SIGTERM at the first batch of events: it is committed, the rest of the run is not done
     res = injected("inject.signal_at_write(15)", "run", long_cfg, "-o", out, *sets)
     assert res.returncode == 75, res.stdout + res.stderr
     _, tasks, _ = reader.read(partial_path(out))
     assert 0 < tasks["events_written"].sum() < 120
-    res = cli("resume", out)
+    res = here("resume", out)
     assert res.returncode == 0, res.stderr
     same_events(ref, out)
-    res = cli("resume", out)
+    res = here("resume", out)
     assert res.returncode == 0 and "complete" in res.stdout
 
 
 def test_resume_refuses_changes_to_the_physics_and_integrator_changes_without_failed_tasks(interrupted):
     cfg, out = interrupted
-    res = cli("resume", out, "--set", "model.b=30")
+    res = here("resume", out, "--set", "model.b=30")
     assert res.returncode == 2 and "model.b" in res.stderr and "new run" in res.stderr
-    res = cli("resume", out, "--set", "integrator.dt=1e-4")
+    res = here("resume", out, "--set", "integrator.dt=1e-4")
     assert res.returncode == 2 and "no failed task" in res.stderr
 
 
@@ -299,22 +302,22 @@ def test_a_failing_task_is_recorded_and_rerun_with_another_integrator(tmp_path):
     cfg = write_config(tmp_path / "mix.toml", sweep={"b": [20.0, 80.0]}, run={"seeds": 1, "events": 30,
                        "transient": 10}, integrator={"method": "rk4", "dt": 1e-3}, output={"batch": 10})
     out = tmp_path / "mix.h5"
-    res = cli("run", cfg, "-o", out)
+    res = here("run", cfg, "-o", out)
     assert res.returncode == 1 and "task 1" in res.stderr and "stability" in res.stderr
     assert "resume" in res.stdout and not out.exists()
     _, tasks, _ = reader.read(partial_path(out))
     assert list(tasks["status"]) == [schema.FINISHED, schema.FAILED] and "stability" in tasks["error"][1]
-    status = cli("status", out)
+    status = here("status", out)
     assert status.returncode == 0 and "failed: tasks 1" in status.stdout
-    assert cli("resume", out).returncode == 1           # nothing changed: still failed, said again
+    assert here("resume", out).returncode == 1           # nothing changed: still failed, said again
     exp4 = ["--set", 'integrator.method="exp4"']
-    res = cli("resume", out, *exp4)
+    res = here("resume", out, *exp4)
     assert res.returncode == 0, res.stderr
     events, tasks, _ = reader.read(out)
     assert list(tasks["status"]) == [schema.FINISHED] * 2 and list(tasks["events_written"]) == [30, 30]
     assert 'method = "rk4"' in tasks["integrator"][0] and 'method = "exp4"' in tasks["integrator"][1]
     ref = tmp_path / "ref.h5"
-    assert cli("run", cfg, "-o", ref, *exp4).returncode == 0
+    assert here("run", cfg, "-o", ref, *exp4).returncode == 0
     ref_events, _, _ = reader.read(ref)
     for name in schema.EVENT_FIELDS:       # the rerun task equals a run with exp4 from the start
         np.testing.assert_array_equal(events[name][events["task"] == 1], ref_events[name][ref_events["task"] == 1])
@@ -396,7 +399,7 @@ def test_kernel_calls_paused_in_the_middle_of_events_give_the_same_catalog(small
     res = injected("from ensemble.run import worker; worker.FIRST_BUDGET = 1000; inject.signal_when_paused(15)",
                    "run", cfg, "-o", cut, *fast)
     assert res.returncode == 75, res.stdout + res.stderr
-    assert cli("resume", cut).returncode == 0
+    assert here("resume", cut).returncode == 0
     same_events(d / "full.h5", cut)
 
 
@@ -417,7 +420,7 @@ def test_a_signal_during_one_very_long_event_is_served_within_a_kernel_call(tmp_
 
 def test_status_of_the_partial_name_and_of_a_damaged_catalog(interrupted, tmp_path):
     cfg, out = interrupted
-    res = cli("status", partial_path(out))          # the .partial's own name: not "complete"
+    res = here("status", partial_path(out))          # the .partial's own name: not "complete"
     assert res.returncode == 0 and "interrupted" in res.stdout.splitlines()[0]
     damaged = tmp_path / "damaged.h5"
     damaged.write_bytes(open(partial_path(out), "rb").read()[:4096])
@@ -442,6 +445,6 @@ def test_status_names_what_a_wrong_file_is(small, tmp_path):
     d, cfg = small
     (tmp_path / "adir.h5").mkdir()
     for path, words in ((cfg, "TOML"), (tmp_path / "adir.h5", "directory")):
-        res = cli("status", path)
+        res = here("status", path)
         assert res.returncode == 1 and str(path) in res.stderr and words in res.stderr, res.stderr
         assert len(res.stderr.strip().splitlines()) == 1
