@@ -19,7 +19,7 @@ from ensemble.store.errors import CatalogError
 from ensemble.config import SECTIONS, ConfigError, load, loads
 
 from .conftest import write_config
-from .processes import Started, child_env, run_bounded
+from .processes import Started, analysis_here, child_env, ensemble_here, run_bounded
 
 TIMEOUT = 120   # seconds for any one command; what these run takes a few
 
@@ -42,9 +42,8 @@ def files(tmp_path_factory):
     d = tmp_path_factory.mktemp("input_errors")
     cfg = write_config(d / "cfg.toml", run={"seeds": 2, "events": 40, "transient": 5},
                        integrator={"method": "ark4"})
-    # (the first run of a session may compile the kernels: about a minute alone, more beside other tests)
-    assert run("ensemble", "run", cfg, "-o", d / "cat.h5", timeout=5 * TIMEOUT).returncode == 0
-    res = run("analysis", "reduce", d / "cat.h5", "-o", d / "sum.h5", "--bootstrap", "20")
+    assert ensemble_here("run", cfg, "-o", d / "cat.h5").returncode == 0
+    res = analysis_here("reduce", d / "cat.h5", "-o", d / "sum.h5", "--bootstrap", "20")
     assert res.returncode == 0, res.stderr
     data = (d / "cat.h5").read_bytes()
     (d / "head.h5").write_bytes(data[:4096])                                  # truncated catalog

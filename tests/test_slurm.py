@@ -27,7 +27,7 @@ from ensemble.slurm.render import PLACEHOLDER, PLACEHOLDERS, TEMPLATES, fill, re
 from ensemble.slurm.stack import python_stack
 
 from .conftest import write_config
-from .processes import child_env, poll_until, run_bounded
+from .processes import child_env, ensemble_here, poll_until, run_bounded
 from .same_catalogs import assert_same_events
 
 PACKAGES = ["slurmctld", "slurmd", "slurm-client", "munge"]
@@ -147,22 +147,22 @@ def test_bad_options_are_refused(tmp_path):
         render(cfg, JobOptions(), tmp_path / "a job")
 
 
+def slurm_cli(*args, cwd):
+    """`python -m ensemble slurm ARGS` (rendering only) from the folder `cwd`, in this process."""
+    with contextlib.chdir(cwd):
+        return ensemble_here("slurm", *args)
+
+
 def test_cli_renders_without_submitting(tmp_path):
     cfg = tiny_config(tmp_path / "tiny.toml")
-    res = run_bounded([sys.executable, "-m", "ensemble", "slurm", cfg, "--ntasks", "4", "--time", "01:00:00",
-                       "-o", tmp_path / "job"], 120, cwd=tmp_path)
+    res = slurm_cli(cfg, "--ntasks", "4", "--time", "01:00:00", "-o", tmp_path / "job", cwd=tmp_path)
     assert res.returncode == 0, res.stderr
     assert "submit with: bash job/submit.sh" in res.stdout
     assert (tmp_path / "job" / "requeue.sbatch").exists() and (tmp_path / "job" / "config.toml").exists()
     snapshot = loads((tmp_path / "job" / "config.toml").read_text())
     assert snapshot.output.path == str(tmp_path / "job" / "tiny.h5")
-    res = run_bounded([sys.executable, "-m", "ensemble", "slurm", cfg, "--ntasks", "4", "--time", "1h"], 120,
-                      cwd=tmp_path)
+    res = slurm_cli(cfg, "--ntasks", "4", "--time", "1h", cwd=tmp_path)
     assert res.returncode == 2 and "--time" in res.stderr
-
-
-def slurm_cli(*args, cwd):
-    return run_bounded([sys.executable, "-m", "ensemble", "slurm", *map(str, args)], 120, cwd=cwd)
 
 
 def test_an_existing_job_directory_is_not_written_over_without_force(tmp_path):
