@@ -234,9 +234,10 @@ def write_config(path, **sections):
     return path
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def events():
-    """Pre-event states of the next few events of a developed chain, and RK4 references."""
+    """Pre-event states of the next few events of a developed chain, and RK4 references (once per session, or
+    per pytest worker: 200 events of RK4 at dt = 1e-3 take about 5 s; the tests read them, none changes them)."""
     model = Model(N=100, b=20.0, a=2.0)
     force, psi = developed_state(model, 200)
     out = []
