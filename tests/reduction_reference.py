@@ -230,9 +230,9 @@ def edges_of(opt, name):
     return opt[name] if name in opt else {**CREEP_EDGES, **SEIS}[name]
 
 
-def seis_cell(dt, d, opt):
-    """Flat cell index (time bin * distance bins + distance bin) of a pair, or None outside the bins."""
-    te, de = edges_of(opt, "seis_time_edges"), edges_of(opt, "seis_distance_edges")
+def seis_cell(dt, d, te, de):
+    """Flat cell index (time bin * distance bins + distance bin) of a pair, or None outside the bins: te and de
+    the time and distance edges (lists of floats)."""
     if not (te[0] <= dt < te[-1] and de[0] <= d < de[-1]):
         return None
     rows = [j for j in range(len(te) - 1) if te[j] <= dt < te[j + 1]]
@@ -385,14 +385,16 @@ class Task:
         """Every pair's cell and stretch (of its mainshock), every mainshock's exposure row and stretch."""
         T = [float(x) * nu for x in ev["t"]]
         x = [int(e) for e in ev["epicenter"]]
-        te, de = edges_of(opt, "seis_time_edges"), edges_of(opt, "seis_distance_edges")
+        # the edges as Python floats: half a million pairs, each compared with every edge
+        te = [float(e) for e in edges_of(opt, "seis_time_edges")]
+        de = [float(e) for e in edges_of(opt, "seis_distance_edges")]
         cells, cell_stretch, exposure, main_stretch = [], [], [], []
         for m in range(self.n):
             if float(ev["mu"][m]) < opt["mu_c"]:
                 continue
             for i in range(self.n):
                 if i != m:
-                    c = seis_cell(T[i] - T[m], abs(x[i] - x[m]), opt)
+                    c = seis_cell(T[i] - T[m], abs(x[i] - x[m]), te, de)
                     if c is not None:
                         cells.append(c)
                         cell_stretch.append(self.stretch[m])
