@@ -1,7 +1,8 @@
 """scripts/stack.py finds an MPI compiler and a parallel HDF5 where clusters put them;
 scripts/setup.sh refuses STACK=parallel without them before it changes anything, chooses the
 stack a new .venv gets, and says what it does while it does it; and every entry point takes the
-one numba cache of the package (ensemble/kernel_cache.py), so the kernels compile once.
+one numba cache of the package (ensemble/kernel_cache.py), so the kernels compile once (that the Quick
+start's run after `make run` on a fresh clone compiles nothing is tests/install_paths.sh's check, in CI).
 
 The machine's own stack is not used: each case builds the places a module system, Spack or a
 virtual environment would (executables, include/H5pubconf.h, .pc files) in a temporary directory,
@@ -263,28 +264,3 @@ def test_every_entry_point_takes_the_packages_kernel_cache(tmp_path, monkeypatch
     job = render(load(cfg), JobOptions(), tmp_path / "job")
     for script in (job.run_script, job.reduce_script):
         assert "export NUMBA_CACHE_DIR" not in script.read_text(), script
-
-
-@pytest.mark.slow
-def test_after_make_run_the_quick_start_run_compiles_nothing(tmp_path):
-    """In a copy of the checkout with an empty cache: `make run` compiles the kernels; the Quick
-    start's `python -m ensemble run` after it must find them (one cache, not two). Slow (a minute of
-    compiling): `make test` checks that both take the same cache (above) and the install paths of CI run
-    the Quick start after `make run` on a fresh clone."""
-    repo = tmp_path / "checkout"
-    for name in ("ensemble", "analysis"):
-        shutil.copytree(ROOT / name, repo / name, ignore=shutil.ignore_patterns("__pycache__"))
-    for name in ("Makefile", "pyproject.toml", "setup.cfg"):
-        shutil.copy(ROOT / name, repo / name)
-    (repo / ".venv").symlink_to(ROOT / ".venv")
-    (repo / "examples").mkdir()
-    write_config(repo / "examples" / "small.toml", model={"N": 20}, run={"events": 20, "transient": 5, "seeds": 1})
-    env = without_cache_variable()
-    res = run_bounded(["make", "-s", "-o", "setup", "run"], 600, cwd=repo, env=env)
-    assert res.returncode == 0, res.stdout + res.stderr
-    assert "compiling kernels" in res.stdout, res.stdout        # the copy's own, empty cache
-    assert (repo / ".numba_cache").is_dir()
-    res = run_bounded([sys.executable, "-m", "ensemble", "run", "examples/small.toml", "-o", "x.h5"], 600,
-                      cwd=repo, env=env)
-    assert res.returncode == 0, res.stdout + res.stderr
-    assert "compiling kernels" not in res.stdout, res.stdout
