@@ -72,7 +72,7 @@ from .reduce import MIN_UNITS, NUMBERS, PARAMS
 from .statistics import bin_names
 
 FORMAT = filekind.SUMMARY_FORMAT_PREFIX + "6"   # 6: checksums (a `crc32` on every dataset, `attrs_crc32` over
-# the file's attributes: _seal, checked by read). 5: the seismicity around large events (/bins/seis_*,
+# the file's attributes: seal, checked by read). 5: the seismicity around large events (/bins/seis_*,
 # /per_task/seis_*, /per_task/seismicity, /points/seismicity_rate, its numbers, the seis_* attributes). 4: the
 # intervals statistic (/per_task/intervals, cv_tnu, mean_gap, cv_gap). 3: the creep episodes (bins, per-task
 # counts and sums, densities, CREEP_NUMBERS). 2: GR b and its standard error, 9 per-task sums, peaks by
@@ -193,8 +193,9 @@ def _attrs_crc(attrs):
     return crc
 
 
-def _seal(h5):
-    """Every dataset's CRC from its values as read back, then the attributes' (read() checks them)."""
+def seal(h5):
+    """Every dataset's CRC from its values as read back, then the attributes' (read() checks them); also for a
+    test that edits a summary by hand."""
     def visit(name, obj):
         if isinstance(obj, h5py.Dataset):
             obj.attrs[CRC] = _crc(name, obj[...])
@@ -266,7 +267,7 @@ def write(path, inputs, per_task, points, opt, force=False):
             for name in st.extra_datasets:
                 h5[f"points/{name}"] = _padded([np.asarray(p[name], dtype=float) for p in points])
         _describe(h5)
-        _seal(h5)
+        seal(h5)
     try:
         space.write_file(tmp, image.getbuffer(), "the summary")
     except OSError as err:
