@@ -232,6 +232,7 @@ def check_summary_output(out, catalogs, force):
     """The summary's path (checks.output: before any file is read); --force replaces a summary,
     never anything else (a catalog, a config)."""
     checks.output(out, inputs=catalogs, force=force, what="summary")
+    checks.output(f"{out}.partial", inputs=catalogs, force=True, what="summary")   # written first, then renamed
     if os.path.exists(out) and filekind.identify(out)[0] != "summary":
         raise checks.UsageError(f"{out} {filekind.describe(out)}; --force replaces only a reduction summary")
     return out

@@ -41,6 +41,7 @@ A catalog is streamed in chunks of schema.READ_CHUNK rows, each verified as it i
 and each task's checksum after its last chunk); the files of an export are written beside their
 names and renamed into place only when all are complete, so an export that fails writes nothing.
 """
+import contextlib
 import os
 
 from ensemble import checks, filekind
@@ -194,19 +195,27 @@ def write(source, directory, fmt="csv", force=False, chunk=schema.READ_CHUNK, pa
     kind = source_kind(source)
     names = CATALOG_TABLES if kind == "catalog" else SUMMARY_TABLES
     paths = [os.path.join(directory, name + suffix) for name in names]
+    beside = [p + ".partial" for p in paths]
     if os.path.isdir(directory):
         for path in paths:   # not the source, not a directory, not there unless force
             checks.output(path, inputs=[source], force=force, what="table")
+        for tmp in beside:   # (a link there would be written through)
+            checks.output(tmp, inputs=[source], force=True, what="table")
     tables, settings = _tables(source, names, chunk, partial)
+    made = not os.path.isdir(directory)
     os.makedirs(directory, exist_ok=True)
-    beside = [p + ".partial" for p in paths]
+    done = False
     try:
         for name, tmp in zip(names, beside):
             writer(tmp, name, tables[name], source, settings)
         for tmp, path in zip(beside, paths):
             os.replace(tmp, path)
+        done = True
     finally:
         for tmp in beside:
             if os.path.exists(tmp):
                 os.remove(tmp)
+        if made and not done:   # a directory this export made and could not fill (a full disk) goes too
+            with contextlib.suppress(OSError):
+                os.rmdir(directory)
     return paths

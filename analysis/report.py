@@ -25,13 +25,13 @@ def varying(s):
     return [p for p in PARAMS if len(np.unique(s[f"points/{p}"])) > 1] or ["b"]
 
 
-def point_label(s, i, keys=None):
-    """"b = 20", or "slip: b = 20" where the summary's points are of more than one law."""
+def point_label(s, i, keys=None, law=False):
+    """"b = 20", or "slip: b = 20" where the summary's points are of more than one law or `law` asks for it."""
     keys = keys or varying(s)
     text = ", ".join(f"{k} = {s[f'points/{k}'][i]:g}" for k in keys
                      if not np.isnan(s[f'points/{k}'][i]))     # NaN: a key of another law
     laws = summary.point_laws(s)
-    return f"{laws[i]}: {text}" if len(set(laws)) > 1 else text
+    return f"{laws[i]}: {text}" if law or len(set(laws)) > 1 else text
 
 
 def unreliable(s, i):
@@ -109,11 +109,11 @@ def table(s):
     lines.append("")
     for i in range(len(s["points/N"])):
         if "points/region" in s:    # a regional reduction (analysis/region.py)
-            lines.append(f"region {i}: {s['points/region_label'][i]}; {point_label(s, i, list(PARAMS))}  (resampling "
-                         f"{s['points/method'][i]}, {s['points/units'][i]} units; "
+            lines.append(f"region {i}: {s['points/region_label'][i]}; {point_label(s, i, list(PARAMS), law=True)}  "
+                         f"(resampling {s['points/method'][i]}, {s['points/units'][i]} units; "
                          f"window {s['points/region_span'][i]:.6g} T*nu per fault)")
         else:
-            lines.append(f"point {i}: " + point_label(s, i, list(PARAMS)) +
+            lines.append(f"point {i}: " + point_label(s, i, list(PARAMS), law=True) +
                          f"  (resampling {s['points/method'][i]}, {s['points/units'][i]} units)")
         if unreliable(s, i):
             lines.append(f"    WARNING: {unreliable(s, i)}")

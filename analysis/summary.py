@@ -47,31 +47,41 @@ the /tasks columns catalog, catalog_task and catalog_point) still reads, without
 (`has_creep` is False: its creep episodes, if any, were not reduced); older ones do not: reduce
 the catalogs again.
 
+Format 6 adds checksums: every dataset a `crc32` attribute (CRC-32 of its name and values), the file an
+`attrs_crc32` over its other attributes; read() checks them all and names the first that fails in one line
+(SummaryError), so one flipped byte is never read as a number. Summaries of formats 5 to 2 read unchecked.
+
 Every dataset carries a one-line `description` attribute (meaning, unit, shape) from the table
 DATASETS below (`python -c "from analysis import summary; print(summary.schema())"` prints it),
 so `h5dump -A` or any HDF5 viewer explains the file. A new dataset needs its line there
 (tests/test_export.py fails on a dataset without one); summaries written before the attribute
 existed read the same.
 """
+import io
 import os
+import zlib
 
 import h5py
 import numpy as np
 
-from ensemble import checks, filekind
+from ensemble import checks, filekind, space
 from ensemble.store import schema as catalog_schema
 
 from . import reduce
 from .reduce import MIN_UNITS, NUMBERS, PARAMS
 from .statistics import bin_names
 
-FORMAT = filekind.SUMMARY_FORMAT_PREFIX + "5"   # 5: the seismicity around large events (/bins/seis_*,
+FORMAT = filekind.SUMMARY_FORMAT_PREFIX + "6"   # 6: checksums (a `crc32` on every dataset, `attrs_crc32` over
+# the file's attributes: seal, checked by read). 5: the seismicity around large events (/bins/seis_*,
 # /per_task/seis_*, /per_task/seismicity, /points/seismicity_rate, its numbers, the seis_* attributes). 4: the
 # intervals statistic (/per_task/intervals, cv_tnu, mean_gap, cv_gap). 3: the creep episodes (bins, per-task
 # counts and sums, densities, CREEP_NUMBERS). 2: GR b and its standard error, 9 per-task sums, peaks by
 # prominence; several catalogs (catalogs, configs, partial, /tasks/catalog, catalog_task, catalog_point)
-# formats 4, 3 and 2 still read, without the datasets that came after them (a number a summary lacks is not shown)
-READS = (FORMAT, *(filekind.SUMMARY_FORMAT_PREFIX + n for n in "432"))
+# formats 5, 4, 3 and 2 still read, without the datasets that came after them (a number a summary lacks is not shown)
+# and without checksums
+READS = (FORMAT, *(filekind.SUMMARY_FORMAT_PREFIX + n for n in "5432"))
+CRC = "crc32"               # the attribute of every dataset of a FORMAT summary: _crc of its name and values
+ATTRS_CRC = "attrs_crc32"   # the file's attribute: _attrs_crc of all the others
 
 # Every dataset, one line each: (unit, shape, meaning), units as in ensemble/store/schema.py's DATASETS
 # (T nu, the plate's displacement during a recurrence time, is a model length).
@@ -161,6 +171,38 @@ def _describe(h5):
     h5.visititems(visit)
 
 
+def _canonical(value):
+    """The bytes a checksum covers of a dataset's values or an attribute, as h5py reads them back (text as
+    UTF-8 items, whatever the container h5py gives it in)."""
+    a = np.asarray(value)
+    if a.dtype.kind in "OSU":
+        items = [x.decode("utf-8", "replace") if isinstance(x, bytes) else str(x) for x in a.ravel()]
+        return f"text{a.shape}".encode() + "\0".join(items).encode()
+    return f"{a.dtype.str}{a.shape}".encode() + np.ascontiguousarray(a).tobytes()
+
+
+def _crc(name, value):
+    return zlib.crc32(name.encode() + b"\0" + _canonical(value))
+
+
+def _attrs_crc(attrs):
+    """Of every attribute of the file but ATTRS_CRC itself, in name order."""
+    crc = 0
+    for key in sorted(k for k in attrs if k != ATTRS_CRC):
+        crc = zlib.crc32(key.encode() + b"\0" + _canonical(attrs[key]), crc)
+    return crc
+
+
+def seal(h5):
+    """Every dataset's CRC from its values as read back, then the attributes' (read() checks them); also for a
+    test that edits a summary by hand."""
+    def visit(name, obj):
+        if isinstance(obj, h5py.Dataset):
+            obj.attrs[CRC] = _crc(name, obj[...])
+    h5.visititems(visit)
+    h5.attrs[ATTRS_CRC] = _attrs_crc(h5.attrs)
+
+
 class SummaryError(RuntimeError):
     """A summary that cannot be written or read; the message names the file."""
 
@@ -185,7 +227,11 @@ def write(path, inputs, per_task, points, opt, force=False):
     """inputs: analysis.merge.Inputs (the catalogs and their task table)."""
     checks.output(path, force=force, what="summary")   # again: one could have appeared during the work
     tmp = str(path) + ".partial"
-    with h5py.File(tmp, "w") as h5:
+    checks.output(tmp, force=True, what="summary")      # (a link there would be written through)
+    # built in memory, then written as plain bytes with its blocks reserved first (space.write_file): a full disk
+    # is one line, where an HDF5 write failing on it could crash the process when the file is closed
+    image = io.BytesIO()
+    with h5py.File(image, "w") as h5:
         h5.attrs.update({"format": FORMAT, **_source_attrs(inputs),
                          "mu_c": opt.mu_c, "window": opt.window, "b_cut": opt.b_cut,
                          "bootstrap": opt.bootstrap, "level": opt.level, "blocks": opt.blocks,
@@ -221,6 +267,11 @@ def write(path, inputs, per_task, points, opt, force=False):
             for name in st.extra_datasets:
                 h5[f"points/{name}"] = _padded([np.asarray(p[name], dtype=float) for p in points])
         _describe(h5)
+        seal(h5)
+    try:
+        space.write_file(tmp, image.getbuffer(), "the summary")
+    except OSError as err:
+        raise SummaryError(f"{tmp}: cannot write the summary ({err.strerror or err})") from None
     os.replace(tmp, path)
 
 
@@ -233,17 +284,47 @@ def _padded(arrays):
     return out
 
 
+class Read(dict):
+    """A summary as read: {dataset path: array, "attrs": {name: value}}. Asking for a dataset (or, in "attrs", an
+    attribute) the file does not hold raises SummaryError naming the file and what is missing, one line for the
+    commands (a summary of another version, or damaged), where a KeyError's traceback would be."""
+
+    def __init__(self, path, items=(), what="dataset"):
+        super().__init__(items)
+        self.path, self.what = path, what
+
+    def __missing__(self, key):
+        raise SummaryError(f"{self.path}: no {self.what} {key!r} in this summary (written by another version, or "
+                           f"damaged); reduce the catalogs again")
+
+
 def read(path):
-    """Summary -> nested dict of arrays and attributes."""
+    """Summary -> Read: a dict of arrays and attributes (see Read)."""
     filekind.require(path, "summary", SummaryError)
-    out = {}
+    out = Read(path)
     with filekind.reading(path, "the reduction summary", SummaryError):
         with h5py.File(path, "r") as h5:
+            sealed = h5.attrs.get("format") == FORMAT
+            damaged, sealed_datasets = [], []
+
             def visit(name, obj):
                 if isinstance(obj, h5py.Dataset):
                     out[name] = obj[...]
+                    want = obj.attrs.get(CRC)
+                    if want is not None:
+                        sealed_datasets.append(name)
+                    if sealed and (want is None or int(want) != _crc(name, out[name])):
+                        damaged.append(name)
             h5.visititems(visit)
-            out["attrs"] = {k: h5.attrs[k] for k in h5.attrs}
+            out["attrs"] = Read(path, {k: h5.attrs[k] for k in h5.attrs}, "attribute")
+            if sealed and (ATTRS_CRC not in h5.attrs or int(h5.attrs[ATTRS_CRC]) != _attrs_crc(h5.attrs)):
+                damaged.append("its attributes")
+            if not sealed and sealed_datasets:   # checksums in a file that says it is of an older format
+                damaged.append("its format attribute")
+        if damaged:
+            raise SummaryError(f"{path}: {damaged[0]} fails its checksum"
+                               + (f" (and {len(damaged) - 1} more)" if len(damaged) > 1 else "")
+                               + ": the summary is damaged; reduce the catalogs again")
         if out["attrs"].get("format") not in READS:
             raise SummaryError(f"{path}: summary format {out['attrs'].get('format', '(none)')}, this version "
                                f"reads {' and '.join(READS)}; reduce the catalog again")

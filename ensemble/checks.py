@@ -4,12 +4,14 @@
     checks.count("--bootstrap", args.bootstrap, lo=1, hi=10**6)
     checks.output(path, inputs=[catalog], force=args.force)   # before any work
     checks.memory("--blocks x bins x tasks", n_bytes)          # an allocation this machine cannot hold
+    checks.write_text(path, text, what="job script")           # a small text output, never through a link
 
 Both raise UsageError (a ValueError): a one-line message naming the option or the path, exit code 2
 in every command. An output is refused when its name is not UTF-8 (HDF5 and the lock need it), when
 it is one of the command's inputs (also with --force), when it is a directory where a file goes (or
 the reverse), when its directory is missing or not writable, and when it exists without --force.
 """
+import errno
 import math
 import os
 
@@ -72,7 +74,8 @@ def shown(path):
 
 
 def output(path, inputs=(), force=False, directory=False, what="output"):
-    """Refuse, before any work, an output that cannot be written or would destroy something.
+    """Refuse, before any work, an output that cannot be written or would destroy something: a file output
+    that is a symbolic link (writing it would write its target, whatever that is), among others.
 
     inputs: the command's input files (never overwritten, --force or not); directory: the output is a
     directory (made if missing) rather than a file; what: how the message names it ("catalog", ...).
@@ -91,6 +94,9 @@ def output(path, inputs=(), force=False, directory=False, what="output"):
     if directory:
         if os.path.exists(text) and not os.path.isdir(text):
             raise UsageError(f"{text}: exists and is not a directory")
+    elif os.path.islink(text):      # (writing it would write the file it points to)
+        raise UsageError(f"{text}: is a symbolic link (to {os.readlink(text)}); an output is never written "
+                         f"through a link: remove the link or give the {what} another name")
     elif os.path.isdir(text):
         raise UsageError(f"{text}: is a directory; give the {what} a file name")
     parent = os.path.dirname(os.path.abspath(text))
@@ -110,3 +116,20 @@ def _existing_ancestor(path):
     while not os.path.exists(path) and os.path.dirname(path) != path:
         path = os.path.dirname(path)
     return path
+
+
+def write_text(path, text, what="file"):
+    """Write `text` (UTF-8) to `path`, made or replaced, never through a symbolic link at `path` (its target
+    would be written); UsageError naming the file where it is a link or cannot be written."""
+    try:
+        fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_NOFOLLOW | os.O_NONBLOCK, 0o644)
+    except OSError as err:
+        if err.errno == errno.ELOOP:
+            raise UsageError(f"{path}: is a symbolic link; the {what} is never written through a link: remove "
+                             f"the link") from None
+        raise UsageError(f"{path}: cannot write the {what} ({err.strerror})") from None
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+    except OSError as err:
+        raise UsageError(f"{path}: cannot write the {what} ({err.strerror})") from None

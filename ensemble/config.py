@@ -17,6 +17,7 @@ from .config_rules import ConfigError, check_overflow, coerce, point_values
 from .integrators import INTEGRATORS
 from .integrators import KEYS as INTEGRATOR_KEYS
 from .model import laws
+from .model.geometry import SOFTEST_STIFFNESS
 from .sections import POPULATION, SECTION_NAMES, SWEEP
 
 __all__ = ["Config", "ConfigError", "DECORRELATION_PER_BLOCK", "Integrator", "LAW_KEYS", "MEASURED_TRANSIENT_PER_BLOCK",
@@ -292,7 +293,23 @@ def from_dict(raw, overridden=None):
         raise ConfigError(f"integrator.creep_tol = {cfg.integrator.creep_tol!r}: model.law = {law.name!r} has no creep "
                           f"phase (its blocks always start inertial events; docs/laws.md)")
     check_overflow(cfg)
+    _check_some_event(cfg, law)
     return cfg
+
+
+def _check_some_event(cfg, law):
+    """Refuse a point whose chain can never have an event: its law's steady weakening (laws: steady_weakening)
+    below the chain's softest stiffness. It would creep steadily at v = nu for ever (a run of it would never end).
+    At equality the whole chain's creep is not positive definite (creep.py): it turns unstable, and events follow."""
+    if not law.steady_weakening:
+        return
+    name, values = point_values(cfg, f"model.{law.steady_weakening}")
+    low = min(values)
+    if low < SOFTEST_STIFFNESS:
+        raise ConfigError(f"{name} = {low:g}: below the chain's softest stiffness {SOFTEST_STIFFNESS:g} (the "
+                          f"loader's spring, every block moving together), so the chain creeps steadily at v = nu for "
+                          f"ever and never has an event; model.law = {law.name!r} needs {law.steady_weakening} >= "
+                          f"{SOFTEST_STIFFNESS:g} (docs/numerics.md)")
 
 
 def _integrator_names():

@@ -79,6 +79,9 @@ def coerce(section, key, value, typ, where=None):
             # "> 0" and ">= 0" alone let inf through (and TOML reads 1e400 as inf)
             raise ConfigError(f"{where} must be a finite number, got {value!r}")
     elif typ is int:
+        # a count written as the docs write counts (2e5) is a float that is an exact integer: taken as that integer
+        if isinstance(value, float) and math.isfinite(value) and value.is_integer() and abs(value) < 2 ** 53:
+            value = int(value)
         if isinstance(value, bool) or not isinstance(value, int):
             raise ConfigError(f"{where} must be an integer, got {value!r}")
         if not -2**63 <= value < 2**63:   # tomllib reads integers of any size; catalogs store int64

@@ -81,3 +81,26 @@ def reserve_file(path):
         reserve(fd, size, "the catalog")
     finally:
         os.close(fd)
+
+
+def write_file(path, data, what):
+    """Write the bytes `data` to `path` (made or replaced, never through a symbolic link) with plain file I/O, its
+    blocks reserved first: a full disk, a quota or `ulimit -f` is an OSError naming `what` (NoSpace where it does
+    not fit), and `path` is removed. For HDF5 files built in memory first (an HDF5 write that fails on a full disk
+    leaves a file that may crash the process when closed)."""
+    limit = size_limit()
+    if limit is not None and len(data) > limit:
+        raise NoSpace(errno.EFBIG, f"File too large: {what} needs {len(data) / MiB:.1f} MiB and the file-size "
+                                   f"limit (ulimit -f) is {limit / MiB:.1f} MiB")
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_NOFOLLOW, 0o644)
+    try:
+        reserve(fd, len(data), what)
+        view = memoryview(data)
+        while view:
+            view = view[os.write(fd, view):]
+        os.fsync(fd)
+    except OSError:
+        os.close(fd)
+        os.remove(path)
+        raise
+    os.close(fd)

@@ -497,6 +497,194 @@ def export_of_an_unfinished_run(w):
              "--partial")
 
 
+def links_are_never_written_through(w):
+    """A symbolic link at the name of a run's lock, its .partial or its catalog, to a finished catalog or a text
+    file, and at a summary's or its .partial's: refused in one line naming it, exit 2, the target unchanged (a
+    PATH.lock link once had its target overwritten by the lock's text, exit 0)."""
+    precious = w.root / "precious.h5"
+    shutil.copy(w.full, precious)
+    notes = w.root / "notes.txt"
+    notes.write_text("mine\n")
+    before = {target: target.read_bytes() for target in (precious, notes)}
+    out = w.root / "linked.h5"
+    for name, target, extra in (("linked.h5.lock", precious, []), ("linked.h5.lock", notes, []),
+                                ("linked.h5.partial", precious, ["--force"]),
+                                ("linked.h5.partial", precious, ["--resume"]), ("linked.h5", notes, ["--force"])):
+        link = w.root / name
+        link.symlink_to(target)
+        try:
+            one_line(_python("ensemble", "run", w.cfg, "-o", out, *extra), (2,), name, "symbolic link")
+        finally:
+            link.unlink()
+    for name in ("s.h5", "s.h5.partial"):
+        link = w.root / name
+        link.symlink_to(notes)
+        try:
+            one_line(_here("analysis", "reduce", w.full, "-o", w.root / "s.h5", "--force"), (2,), name,
+                     "symbolic link")
+        finally:
+            link.unlink()
+    assert {target: target.read_bytes() for target in before} == before
+    nothing_left(w.root, "linked.h5")
+    nothing_left(w.root, "s.h5")
+
+
+def a_file_at_the_locks_name_is_not_a_lock(w):
+    """A file of someone else's where the lock goes (not a lock: no host, no pid) is left as it is."""
+    mine = w.root / "other.h5.lock"
+    mine.write_text("my notes\n")
+    one_line(_python("ensemble", "run", w.cfg, "-o", w.root / "other.h5"), (2,), str(mine), "not a lock")
+    assert mine.read_text() == "my notes\n"
+    mine.unlink()
+    nothing_left(w.root, "other.h5")
+
+
+def slurm_job_where_it_cannot_be_written(w):
+    """`ensemble slurm -o` below a plain file (the folder cannot be made), and a job directory whose submit.sh is a
+    link to a file of the user's: one line naming the path, exit 2, the file unchanged (a PermissionError's
+    traceback before)."""
+    plain = w.root / "plain.txt"
+    plain.write_text("mine\n")
+    one_line(_here("ensemble", "slurm", w.cfg, "--ntasks", 2, "--time", 10, "-o", plain / "job"), (2,),
+             "plain.txt", "cannot write the job")
+    job = w.root / "job-with-a-link"
+    job.mkdir()
+    (job / "submit.sh").symlink_to(plain)
+    one_line(_here("ensemble", "slurm", w.cfg, "--ntasks", 2, "--time", 10, "-o", job, "--force"), (2,),
+             "submit.sh", "symbolic link")
+    assert plain.read_text() == "mine\n"
+    # an option's error names that option (--reduce-time's once named --time)
+    one_line(_here("ensemble", "slurm", w.cfg, "--ntasks", 2, "--time", 10, "--reduce-time", 0, "-o",
+                   w.root / "job-reduce-time"), (2,), "--reduce-time must be positive")
+    nothing_left(w.root, "job-reduce-time")
+
+
+def _whole_summary(w):
+    """The finished catalog's summary (made once)."""
+    whole = w.root / "whole.summary.h5"
+    if not whole.exists():
+        assert _here("analysis", "reduce", w.full, "-o", whole, "--bootstrap", 20).returncode == 0
+    return whole
+
+
+def what_a_reader_sees_says_what_it_is(w):
+    """The report names each point's law (it printed the parameters alone); the run's last line tells rows,
+    inertial events and creep episodes apart (it called every row an event)."""
+    res = _here("analysis", "report", _whole_summary(w))
+    assert res.returncode == 0 and "point 0: aging: N = 60" in res.stdout, res.stdout
+    res = _python("ensemble", "run", w.creep_config(), "-o", w.root / "rows.h5", "--set", "run.events=40")
+    assert res.returncode == 0, res.stderr
+    line = res.stdout.strip().splitlines()[-1]
+    assert "160 rows: " in line and " inertial events, " in line and " creep episodes in " in line, line
+    assert "wrote " in _python("ensemble", "run", w.cfg, "-o", w.root / "plain.h5").stdout.strip().splitlines()[-1]
+
+
+def flipped_summary(w):
+    """One flipped byte in a summary's number, parameter, law, peak or unit count, or a changed attribute: report,
+    plot, export and paper refuse it in one line naming what fails its checksum, exit 1 (each passed with exit 0,
+    showing the wrong value, before summaries had checksums)."""
+    whole = _whole_summary(w)
+    commands = {"report": [], "plot": ["--figure", "magnitude", "-o", w.root / "flipped.png"],
+                "export": ["-o", w.root / "flipped-tables"], "paper": []}
+    for target in ("points/numbers/gr_b", "points/b", "points/law", "points/peaks", "points/units", "level"):
+        flipped = w.root / "flipped.summary.h5"
+        shutil.copy(whole, flipped)
+        if target == "level":
+            with h5py.File(flipped, "r+") as h5:
+                h5.attrs["level"] = 0.9
+        else:
+            _flip(flipped, target, byte=0 if target == "points/law" else 3)
+        for command, out in commands.items():
+            one_line(_here("analysis", command, flipped, *out), (1,), "flipped.summary.h5",
+                     "its attributes" if target == "level" else target, "fails its checksum")
+        nothing_left(w.root, "flipped.png")
+        nothing_left(w.root, "flipped-tables")
+
+
+def slurm_with_the_mpich_wheel(w):
+    """The jobs' python has the mpich wheel (whose ranks srun cannot start): without --launcher the job takes
+    mpiexec (it once said so in a note and wrote srun); an explicit --launcher srun is kept, with the note."""
+    from ensemble.slurm import command, stack
+    real = command.python_stack
+    command.python_stack = lambda python: (None, f"MPICH 4, {stack.WHEEL_MPI}")
+    try:
+        for extra, launcher, note in (([], "mpiexec", False), (["--launcher", "srun"], "srun", True)):
+            job = w.root / f"job-wheel-{launcher}"
+            res = _here("ensemble", "slurm", w.cfg, "--ntasks", 2, "--time", 10, "-o", job, *extra)
+            assert res.returncode == 0, res.stderr
+            script = (job / "requeue.sbatch").read_text()
+            assert f'LAUNCHER="{launcher}"' in script or f"LAUNCHER={launcher}" in script, script
+            assert ("--launcher mpiexec" in res.stdout) == note, res.stdout
+    finally:
+        command.python_stack = real
+
+
+def summary_missing_what_a_reader_needs(w):
+    """A summary without a dataset or an attribute its readers need (written by another version, or damaged):
+    report, plot, export and paper each either do without it (exit 0) or say so in one line naming it, exit 1
+    (KeyError tracebacks before); each is needed by one of them at least."""
+    whole = _whole_summary(w)
+    # each with the commands that must refuse it (the others may do without it)
+    for name, commands in (("points/mu_density", ("plot",)), ("bins/mu", ("plot", "export")),
+                           ("points/units", ("report", "plot")), ("tasks/catalog", ("paper",)),
+                           ("catalogs", ("paper",)), ("configs", ("paper",))):
+        lacking = w.root / "lacking.summary.h5"
+        shutil.copy(whole, lacking)
+        with h5py.File(lacking, "r+") as h5:   # as a summary of format 5 (no checksums) would lack it
+            h5.attrs["format"] = "bk-summary-5"
+            del h5.attrs["attrs_crc32"]
+            h5.visititems(lambda _, obj: obj.attrs.__delitem__("crc32") if isinstance(obj, h5py.Dataset) else None)
+            if name in h5.attrs:
+                del h5.attrs[name]
+            else:
+                del h5[name]
+        refused = 0
+        for command in ("report", "plot", "export", "paper"):
+            out = {"plot": ["--figure", "magnitude", "-o", w.root / "lacking.png", "--force"],
+                   "export": ["-o", w.root / "lacking-tables", "--force"]}.get(command, [])
+            res = _here("analysis", command, lacking, *out)
+            if res.returncode != 0 or command in commands:
+                one_line(res, (1,), "lacking.summary.h5", repr(name))
+                refused += 1
+        assert refused, f"no reader needs {name}"
+
+
+def a_chain_that_never_has_an_event(w):
+    """b below the loader's stiffness 1 (the chain's softest: every block moving together): the chain creeps at
+    v = nu for ever and no event starts (a run of it once ran at full CPU without end). validate and run refuse it
+    in one line naming the key, for either rate-and-state law, a sweep and a population (b = 1 runs:
+    tests/test_creep.py)."""
+    population = w.root / "never.toml"
+    population.write_text("[model]\nN = 5\n[run]\nevents = 1\ntransient = 0\n[population]\nfaults = 3\n"
+                          'b = {distribution = "uniform", min = 0.1, max = 0.9}\n')
+    for cfg, sets, key in ((w.cfg, ["model.N=1", "model.b=0.5"], "model.b = 0.5"),
+                           (w.cfg, ["model.N=5", "model.b=0.99", 'model.law="slip"'], "model.b = 0.99"),
+                           (w.cfg, ["sweep.b=[20, 0.9]"], "sweep.b = 0.9"),
+                           (population, [], "population.b = 0.1")):
+        args = [a for s in sets for a in ("--set", s)]
+        one_line(_here("ensemble", "validate", cfg, *args), (2,), key, "never has an event")
+    one_line(_python("ensemble", "run", w.cfg, "--set", "model.N=1", "--set", "model.b=0.5", "--set",
+                     "run.events=1", "-o", w.root / "never.h5"), (2,), "model.b = 0.5", "never has an event")
+    nothing_left(w.root, "never.h5")
+
+
+def reduce_and_export_onto_a_full_disk(w):
+    """`analysis reduce` and `export` onto a 100 KB tmpfs: one line, exit 1, nothing left behind (reduce once
+    crashed in HDF5's close, exit 139 with a backtrace, leaving S.h5.partial; export left an empty folder). Each
+    in a process of its own: a crash must show as one."""
+    mount = _mount_tmpfs("100k")
+    try:
+        one_line(_python("analysis", "reduce", w.full, "-o", mount / "S.h5"), (1,), "S.h5.partial",
+                 "No space left on device")
+        nothing_left(mount, "S.h5")
+        stat = os.statvfs(mount)        # the rest of the disk taken: the tables (a few KB) cannot be written
+        (mount / "filler").write_bytes(bytes(stat.f_bavail * stat.f_frsize))
+        one_line(_python("analysis", "export", w.full, "-o", mount / "tables"), (1,), "No space left on device")
+        nothing_left(mount, "tables")
+    finally:
+        _unmount(mount)
+
+
 def one_rank_fails(target, rank, writer="auto", branch=False):
     """A step of a collective path fails on one rank: every rank leaves, at once, with a non-zero exit."""
     def attack(w):
@@ -538,6 +726,15 @@ ATTACKS = {
     "output folder missing": missing_folder,
     "non-finite and huge analysis options": bad_analysis_numbers,
     "export of an unfinished run": export_of_an_unfinished_run,
+    "links at a run's and a summary's output names are never written through": links_are_never_written_through,
+    "a file at the lock's name that is not a lock is left alone": a_file_at_the_locks_name_is_not_a_lock,
+    "a Slurm job where it cannot be written": slurm_job_where_it_cannot_be_written,
+    "a Slurm job for the mpich wheel starts its ranks with mpiexec": slurm_with_the_mpich_wheel,
+    "a summary without a dataset or an attribute its readers need": summary_missing_what_a_reader_needs,
+    "a flipped byte or a changed attribute in a summary": flipped_summary,
+    "what a reader sees says what it is": what_a_reader_sees_says_what_it_is,
+    "a chain that can never have an event is refused": a_chain_that_never_has_an_event,
+    "analysis reduce and export onto a full disk": reduce_and_export_onto_a_full_disk,
     **{f"mpi: {target} fails on rank {rank} ({writer})": one_rank_fails(target, rank, writer)
        for target, rank, writer in (
            ("ensemble.store.create:create_layout", 1, "parallel"),

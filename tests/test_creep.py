@@ -291,6 +291,26 @@ def test_above_the_block_stiffness_nothing_creeps():
     assert not creep.possible(kernel_params(cl, Integrator()), 100)
 
 
+@pytest.mark.parametrize("law, n", [("aging", 1), ("aging", 5)])
+def test_at_the_softest_stiffness_events_still_start(tmp_path, law, n):
+    """The boundary config.py draws: b below 1 (the loader's stiffness, the chain's softest) is refused, since the
+    chain would creep for ever (tests/attack.py); at b = 1 the aging law's whole-chain creep is not positive
+    definite, turns unstable, and the run reaches its inertial events. (The slip law at b = 1, N = 5 ran for
+    minutes without its events: where its boundary lies is not settled yet.)"""
+    from ensemble.config import ConfigError, loads
+    from ensemble.store import reader
+    from .conftest import write_config
+    from .processes import ensemble_here
+    cfg = write_config(tmp_path / "edge.toml", model={"N": n, "b": 1.0, "law": law},
+                       run={"seeds": 1, "events": 6, "transient": 0})
+    with pytest.raises(ConfigError, match="model.b = 0.999: below the chain's softest stiffness 1"):
+        loads(cfg.read_text().replace("b = 1.0", "b = 0.999"))
+    res = ensemble_here("run", cfg, "-o", tmp_path / "edge.h5")
+    assert res.returncode == 0, res.stderr
+    events, _, _ = reader.read(tmp_path / "edge.h5")
+    assert len(events["t"]) == 6 and np.any(events["kind"] == KIND_EVENT), events["kind"]
+
+
 def test_a_block_that_stuck_on_its_threshold_does_not_creep_in_place():
     """With a strong velocity strengthening (a = 30, b = 15) events leave blocks stuck on their threshold
     while it outruns the loader. Such a block is on its threshold for an instant only: it must not start a

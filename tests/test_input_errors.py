@@ -124,6 +124,14 @@ def test_non_finite_sweep_value_refused(key):
         loads("", [f"sweep.{key}=[0.5, nan]"])
 
 
+def test_a_count_written_as_a_float_that_is_an_integer_is_that_integer():
+    """Counts as the docs write them (2e5 events): an exact integer as a float is taken; 1.5 is not."""
+    assert loads("[run]\nevents = 2e5\n").run.events == 200000
+    assert loads("", ["run.events=3e3", "run.seeds=2.0"]).run.events == 3000
+    with pytest.raises(ConfigError, match=r"run\.events must be an integer, got 1500\.5"):
+        loads("[run]\nevents = 1500.5\n")
+
+
 def test_integer_beyond_64_bits_refused():
     with pytest.raises(ConfigError, match="run.events must fit in 64 bits"):
         loads("[run]\nevents = 100000000000000000000\n")

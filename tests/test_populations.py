@@ -231,7 +231,7 @@ def test_a_region_of_two_faults_is_their_rate_weighted_mixture(two_faults):
     p = summary.read(plain)
     assert list(p["points/numbers/n_events"][:, 0]) == [400, 400]
     res = analysis_here("report", out)
-    assert res.returncode == 0 and "region 0: b: uniform on [20, 50]; N = 40" in res.stdout
+    assert res.returncode == 0 and "region 0: b: uniform on [20, 50]; aging: N = 40" in res.stdout
     # the later part alone: windows from 100 (T nu / nu) after each first onset, for the 299 left of the shorter span
     later = d / "two.later.h5"
     res = analysis_here("reduce", path, "--region", "--region-skip", 100 * nu, "-o", later, "--bootstrap", 20)

@@ -5,6 +5,11 @@ w = u + c), so a block's force is compared with its law's threshold (laws/__init
 """
 import numba as nb
 
+# The smallest eigenvalue of the chain's stiffness operator (the loader's spring 1 on every block, l^2 between
+# neighbours, free ends): every block moving together stretches only the loader's springs. No cluster of creeping
+# blocks is softer, so a law whose steady creep weakens by at most this never turns unstable (laws: steady_weakening).
+SOFTEST_STIFFNESS = 1.0
+
 
 @nb.njit(cache=True, inline="always")
 def left(i):

@@ -5,6 +5,7 @@ refused (Refused, exit 2) when its output cannot become a catalog, exists withou
 interrupted run beside it without --resume; a resume is refused when its config differs from the
 stored one. A catalog that does not fit on its disk (space.py) is refused before any HDF5 call.
 """
+import errno
 import os
 
 import numpy as np
@@ -17,6 +18,7 @@ from ..store.errors import CatalogError
 from ..store.schema import FAILED, FINISHED
 from ..sweep import task_list
 from .branching import spins_needed
+from .lock import lock_path
 
 
 class Refused(RuntimeError):
@@ -39,11 +41,12 @@ def config_differences(stored_text, cfg, sections=("model", "run", "integrator")
 
 def check_output(ctx):
     """Refuse, before the lock and any work, an output that cannot become a catalog (checks.output):
-    a name that is not UTF-8, one of the run's inputs (its config), a directory, a missing or read-only
-    folder. Whether the catalog exists is prepare's to judge (--resume, --force)."""
+    a name that is not UTF-8, one of the run's inputs (its config), a directory, a symbolic link (the catalog,
+    its .partial or its lock: never written through), a missing or read-only folder. Whether the catalog
+    exists is prepare's to judge (--resume, --force)."""
     try:
-        for p in (ctx.path, ctx.partial):
-            checks.output(p, inputs=ctx.inputs, force=True, what="catalog")
+        for p, what in ((ctx.path, "catalog"), (ctx.partial, "catalog"), (lock_path(ctx.path), "lock")):
+            checks.output(p, inputs=ctx.inputs, force=True, what=what)
     except checks.UsageError as err:
         raise Refused(str(err)) from None
 
@@ -96,8 +99,12 @@ def prepare(ctx):
 
 
 def _fits(partial, check):
-    """Run a space check (space.py) before any HDF5 call; a catalog that does not fit is refused on every rank alike."""
+    """Run a space check (space.py) before any HDF5 call; a catalog that does not fit, or cannot be written at all
+    (a read-only file or file system: not a matter of space), is refused on every rank alike."""
     try:
         check()
     except OSError as err:
+        if err.errno in (errno.EACCES, errno.EPERM, errno.EROFS):
+            raise CatalogError(f"{partial}: cannot be written ({err.strerror}); a run writes its catalog there",
+                               collective=True) from None
         raise CatalogError(f"{partial}: the catalog does not fit ({err.strerror or err})", collective=True) from None

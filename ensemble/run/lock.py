@@ -18,6 +18,7 @@ import errno
 import fcntl
 import os
 import socket
+import stat
 import threading
 import time
 
@@ -124,9 +125,17 @@ class RunLock:
 
     def _try_acquire(self):
         try:
-            fd = os.open(self.file, os.O_RDWR | os.O_CREAT, 0o644)
+            # never through a link (ELOOP), and never blocking on a FIFO put there (a regular file is checked next)
+            fd = os.open(self.file, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_NONBLOCK, 0o644)
         except OSError as err:
+            if err.errno == errno.ELOOP:
+                raise LockError(f"{self.file}: the lock file is a symbolic link; a lock is never written through "
+                                f"a link: remove it (rm {self.file}) and start again") from None
             raise LockError(f"{self.file}: cannot create the lock file ({err.strerror})") from None
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            os.close(fd)
+            raise LockError(f"{self.file}: not a regular file, so not a lock of this package: remove it and start "
+                            f"again")
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError as err:
@@ -144,7 +153,12 @@ class RunLock:
         if not same:
             os.close(fd)
             return self._try_acquire()
-        info = _parse(os.pread(fd, 4096, 0).decode(errors="replace"))
+        text = os.pread(fd, 4096, 0).decode(errors="replace")
+        info = _parse(text)
+        if text.strip() and not {"host", "pid"} <= set(info):
+            os.close(fd)        # a file of someone else's at the lock's name: not ours to overwrite
+            raise LockError(f"{self.file}: exists and is not a lock of this package (no host and pid); it is left "
+                            f"as it is: move it away and start again")
         if info:
             self._judge_leftover(fd, info)
         self.fd = fd

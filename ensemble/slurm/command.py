@@ -8,7 +8,7 @@ from ..config import load
 from .kinds import KINDS
 from .options import JobOptions, SlurmError
 from .render import check, rel, render
-from .stack import mpi_note, python_stack
+from .stack import WHEEL_MPI, mpi_note, python_stack
 from .submit import SubmitError, submit
 
 
@@ -36,7 +36,9 @@ def add_arguments(p):
     p.add_argument("--startup-seconds", type=int, help="hold a USR1 that comes earlier than this "
                    "after launch (default 60, at most a quarter of the limit)")
     p.add_argument("--max-requeues", type=int, default=d.max_requeues, help="default %(default)s")
-    p.add_argument("--launcher", choices=("srun", "mpiexec"), default=d.launcher)
+    p.add_argument("--launcher", choices=("srun", "mpiexec"), default=None,
+                   help=f"how the job starts its ranks (default {d.launcher}; mpiexec where the jobs' python has "
+                        f"the mpich wheel, whose ranks srun cannot start)")
     p.add_argument("--srun-mpi", default=d.srun_mpi, help="srun --mpi plugin (default %(default)s)")
     p.add_argument("--python", default=d.python, help="python on the nodes (default: this one)")
     p.add_argument("--setup", action="append", default=[], metavar="LINE",
@@ -64,7 +66,8 @@ def command(args):
     opt = JobOptions(kind=args.kind, ntasks=args.ntasks, time=args.time, partition=args.partition,
                      account=args.account, cpus_per_task=args.cpus_per_task,
                      signal_seconds=args.signal_seconds, startup_seconds=args.startup_seconds,
-                     max_requeues=args.max_requeues, launcher=args.launcher, srun_mpi=args.srun_mpi,
+                     max_requeues=args.max_requeues, launcher=args.launcher or JobOptions.launcher,
+                     srun_mpi=args.srun_mpi,
                      python=args.python, setup=tuple(args.setup), sbatch=tuple(args.sbatch),
                      numba_cache=args.numba_cache, file_locking=not args.no_file_locking,
                      array_limit=args.array_limit, reduce_ntasks=args.reduce_ntasks,
@@ -76,6 +79,8 @@ def command(args):
         check(opt)     # a bad option is refused before python_stack() starts the jobs' python
         problem, mpi = python_stack(opt.python)
         opt = dataclasses.replace(opt, mpi=mpi)
+        if args.launcher is None and mpi.endswith(WHEEL_MPI):    # what the note would otherwise ask for
+            opt = dataclasses.replace(opt, launcher="mpiexec")
         out = render(cfg, opt, directory, name, force=args.force)
     except SlurmError as err:
         print(f"error: {err}", file=sys.stderr)

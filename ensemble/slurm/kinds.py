@@ -7,6 +7,7 @@ parameter point of the sweep (point_configs), each with a seed of its own drawn 
 import dataclasses
 from pathlib import Path
 
+from .. import checks
 from ..config import replace
 from .options import check_path
 
@@ -37,7 +38,7 @@ def _single_configs(cfg, directory):
     path = Path(cfg.output.path)
     catalog = path if path.is_absolute() else directory / path
     snapshot = directory / "config.toml"
-    snapshot.write_text(replace(cfg, "output", path=str(catalog)).to_toml())
+    checks.write_text(snapshot, replace(cfg, "output", path=str(catalog)).to_toml(), "config snapshot")
     return {"CONFIG": check_path(snapshot), "CATALOG": check_path(catalog)}, [snapshot], [catalog]
 
 
@@ -52,9 +53,9 @@ def _array_configs(cfg, directory):
         values = ", ".join(f"{key}={getattr(sub.model, key)!r}" if not key.startswith("population.") else
                            f"{key}={dict(sub.population.draws)[key.partition('.')[2]].to_toml()}"
                            for key, _ in cfg.sweep)
-        path.write_text(f"# array element {i}: point {i} of the sweep ({values or 'no sweep'}); "
-                        f"run.seed from SeedSequence({cfg.run.seed}, spawn_key=({i},))\n"
-                        + replace(sub, "output", path=str(catalog)).to_toml())
+        checks.write_text(path, f"# array element {i}: point {i} of the sweep ({values or 'no sweep'}); "
+                                f"run.seed from SeedSequence({cfg.run.seed}, spawn_key=({i},))\n"
+                                + replace(sub, "output", path=str(catalog)).to_toml(), "config snapshot")
         files.append(path)
         catalogs.append(catalog)
     return {"POINTS_DIR": check_path(points_dir), "ARRAY": f"0-{len(catalogs) - 1}"}, files, catalogs

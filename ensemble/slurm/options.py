@@ -42,15 +42,15 @@ class JobOptions:
     mpi: str = ""                   # the MPI PYTHON was built against (python_stack()), for a comment
 
 
-def time_seconds(text):
+def time_seconds(text, option="--time"):
     """A Slurm time limit (M, M:S, H:M:S, D-H, D-H:M, D-H:M:S) -> seconds, as Slurm rounds it
-    (up to whole minutes)."""
+    (up to whole minutes); `option` names it in the error."""
     days, dash, rest = text.strip().partition("-")
     if not dash:
         days, rest = "", days
     parts = rest.split(":")
     if (dash and not days.isdigit()) or not all(p.isdigit() for p in parts) or len(parts) > 3:
-        raise SlurmError(f"--time must be a Slurm time limit like 90, 02:00:00 or 1-12:00, got {text!r}")
+        raise SlurmError(f"{option} must be a Slurm time limit like 90, 02:00:00 or 1-12:00, got {text!r}")
     nums = [int(p) for p in parts]
     if days:
         h, m, s = (nums + [0, 0])[:3]
@@ -59,7 +59,7 @@ def time_seconds(text):
         seconds = {1: lambda m: m * 60, 2: lambda m, s: m * 60 + s,
                    3: lambda h, m, s: h * 3600 + m * 60 + s}[len(nums)](*nums)
     if seconds <= 0:
-        raise SlurmError(f"--time must be positive, got {text!r}")
+        raise SlurmError(f"{option} must be positive, got {text!r}")
     return -(-seconds // 60) * 60
 
 

@@ -4,6 +4,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
+from .. import checks
 from ..config import Config
 from . import options
 from .kinds import KINDS
@@ -89,7 +90,7 @@ def render(cfg: Config, opt: JobOptions, directory, name="run", templates=TEMPLA
     check(opt)
     limit = time_seconds(opt.time)
     signal, startup = defaults(opt, limit)
-    time_seconds(opt.reduce_time)
+    time_seconds(opt.reduce_time, "--reduce-time")
     directory = Path(directory).resolve()
     if not force and directory.is_dir() and any(directory.iterdir()):
         raise SlurmError(f"{rel(directory)}: a job directory exists (scripts, config snapshot, catalogs); "
@@ -97,9 +98,14 @@ def render(cfg: Config, opt: JobOptions, directory, name="run", templates=TEMPLA
     if directory.exists() and not directory.is_dir():
         raise SlurmError(f"{rel(directory)}: exists and is not a directory")
     template, configs = KINDS[opt.kind]
-    for d in (directory, directory / "logs"):
-        d.mkdir(parents=True, exist_ok=True)
-    values, files, catalogs = configs(cfg, directory)
+    try:
+        for d in (directory, directory / "logs"):
+            d.mkdir(parents=True, exist_ok=True)
+        values, files, catalogs = configs(cfg, directory)
+    except OSError as err:      # (a folder that cannot be written, a file where a folder goes)
+        raise SlurmError(f"{rel(directory)}: cannot write the job there ({err.strerror})") from None
+    except checks.UsageError as err:
+        raise SlurmError(str(err)) from None
     # one summary of the run: named after its catalog, or after the config for an array's catalogs
     result_name = Path(catalogs[0]).stem if opt.kind != "array" else name
     check_path(result_name)
@@ -124,17 +130,22 @@ def render(cfg: Config, opt: JobOptions, directory, name="run", templates=TEMPLA
         "REGION": "1" if cfg.population is not None else "0",
     })
     reduce_script = directory / "reduce.sbatch"
-    for src, dst in ((template, run_script), ("reduce.sbatch", reduce_script)):
-        dst.write_text(fill((Path(templates) / src).read_text(), values))
     submit_sh = directory / "submit.sh"
-    submit_sh.write_text(
-        "#!/bin/bash\n# Submit the run job, then the reduction, which starts when the run has succeeded.\n"
-        "set -euo pipefail\n"
-        f"run=$(sbatch --parsable {run_script})\nrun=${{run%%;*}}\n"
-        f"reduce=$(sbatch --parsable --dependency=afterok:$run {reduce_script})\nreduce=${{reduce%%;*}}\n"
-        f'echo "run job $run ({run_script.name}); reduction job $reduce (after job $run has succeeded)"\n')
-    for script in (run_script, reduce_script, submit_sh):
-        script.chmod(0o755)
+    texts = {run_script: fill((Path(templates) / template).read_text(), values),
+             reduce_script: fill((Path(templates) / "reduce.sbatch").read_text(), values),
+             submit_sh: "#!/bin/bash\n# Submit the run job, then the reduction, which starts when the run has "
+                        "succeeded.\nset -euo pipefail\n"
+                        f"run=$(sbatch --parsable {run_script})\nrun=${{run%%;*}}\n"
+                        f"reduce=$(sbatch --parsable --dependency=afterok:$run {reduce_script})\n"
+                        "reduce=${reduce%%;*}\n"
+                        f'echo "run job $run ({run_script.name}); reduction job $reduce (after job $run has '
+                        'succeeded)"\n'}
+    try:
+        for script, text in texts.items():
+            checks.write_text(script, text, "job script")
+            script.chmod(0o755)
+    except checks.UsageError as err:
+        raise SlurmError(str(err)) from None
     return Rendered(directory, run_script, reduce_script, tuple(catalogs), directory / "results",
                     tuple([run_script, reduce_script, submit_sh] + files),
                     directory / "results" / f"{result_name}.summary.h5")

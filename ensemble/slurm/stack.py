@@ -22,6 +22,9 @@ print(wheel)
 """
 
 
+WHEEL_MPI = "the mpich wheel inside the environment"   # how python_stack names that MPI (the end of its text)
+
+
 def python_stack(python):
     """(problem, mpi) for the jobs' `python`, started outside the repository as the jobs are:
     problem is None or a warning (not on this machine, cannot import what the jobs need); mpi
@@ -36,7 +39,7 @@ def python_stack(python):
                 f"({why}); install the package into it (pip install -e .)"), ""
     library, files, wheel = (res.stdout.splitlines() + ["", "", ""])[:3]
     if wheel:
-        return None, f"{library}, the mpich wheel inside the environment"
+        return None, f"{library}, {WHEEL_MPI}"
     return None, f"{library}" + (f", {files}" if files else "")
 
 
@@ -45,7 +48,7 @@ def mpi_note(opt):
     if not opt.mpi:
         return ("note: the nodes need the MPI that mpi4py and h5py of the jobs' python were built against "
                 "(load it with --setup 'module load ...')")
-    if opt.mpi.endswith("the mpich wheel inside the environment"):
+    if opt.mpi.endswith(WHEEL_MPI):
         hint = ("" if opt.launcher == "mpiexec"
                 else "; start its ranks with --launcher mpiexec (docs/install.md: srun and PMI)")
         return f"note: MPI: {opt.mpi}; the nodes need no MPI of their own{hint}"

@@ -78,6 +78,10 @@ class Law:
     creep_state: object = None  # (law, psi0, v, h) -> (psi, d psi / d v): the state after a backward
                           # Euler step of size h at velocity v from psi0
     friction_slopes: object = None  # (law, v, psi) -> (d friction / d v, d friction / d psi)
+    steady_weakening: str = ""  # the [model] key whose value is the weakening of a block creeping steadily at
+                          # a small v (-d friction / d slip at the steady state; aging and slip: b): a chain
+                          # whose softest stiffness (geometry.SOFTEST_STIFFNESS) is above that creeps steadily
+                          # for ever and never has an event, so config.py refuses it; "": no creep
 
     @property
     def creeps(self):

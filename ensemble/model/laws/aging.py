@@ -218,6 +218,7 @@ LAW = Law(
     onset_delay=onset_delay, implicit_state=implicit_state, stiff_limit=stiff_limit,
     rk4_unstable=rk4_unstable, linear_state=linear_state,
     creep_weakening=creep_weakening, creep_state=creep_state, friction_slopes=friction_slopes,
+    steady_weakening="b",
     # the paper's axes: R(mu) over 0..7, large events mu >= 4, GR fit above 3, T nu up to 2000
     scales=Scales(mu_bins="0:7:70", mu_c=4.0, b_cut=3.0, tnu_bins="0:2000:80"),
     # exponential in the state: at rtol 1e-4 its magnitudes and recurrence times are those of ark4 at rtol 1e-7

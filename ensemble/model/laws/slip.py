@@ -118,4 +118,5 @@ LAW = Law(
     onset_delay=onset_delay, implicit_state=implicit_state, stiff_limit=stiff_limit,
     rk4_unstable=rk4_unstable,
     creep_weakening=creep_weakening, creep_state=creep_state, friction_slopes=friction_slopes,
+    steady_weakening="b",
     scales=AGING.scales)
