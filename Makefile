@@ -10,9 +10,10 @@
 PY := .venv/bin/python
 STACK ?= auto
 # `make test` runs the test files on this many pytest workers (pytest-xdist; a file's tests stay on one worker, so
-# its module fixtures are made once): 2 halves the suite's time on a 2-core machine (docs/tests.md); 1 runs it serially
+# its module fixtures are made once; in tests/conftest.py's order, the longest files first): 2 halves the suite's time
+# on a 2-core machine (docs/tests.md); 1 runs it serially
 TEST_WORKERS ?= 2
-XDIST := $(if $(filter 1,$(TEST_WORKERS)),,-n $(TEST_WORKERS) --dist loadfile)
+XDIST := $(if $(filter 1,$(TEST_WORKERS)),,-n $(TEST_WORKERS) --dist loadfile --no-loadscope-reorder)
 TEST_STACK := $(if $(filter wheels,$(STACK)),wheels,parallel)
 export OMP_NUM_THREADS := 1
 export NUMBA_NUM_THREADS := 1

@@ -40,7 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ensemble import checks
+from ensemble import checks, space
 
 from . import merge
 from .reduce import PARAMS, point_statistics
@@ -175,12 +175,11 @@ def write(points, opt, out_dir, command, force=False, inputs=()):
     from .compare_plot import figures
     check_output(out_dir, force, inputs)
     os.makedirs(out_dir, exist_ok=True)
-    with open(os.path.join(out_dir, "comparison.md"), "w") as f:
-        f.write(table(points, opt, command))
+    space.write_file(os.path.join(out_dir, "comparison.md"), table(points, opt, command), "the comparison table")
     numbers = [{"label": p["label"], "law": p["law"], "method": p["method"], "units": p["units"],
                 **{name: [float(p["numbers"][j]), float(p["numbers_lo"][j]), float(p["numbers_hi"][j])]
                    for j, name in enumerate(NUMBERS)}} for p in points]
-    with open(os.path.join(out_dir, "comparison.json"), "w") as f:
-        json.dump({"options": opt.__dict__, "points": numbers}, f, indent=1)
+    space.write_file(os.path.join(out_dir, "comparison.json"),
+                     json.dumps({"options": opt.__dict__, "points": numbers}, indent=1), "the comparison numbers")
     figures(points, opt, out_dir, MU_EDGES)
     return [os.path.join(out_dir, n) for n in OUTPUTS]

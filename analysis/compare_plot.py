@@ -8,7 +8,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from .drawing import band
+from .drawing import band, save
 from .stats import centers
 
 TNU_BINS = np.linspace(0.0, 5.0, 101)      # T / median(T)
@@ -49,8 +49,7 @@ def figures(points, opt, out_dir, mu_edges):
            title=f"rupture length (dotted: power law fitted below n = {opt.n_large})")
     _legend(ax)
     fig.tight_layout()
-    fig.savefig(os.path.join(out_dir, "size.png"), dpi=120)
-    plt.close(fig)
+    save(fig, os.path.join(out_dir, "size.png"))
 
     fig, ax = plt.subplots(figsize=(9.6, 4.4))
     for p, color in zip(points, colors):
@@ -61,8 +60,7 @@ def figures(points, opt, out_dir, mu_edges):
            title="magnitude distribution")
     _legend(ax)
     fig.tight_layout()
-    fig.savefig(os.path.join(out_dir, "magnitude.png"), dpi=120)
-    plt.close(fig)
+    save(fig, os.path.join(out_dir, "magnitude.png"))
 
     fig, ax = plt.subplots(figsize=(9.6, 4.4))
     x = centers(TNU_BINS)
@@ -77,5 +75,4 @@ def figures(points, opt, out_dir, mu_edges):
            ylabel="density", title="local recurrence time")
     _legend(ax)
     fig.tight_layout()
-    fig.savefig(os.path.join(out_dir, "recurrence.png"), dpi=120)
-    plt.close(fig)
+    save(fig, os.path.join(out_dir, "recurrence.png"))

@@ -1,7 +1,9 @@
 """What every figure of the analysis draws with: the curve with its bootstrap band, colours, the grid of
 panels, the title above the panels, and an inset placed where it covers no data (place_inset;
 tests/test_figures.py checks every figure in display coordinates). No text is smaller than FONT points."""
+import io
 import math
+import os
 
 import matplotlib
 
@@ -9,6 +11,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.transforms import Bbox
+
+from ensemble import space
 
 FONT = 8            # the smallest text of a figure, points
 INSET = (0.36, 0.34)    # an inset's width and height, fractions of its panel's axes
@@ -43,9 +47,12 @@ def band(ax, x, y, lo, hi, label, color, log=False, style="-", open_ends=False):
 
 
 def palette(n):
-    if n <= 10:
-        return [f"C{i}" for i in range(n)]
-    return [plt.cm.viridis(i / (n - 1)) for i in range(n)]
+    """n colours that can be told apart on white: matplotlib's ten; up to 18, then black and Dark2's seven strong
+    ones (no pastel, no pale yellow: neighbours in a sweep never look alike); beyond, viridis without its pale end."""
+    strong = [f"C{i}" for i in range(10)] + ["black"] + list(plt.cm.Dark2.colors[:7])
+    if n <= len(strong):
+        return strong[:n]
+    return [plt.cm.viridis(0.88 * i / (n - 1)) for i in range(n)]
 
 
 def legend_columns(n):
@@ -129,3 +136,14 @@ def layout(fig, text, bottom):
         if short <= 0:
             break
         fig.subplots_adjust(top=fig.subplotpars.top - short / fig.bbox.height)
+
+
+def save(fig, path, dpi=DPI):
+    """Draw `fig` into the file `path`, in the format its suffix names (png without one), and close it: drawn in
+    memory, then written by space.write_file (never through a link, its blocks reserved first)."""
+    image = io.BytesIO()
+    try:
+        fig.savefig(image, format=os.path.splitext(str(path))[1][1:].lower() or "png", dpi=dpi)
+    finally:
+        plt.close(fig)
+    space.write_file(path, image.getbuffer(), "the figure")

@@ -1,5 +1,5 @@
 """CSV files of an export's tables (analysis/export.py: FORMATS["csv"]; the format is described there)."""
-from ensemble import __version__
+from ensemble import __version__, space
 
 from .export_tables import TITLES
 
@@ -42,11 +42,13 @@ def _csv_header(name, table, source, settings):
 
 
 def write_csv(path, name, table, source, settings=""):
-    """One table into the CSV file `path` (streamed part by part)."""
-    with open(path, "w", encoding="utf-8", newline="") as fh:
-        fh.write(_csv_header(name, table, source, settings))
-        names = list(table.columns)
+    """One table into the CSV file `path`, streamed part by part (space.write_file)."""
+    names = list(table.columns)
+
+    def text():
+        yield _csv_header(name, table, source, settings)
         for part in table.parts:
             if len(part):
                 cells = [_cells(part, n) for n in names]
-                fh.write("\n".join(map(",".join, zip(*cells))) + "\n")
+                yield "\n".join(map(",".join, zip(*cells))) + "\n"
+    space.write_file(path, text(), f"the table {name}")

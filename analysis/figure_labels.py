@@ -80,7 +80,7 @@ def _creep_sizes(summaries):
 
 def title_text(summaries, names, title=None, kind=None):
     """The figure's title: `title` (then the description below) or by default the description
-    alone: events per point, mu_c, window and the bands (never the file names; for the creep
+    alone: the friction law(s), events per point, mu_c, window and the bands (never the file names; for the creep
     figure the creep episodes per point and the bands); then one line for each partial reduction
     (events reduced of expected), whatever the title."""
     levels = " / ".join(dict.fromkeys(level_text(s["attrs"]["level"]) for s in summaries))
@@ -88,10 +88,12 @@ def title_text(summaries, names, title=None, kind=None):
     if kind == "seismicity":   # a map has no band: its numbers (analysis report) have the intervals
         bands = (f"\nmaps without intervals; the numbers' {levels} intervals (analysis report) over "
                  f"{_values(_units(s) for s in summaries)}")
+    # the friction law(s) first: a slip-law figure must not pass for the paper's aging law
+    laws = f"{_values(str(law) for s in summaries for law in summary_file.point_laws(s))} law: "
     if kind == "creep":
-        description = f"{_creep_sizes(summaries)}; {bands}"
+        description = f"{laws}{_creep_sizes(summaries)}; {bands}"
     else:
-        description = (f"{_values(size_text(s) for s in summaries)}, "
+        description = (f"{laws}{_values(size_text(s) for s in summaries)}, "
                        f"mu_c = {_values((s['attrs']['mu_c'] for s in summaries), '{:g}')}, "
                        f"window = {_values((s['attrs']['window'] for s in summaries), '{:g}')} blocks; {bands}")
     partials = []

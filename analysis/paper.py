@@ -32,6 +32,7 @@ from .report import LABELS, count_text, events_per_point, level_text, partial_te
 
 PAPER_EVENTS = 200_000      # events the paper recorded per point (one trajectory, N = 800) ...
 PAPER_TRANSIENT = 10_000    # ... after discarding these
+PAPER_LAW = "aging"         # the paper's friction law: a point of another law is not the paper's model
 # the committed full-size panels (docs/paper.md), in the order whose claims read their own panel;
 # a reduced run's numbers are set beside theirs
 FULL_SIZE = Path(__file__).resolve().parents[1] / "docs" / "paper"
@@ -206,8 +207,9 @@ CLAIMS = (
 
 
 def _matching(s, claim):
+    laws = summary.point_laws(s)
     rows = [i for i in range(len(s["points/N"]))
-            if all(s[f"points/{k}"][i] in values for k, values in claim.where.items())]
+            if laws[i] == PAPER_LAW and all(s[f"points/{k}"][i] in values for k, values in claim.where.items())]
     return rows, len({float(s[f"points/{claim.vary}"][i]) for i in rows})
 
 
@@ -299,7 +301,22 @@ def _short(path):
 
 
 def _same_point(s, i, r, j):
-    return all(np.array_equal(s[f"points/{k}"][i], r[f"points/{k}"][j], equal_nan=True) for k in PARAMS)
+    return (summary.point_laws(s)[i] == summary.point_laws(r)[j]
+            and all(np.array_equal(s[f"points/{k}"][i], r[f"points/{k}"][j], equal_nan=True) for k in PARAMS))
+
+
+def other_models(summaries, names):
+    """A line for each summary with points of another friction law than the paper's: not its model, so never set
+    beside its claims nor judged against the full size."""
+    lines = []
+    for s, name in zip(summaries, names):
+        laws = summary.point_laws(s)
+        other = [str(law) for law in laws if law != PAPER_LAW]
+        if other:
+            kinds = ", ".join(f"{other.count(law)} of the {law} law" for law in dict.fromkeys(other))
+            lines.append(f"not the paper's model: {name}: {kinds} of its {len(laws)} point(s) (the paper's law is "
+                         f"the {PAPER_LAW} law): left out of the claims and of the comparison with the full size")
+    return lines
 
 
 def against_full_size(summaries, names, reference):
@@ -347,6 +364,7 @@ def text(summaries, names, reference=None):
         if partial_text(s):
             lines.append(f"warning: {name}: {partial_text(s)}")
         lines += transients(s, name)
+    lines += other_models(summaries, names)
     lines += ["", claims_table(summaries)]
     if not is_full_size(summaries):
         comparison = against_full_size(summaries, names, full_size_panels() if reference is None else reference)

@@ -1,5 +1,5 @@
 """Figures from one or more summaries: R(mu) of every point overlaid, with bootstrap bands;
-recurrence-time distributions, one panel per point, each with its main peak enlarged in an inset;
+recurrence-time distributions, one panel per point, each with its highest peak enlarged in an inset;
 the slow side (creep episodes): their size and duration densities, of the points that have any,
 and the aseismic slip fraction against the swept parameter; the seismicity around large events,
 one map per point: the rate of events at (distance from a mainshock's epicenter, time from its onset)
@@ -21,7 +21,7 @@ from matplotlib.lines import Line2D
 from matplotlib.ticker import MaxNLocator
 
 from . import summary as summary_file
-from .drawing import (DPI, FONT, OPEN, OPEN_NOTE, band, grid, layout, legend_columns, palette,
+from .drawing import (DPI, FONT, OPEN, OPEN_NOTE, band, grid, layout, legend_columns, palette, save,
                       place_inset)
 from .figure_labels import legend_labels, points_of, summary_name, title_text
 from .report import count_text
@@ -77,7 +77,7 @@ def _zoom(s, i, x, peak):
         inset.tick_params(labelsize=FONT)
         inset.xaxis.set_major_locator(MaxNLocator(4))
         inset.yaxis.set_major_locator(MaxNLocator(3))
-        inset.set_title(f"main peak, T$\\nu$ = {peak:g}", fontsize=FONT)
+        inset.set_title(f"highest peak, T$\\nu$ = {peak:g}", fontsize=FONT)
     return draw
 
 
@@ -111,7 +111,8 @@ def interval_text(est, lo, hi):
 
 
 def place_insets(summaries, fig):
-    """Each panel's main peak (the highest significant one) enlarged, where the data are low."""
+    """Each panel's highest peak (the first of the report's `T*nu peaks`: the highest significant peak of the
+    smoothed histogram, which may differ from `mode T*nu`, the highest bin) enlarged, where the data are low."""
     renderer = fig.canvas.get_renderer()
     for ax, (s, i) in zip(fig.axes, points_of(summaries)):
         peak = s["points/peaks"][i][0][0]
@@ -250,6 +251,4 @@ def figure(summaries, kind, title=None, names=None):
 
 def plot(summaries, figure_kind, path, title=None, names=None):
     """Draw figure(summaries, figure_kind, title, names) into `path`."""
-    fig = figure(summaries, figure_kind, title, names)
-    fig.savefig(path, dpi=DPI)
-    plt.close(fig)
+    save(figure(summaries, figure_kind, title, names), path)

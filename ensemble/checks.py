@@ -15,6 +15,8 @@ import errno
 import math
 import os
 
+from . import space
+
 
 class UsageError(ValueError):
     """A bad option or output path, found before any work (exit code 2)."""
@@ -119,17 +121,12 @@ def _existing_ancestor(path):
 
 
 def write_text(path, text, what="file"):
-    """Write `text` (UTF-8) to `path`, made or replaced, never through a symbolic link at `path` (its target
-    would be written); UsageError naming the file where it is a link or cannot be written."""
+    """Write `text` (UTF-8) to `path`, made or replaced (space.write_file: never through a symbolic link at `path`,
+    whose target would be written); UsageError naming the file where it is a link or cannot be written."""
     try:
-        fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_NOFOLLOW | os.O_NONBLOCK, 0o644)
+        space.write_file(path, text, f"the {what}")
     except OSError as err:
         if err.errno == errno.ELOOP:
             raise UsageError(f"{path}: is a symbolic link; the {what} is never written through a link: remove "
                              f"the link") from None
-        raise UsageError(f"{path}: cannot write the {what} ({err.strerror})") from None
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-    except OSError as err:
         raise UsageError(f"{path}: cannot write the {what} ({err.strerror})") from None

@@ -46,6 +46,7 @@ class Key:
 # recurrence times at b = 50 are not (benchmarks/statistics.py --catalogs, docs/benchmarks.md).
 # The method's default is ark4 in the dataclass; a config file without it takes its law's
 # (Law.method: exp4 for the aging law, ark4 for the others; config.from_dict).
+CREEP_TOL_FLOOR = 1e-12
 KEYS = {
     "method": Key("ark4", "text", "event integrator (exp4 exponential in the aging law's state, its default; "
                                   "ark4, ark3, ark5 adaptive IMEX; rk4 fixed step)"),
@@ -58,8 +59,12 @@ KEYS = {
     "max_step": Key(0.5, "model time", "largest step", lambda x: x > 0, "> 0", adaptive=True),
     "max_duration": Key(1e5, "model time", "an event lasting longer is an error", lambda x: x > 0, "> 0"),
     # the creep phase: a law that creeps, b below a block's stiffness (model/creep.py)
-    "creep_tol": Key(1e-6, "1", "creep phase: local error of the state psi per creep step", lambda x: 0 < x < 1,
-                     "in (0, 1)"),
+    # its floor: a creep step's error estimate is a difference of psi-rates over steps of psi ~ 10-40, whose
+    # rounding is ~1e-14; at 1e-14 (b = 15, N = 100) the steps shrink until the event exceeds max_duration,
+    # at 1e-13 a run crawls (0.1 events/s, 1e-6: hundreds), so the floor keeps a factor 100 above the rounding
+    "creep_tol": Key(1e-6, "1", "creep phase: local error of the state psi per creep step",
+                     lambda x: CREEP_TOL_FLOOR <= x < 1,
+                     f"in [{CREEP_TOL_FLOOR:g}, 1): below, a creep step's error is the rounding of psi"),
 }
 
 

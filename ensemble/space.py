@@ -84,22 +84,30 @@ def reserve_file(path):
 
 
 def write_file(path, data, what):
-    """Write the bytes `data` to `path` (made or replaced, never through a symbolic link) with plain file I/O, its
-    blocks reserved first: a full disk, a quota or `ulimit -f` is an OSError naming `what` (NoSpace where it does
-    not fit), and `path` is removed. For HDF5 files built in memory first (an HDF5 write that fails on a full disk
-    leaves a file that may crash the process when closed)."""
+    """Write `data` to `path` (made or replaced), the one way the project writes a file that is not a catalog or
+    its lock (summaries, figures, export tables, comparisons, Slurm jobs): never through a symbolic link at
+    `path` (its target would be written: O_NOFOLLOW, ELOOP), with plain file I/O, the blocks reserved first where
+    the size is known. `data`: bytes or text (UTF-8), or an iterable of them written in turn (a large table,
+    streamed: nothing to reserve ahead, and a write that fails is an OSError like any other). A full disk, a
+    quota or `ulimit -f` is an OSError naming `what` (NoSpace where it does not fit), and `path` is removed. HDF5
+    files are built in memory first and written here (an HDF5 write that fails on a full disk leaves a file that
+    may crash the process when closed)."""
+    parts = [data] if isinstance(data, (bytes, bytearray, memoryview, str)) else data
+    size = len(data.encode() if isinstance(data, str) else data) if parts is not data else None
     limit = size_limit()
-    if limit is not None and len(data) > limit:
-        raise NoSpace(errno.EFBIG, f"File too large: {what} needs {len(data) / MiB:.1f} MiB and the file-size "
+    if size is not None and limit is not None and size > limit:
+        raise NoSpace(errno.EFBIG, f"File too large: {what} needs {size / MiB:.1f} MiB and the file-size "
                                    f"limit (ulimit -f) is {limit / MiB:.1f} MiB")
-    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_NOFOLLOW, 0o644)
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_NOFOLLOW | os.O_NONBLOCK, 0o644)
     try:
-        reserve(fd, len(data), what)
-        view = memoryview(data)
-        while view:
-            view = view[os.write(fd, view):]
+        if size is not None:
+            reserve(fd, size, what)
+        for part in parts:
+            view = memoryview(part.encode() if isinstance(part, str) else part)
+            while view:
+                view = view[os.write(fd, view):]
         os.fsync(fd)
-    except OSError:
+    except BaseException:
         os.close(fd)
         os.remove(path)
         raise

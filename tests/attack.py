@@ -668,6 +668,19 @@ def a_chain_that_never_has_an_event(w):
     nothing_left(w.root, "never.h5")
 
 
+def creep_tol_out_of_reach(w):
+    """integrator.creep_tol below what a creep step can resolve (1e-14 was accepted, then failed the task at its
+    first event with a message that named max_duration, dt and rtol): refused in one line naming the key and its
+    floor. A creeping task that fails names creep_tol among the integrator's keys, and so does the hint."""
+    one_line(_here("ensemble", "validate", w.creep_config(), "--set", "integrator.creep_tol=1e-14"), (2,),
+             "integrator.creep_tol", "[1e-12, 1)", "got 1e-14")
+    res = _python("ensemble", "run", w.creep_config(), "-o", w.root / "tight.h5", "--set",
+                  "integrator.max_duration=1e-3")
+    assert res.returncode == 1, res.stdout + res.stderr
+    assert "exceeded integrator.max_duration" in res.stdout and "creep_tol=" in res.stdout, res.stdout
+    assert "(or method, rtol, creep_tol)" in res.stdout, res.stdout
+
+
 def reduce_and_export_onto_a_full_disk(w):
     """`analysis reduce` and `export` onto a 100 KB tmpfs: one line, exit 1, nothing left behind (reduce once
     crashed in HDF5's close, exit 139 with a backtrace, leaving S.h5.partial; export left an empty folder). Each
@@ -735,6 +748,8 @@ ATTACKS = {
     "what a reader sees says what it is": what_a_reader_sees_says_what_it_is,
     "a chain that can never have an event is refused": a_chain_that_never_has_an_event,
     "analysis reduce and export onto a full disk": reduce_and_export_onto_a_full_disk,
+    "a creep_tol no creep step can honour is refused; a creeping task's failure names creep_tol":
+        creep_tol_out_of_reach,
     **{f"mpi: {target} fails on rank {rank} ({writer})": one_rank_fails(target, rank, writer)
        for target, rank, writer in (
            ("ensemble.store.create:create_layout", 1, "parallel"),

@@ -106,6 +106,7 @@ QUICK = {
     "test_mutation_targets.py": ["test_every_mutant_applies_once_and_names_existing_tests"],
     "test_quick_tier.py": ["test_every_test_named_in_the_quick_tier_exists",
                            "test_every_test_file_is_in_the_quick_tier_or_says_why_not"],
+    "test_writes.py": ["test_no_module_writes_a_file_around_the_helper"],
 }
 NOT_QUICK = {   # test files with no test in the quick tier, and why
     "test_sequences.py": "every test needs a serial catalog and a full-chain reference (10 s and more)",
@@ -129,7 +130,17 @@ def pytest_configure(config):
                                 "(rerun `make test`, or `make test STACK=wheels` to skip the MPI-IO tests)")
 
 
+# The files that take longest (2026-11-29: the slower tier's two, then `make test`'s), run first: with the Makefile's
+# --dist loadfile --no-loadscope-reorder the workers take files in this order, so the long ones do not end the run
+# on one worker while the other idles. Only the order of the run; a stale list costs time, never a result.
+LONGEST_FIRST = ("test_slurm.py", "test_compiled.py", "test_attacks.py", "test_mpi.py", "test_faults.py",
+                 "test_reduction.py", "test_input_errors.py", "test_catalog_creep.py", "test_budget.py", "test_hard_cases.py", "test_branch.py",
+                 "test_populations.py", "test_figures.py", "test_laws.py", "test_cli.py", "test_export.py")
+
+
 def pytest_collection_modifyitems(config, items):
+    rank = {name: k for k, name in enumerate(LONGEST_FIRST)}
+    items.sort(key=lambda item: rank.get(item.path.name, len(rank)))     # stable: the rest as collected
     for item in items:      # a name in QUICK is every case of a test, or one case: "test_x[its id]"
         if {item.name, item.originalname} & set(QUICK.get(item.path.name, ())):
             item.add_marker(pytest.mark.quick)

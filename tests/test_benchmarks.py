@@ -1,4 +1,7 @@
-"""The benchmark scripts at tiny sizes: their helpers against known answers, their outputs sane."""
+"""The benchmark scripts at tiny sizes: their helpers against known answers, their outputs sane.
+
+The scripts' tiny runs (SCRIPT_RUN) are in the slower tier: they test the benchmarks, not the product, and take
+80 s together; their helpers' known answers stay in `make test`."""
 import json
 import subprocess
 from pathlib import Path
@@ -14,6 +17,8 @@ from ensemble.config import Model
 from ensemble.events import advance_to_onset
 
 from .conftest import developed_state
+
+SCRIPT_RUN = pytest.mark.slow    # a benchmark script run end to end at a tiny size (docs/tests.md: the slower tier)
 
 
 def test_distances_agree_with_scipy():
@@ -55,6 +60,7 @@ def test_baseline_timeout_is_recorded():
         assert work_precision.measure(parse_setting(text, BASELINES), f, p, epicenter, model, 0.0)[-1] == "timeout"
 
 
+@SCRIPT_RUN
 def test_work_precision_tiny(tmp_path):
     # no wall-time cap on the baselines ("inf"): every row must be "ok", which a cap would make
     # depend on the machine's load; the per-test timeout stands guard against a hang
@@ -79,6 +85,7 @@ def test_work_precision_tiny(tmp_path):
                                     for q in data["speedups"])
 
 
+@SCRIPT_RUN
 def test_statistics_tiny(tmp_path):
     data = statistics.main(["--N", "40", "--seeds", "2", "--events", "60", "--transient", "20",
                             "--reference", "rk4:dt=1e-3", "--runs", "ark3:rtol=1e-3", "--out", str(tmp_path)])
@@ -106,6 +113,7 @@ def brute_recurrences(t, epicenter, mu, mu_c=4.0, window=10):
     return np.array(T)
 
 
+@SCRIPT_RUN
 def test_statistics_from_catalogs(tmp_path, capsys):
     from ensemble.store import reader
     from .catalog_writer import write_events
@@ -166,6 +174,7 @@ def test_catalog_labels():
     assert statistics.short(0.5) == "0.5" and statistics.short(800.0) == "800" and statistics.short(1e-8) == "1e-8"
 
 
+@SCRIPT_RUN
 def test_cost_scaling_tiny(tmp_path):
     # the aging law's own method (exp4), a fraction of rk4's time: the cost classes are the same
     data = cost_scaling.main(["--runs", "exp4:rtol=1e-4", "--Ns", "40", "80", "--bs", "20", "30", "--N-at", "40",
@@ -198,6 +207,7 @@ class CallClock:
         return float(self.checks)
 
 
+@SCRIPT_RUN
 def test_hard_cases_tiny(tmp_path, monkeypatch):
     # The benchmark's choices hang on its wall-time caps: which nu the long run takes (the probe's
     # estimate against --long-max-seconds) and whether each phase ends "ok" or at its cap. Counted
@@ -223,6 +233,7 @@ def test_hard_cases_tiny(tmp_path, monkeypatch):
     assert all(r["status"] == "ok" and r["events_to_target"] > 0 for r in data["probe"])
 
 
+@SCRIPT_RUN
 def test_step_budget_tiny(tmp_path):
     data = step_budget.main(["--N", "40", "--transient", "60", "--sizes", "small:-inf:2", "large:2:inf",
                              "--runs", "rk4:dt=1e-3", "ark4:rtol=1e-4", "ark4:rtol=1e-7",
@@ -246,6 +257,7 @@ def test_step_budget_tiny(tmp_path):
     assert "speed-up over rk4:dt=1e-3" in text and "one step alone" in text
 
 
+@SCRIPT_RUN
 def test_step_trace_tiny(tmp_path):
     data = step_trace.main(["--N", "40", "--transient", "60", "--sizes", "small:-inf:2", "large:2:inf",
                             "--runs", "ark4:rtol=1e-5", "ark5:rtol=1e-5", "--out", str(tmp_path)])
@@ -264,6 +276,7 @@ def test_step_trace_tiny(tmp_path):
         step_trace.main(["--runs", "rk4:dt=1e-3", "--out", str(tmp_path)])
 
 
+@SCRIPT_RUN
 def test_paired_tiny(tmp_path):
     data = paired.main(["--N", "40", "--rounds", "2", "--transient", "20", "--events", "60", "--cpu", "-1",
                         "--runs", "rk4:dt=1e-3", "ark4:rtol=1e-4", "--out", str(tmp_path)])
@@ -277,6 +290,7 @@ def test_paired_tiny(tmp_path):
         paired.main(["--runs", "ark4:rtol=1e-4,atol=1e-9", "--out", str(tmp_path)])
 
 
+@SCRIPT_RUN
 def test_revisions_tiny(tmp_path):
     # a command that writes which package it ran: the same check as a reduction (as in docs/benchmarks.md), which
     # took 13 s here (four of them, and the revision's fresh checkout compiles its analysis kernels first)
@@ -329,6 +343,7 @@ def test_transient_finds_a_known_drift():
     assert steady["floor"] > 2 * iid
 
 
+@SCRIPT_RUN
 def test_transient_tiny(tmp_path):
     from benchmarks import transient
     from ensemble.store import reader
@@ -449,6 +464,7 @@ def test_decorrelation_unperturbed_branch_continues_the_trajectory():
     assert np.array_equal(start.force, force)      # the branch point is left as it was
 
 
+@SCRIPT_RUN
 def test_decorrelation_tiny(tmp_path):
     from benchmarks import decorrelation
     data = decorrelation.main(["--N", "40", "--b", "20", "--spinup", "200", "--events", "200", "--branches", "2",

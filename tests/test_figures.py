@@ -132,7 +132,7 @@ def _check(fig):
 
 
 @pytest.mark.parametrize("kind", KINDS)
-@pytest.mark.parametrize("name", PANELS)
+@pytest.mark.parametrize("name", [pytest.param(p, marks=pytest.mark.slow) if p == "all" else p for p in PANELS])
 def test_committed_figures_cover_no_data(name, kind):
     s = load(name)
     fig = plot.figure(s, kind, names=[f"{name}.summary.h5"])
@@ -141,7 +141,7 @@ def test_committed_figures_cover_no_data(name, kind):
         if kind == "recurrence":   # every panel with a peak has its inset
             assert sum(len(ax.child_axes) for ax in fig.axes) == int(np.isfinite(s["points/peaks"][:, 0, 0]).sum())
         title = fig._suptitle.get_text()
-        for words in ("mu_c = 4", "window = 10 blocks", "events per point", "95% bootstrap"):
+        for words in ("aging law: ", "mu_c = 4", "window = 10 blocks", "events per point", "95% bootstrap"):
             assert words in title, title
         assert name not in title and ".h5" not in title
     finally:
@@ -155,7 +155,7 @@ def test_overlaid_summaries_cover_no_data(kind):
     fig = plot.figure([load("fig1_b"), load("large_b")], kind, names=names)
     try:
         _check(fig)
-        assert fig._suptitle.get_text().startswith("2e5 events per point, mu_c = 4, window = 10 blocks")
+        assert fig._suptitle.get_text().startswith("aging law: 2e5 events per point, mu_c = 4, window = 10 blocks")
     finally:
         plot.plt.close(fig)
 
@@ -173,7 +173,8 @@ def test_synthetic_figures_cover_no_data(case, n_points):
                 assert all(ax.child_axes for ax in fig.axes), case
         finally:
             plot.plt.close(fig)
-    assert plot.title_text([s], ["x"]) == ("8000 events per point (4 seeds x 2000), mu_c = 4, window = 10 blocks; "
+    assert plot.title_text([s], ["x"]) == ("aging law: 8000 events per point (4 seeds x 2000), mu_c = 4, "
+                                           "window = 10 blocks; "
                                            "bands: 95% bootstrap over 4 seeds")
 
 

@@ -55,6 +55,22 @@ def test_each_summary_alone_says_what_it_cannot_compute(name):
         assert (found is None) or "[" in row, row       # every computed claim with its intervals
 
 
+def test_a_point_of_another_law_is_not_the_papers_model():
+    """fig1_b's points relabelled as the slip law (what a slip-law run at the same keys gives): said to be another
+    model, no claim computed from them, and not set against the full size's aging-law numbers (they were: the slip
+    law's recurrence peaks beside the paper's ~500, and "inside" verdicts)."""
+    aging = summary.read(DOCS / "fig1_b.summary.h5")
+    slip = dict(aging, **{"points/law": np.array(["slip"] * len(aging["points/N"]))})
+    out = paper.text([slip], ["slip-run"], reference=[(DOCS / "fig1_b.summary.h5", aging)])
+    n = len(aging["points/N"])
+    assert f"not the paper's model: slip-run: {n} of the slip law of its {n} point(s)" in out, out
+    rows = out[out.index("|---|---|"):].splitlines()[1:1 + len(paper.CLAIMS)]
+    assert all("not computed: needs points" in row for row in rows), rows
+    # a reduced run's point is set against the full size's only where the law is the same too
+    assert paper._same_point(aging, 0, aging, 0) and not paper._same_point(slip, 0, aging, 0)
+    assert "not the paper's model" not in paper.text([aging], ["fig1_b"])
+
+
 def test_claims_read_their_own_panel():
     """Given all five, each claim takes the summary with the most values of what it varies."""
     panels = [summary.read(DOCS / f"{p}.summary.h5") for p in PANELS]
@@ -90,6 +106,7 @@ def reduced(tmp_path_factory):
     return d
 
 
+@pytest.mark.slow     # the reduced run: a real catalog of 4 points (26 s)
 def test_reduced_run_is_labelled_and_warned(reduced):
     res = run_analysis("paper", reduced / "sum.h5")
     assert res.returncode == 0, res.stderr
@@ -116,6 +133,7 @@ def test_reduced_run_is_labelled_and_warned(reduced):
         assert rows[claim.statement].startswith("not computed: needs points with b = "), rows[claim.statement]
 
 
+@pytest.mark.slow     # the reduced run: a real catalog of 4 points (26 s)
 def test_reduced_run_beside_the_full_size(reduced):
     """Every point of the reduced run is in fig1_b's full-size panel: each compared number with
     both intervals, and whether the full size's value is inside this run's interval."""
@@ -182,6 +200,7 @@ def test_shapes_in_merged_bins_are_those_of_the_coarser_summary():
         paper.shape_statistics(s, 0, merge=3)
 
 
+@pytest.mark.slow     # the reduced run: a real catalog of 4 points (26 s)
 def test_tables_py_on_a_reduced_run_says_reduced(reduced, tmp_path):
     """The reported case: examples/paper/tables.py on a reduced Fig. 1 top summary printed
     "346 [160, nan]" under a heading saying full size. It is analysis paper's table now."""

@@ -453,13 +453,13 @@ def test_single_run_job_equals_serial_run(cluster, tmp_path, launcher):
 @pytest.mark.timeout(4200)
 def test_walltime_job_requeues_resumes_and_equals_uninterrupted_run(cluster, tmp_path):
     """A one-minute limit, USR1 30 s ahead: Slurm checks every ~30 s, so the signal comes 0-30 s
-    after each start and is held until 20 s (--startup-seconds). The run needs about 75 s of
-    computing on each of two ranks (4 x 10000 events with ark4 at N = 60, b = 20: 39 s of CPU per
-    10000 on this kind of machine), two and a half times the most a start can do before the signal,
-    so a requeue happens however Slurm's checks fall. Load can only make the run slower, hence more
-    requeues (each start computes 20-30 s less its start-up): the cap (50) and the waits leave room
-    for a several times slower run."""
-    cfg = tiny_config(tmp_path / "long.toml", sweep={"b": [20.0]}, run={"seeds": 4, "events": 10000},
+    after each start and is held until 20 s (--startup-seconds). The run needs about 45 s of
+    computing on each of two ranks (4 x 6000 events with ark4 at N = 60, b = 20: 39 s of CPU per
+    10000 on this kind of machine), one and a half times the most a start can do before the signal
+    (30 s, less its start-up), so a requeue happens however Slurm's checks fall. Load can only make the
+    run slower, hence more requeues (each start computes 20-30 s less its start-up): the cap (50) and
+    the waits leave room for a several times slower run."""
+    cfg = tiny_config(tmp_path / "long.toml", sweep={"b": [20.0]}, run={"seeds": 4, "events": 6000},
                       output={"progress_seconds": 5.0})
     reference_run(cfg, tmp_path / "full.h5", ranks=2)   # = serial (tests/test_mpi.py)
     job = tmp_path / "job"

@@ -125,7 +125,9 @@ class RunLock:
 
     def _try_acquire(self):
         try:
-            # never through a link (ELOOP), and never blocking on a FIFO put there (a regular file is checked next)
+            # never through a link (ELOOP), and never blocking on a FIFO put there (a regular file is checked next).
+            # decision.check_output refuses a link here before the run starts; this is the guard for one made
+            # after that check (the lock is the one file not written by space.write_file: it stays open)
             fd = os.open(self.file, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_NONBLOCK, 0o644)
         except OSError as err:
             if err.errno == errno.ELOOP:

@@ -126,7 +126,7 @@ def _serve(ctx, tasks, spins, t_start):
             for k, message in failed:
                 log(f"  task {k}: {message}")
             log(f"rerun them from their start with another integrator, e.g. `python -m ensemble resume "
-                f"{ctx.path} --set integrator.dt=...` (or method, rtol)")
+                f"{ctx.path} --set integrator.dt=...` (or method, rtol, creep_tol)")
         else:
             os.replace(ctx.partial, ctx.path)
             log(f"wrote {ctx.path}: {len(tasks)} tasks, {_rows_text(ctx.path)} in {elapsed:.1f} s")

@@ -69,9 +69,10 @@ class Trajectory:
         if status not in (OK, PAUSED):
             where = self.done + k
             phase = "transient " if where < self.discarded else ""
+            creep = f", creep_tol={self.integrator.creep_tol}" if self.creeps else ""
             raise SimulationError(f"{self.label} {phase}event {where}: {STATUS_TEXT[status]} "
                                   f"(method={self.integrator.method}, dt={self.integrator.dt}, "
-                                  f"rtol={self.integrator.rtol})")
+                                  f"rtol={self.integrator.rtol}{creep})")
         self.done += k
         return t[:k], epicenter[:k], diag[:k]
 

@@ -29,12 +29,13 @@ import numpy as np
 
 from analysis import stats, summary
 from analysis.paper import shape_statistics
+from ensemble import space
 
 DECADES = 2.0        # the stretch of mu a critical-looking region must follow GR over
 MIN_EVENTS = 1000    # events a stretch needs for its KS distance to be read
 RESAMPLES = 300      # bootstrap resamples of the faults for the two-decade KS
 CRITICAL_KS = 0.05
-HUMP_MERGE = 10      # the hump is read in bins of 0.1 in mu (10 of the summary's 0.01): from 0.01 bins its dip is noise
+HUMP_BIN = 0.1       # the hump is read in bins of 0.1 in mu (10 of the summary's 0.01): from 0.01 bins its dip is noise
 # a Gutenberg-Richter law falls with mu: b is fitted within this range (a rising R(mu) is no GR law; at the lower
 # end the fit is a flat R(mu), and its KS says how far the data are from even that)
 B_RANGE = (0.01, 8.0)
@@ -114,13 +115,18 @@ def _with_interval(fn, per_fault, edges, rng, level):
     return {"ks": [float(est[0]), float(lo), float(hi)], "lo": float(est[1]), "gr_b": float(est[2])}
 
 
+def hump_merge(s):
+    """The summary's bins merged into one of HUMP_BIN (1 where they are that wide or wider)."""
+    return max(1, int(round(HUMP_BIN / float(np.diff(s["bins/mu"]).mean()))))
+
+
 def region_rows(s, f=None, level=0.95, rng=None):
     rng = rng or np.random.default_rng(0)
     out = []
     for i in range(len(s["points/N"])):
         rows = np.flatnonzero(s["tasks/point"] == i)
         per_fault = summary.point_units(s, i)[1].sum(axis=1)    # (faults, bins)
-        shape = shape_statistics(s, i, level, merge=HUMP_MERGE)
+        shape = shape_statistics(s, i, level, merge=hump_merge(s))
         row = {
             "region": s["points/region_label"][i], "faults": int(len(rows)),
             "span_tnu": float(s["points/region_span"][i]),
@@ -134,11 +140,21 @@ def region_rows(s, f=None, level=0.95, rng=None):
             own, hists = _single_faults(s, rows, f)
             best = np.array([best_decades(h, f["bins/mu"])[0] for h in hists])
             top = np.array([top_decades(h, f["bins/mu"])[0] for h in hists])
-            row.update({f"single_faults_{name}": {"median": float(np.nanmedian(v)), "p5": float(np.nanpercentile(v, 5)),
-                                                  "p95": float(np.nanpercentile(v, 95))}
+            row.update({f"single_faults_{name}": _spread(v)
                         for name, v in (("ks_gr", own), ("best_two_decades", best), ("top_two_decades", top))})
         out.append(row)
     return out
+
+
+def _spread(values):
+    """The median and 5-95% range of the faults' values that could be computed, and how many could: None where none
+    could (a fault needs MIN_EVENTS events in two decades of mu; in a small run none may have them)."""
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    if not len(v):
+        return {"median": None, "p5": None, "p95": None, "faults": 0}
+    return {"median": float(np.median(v)), "p5": float(np.percentile(v, 5)), "p95": float(np.percentile(v, 95)),
+            "faults": int(len(v))}
 
 
 def _single_faults(s, rows, f):
@@ -151,15 +167,21 @@ def _single_faults(s, rows, f):
 
 def table(rows):
     def iv(t, d=3):
+        if not np.isfinite(t[0]):
+            return f"- (fewer than {MIN_EVENTS} events)"
         return f"{t[0]:.{d}g} [{t[1]:.{d}g}, {t[2]:.{d}g}]"
     head = ("| region | faults | events | GR b | KS to GR (mu >= b_cut) | best two decades: KS (from mu, b) | "
             "top two decades: KS (from mu, b) | large (mu >= mu_c) | hump: peak / dip | CV of T nu | "
             "single faults' KS to GR / best / top two decades (median, 5-95%) |")
     lines = [head, "|" + " --- |" * (head.count("|") - 1)]
     def decades(d):
+        if not np.isfinite(d["ks"][0]):
+            return f"- (no two decades with {MIN_EVENTS} events)"
         return f"{iv(d['ks'])} (from {d['lo']:g}, b {d['gr_b']:.3g})"
 
     def spread(d):
+        if d["median"] is None:
+            return "- (no fault has enough events)"
         return f"{d['median']:.3g} ({d['p5']:.3g}-{d['p95']:.3g})"
     for r in rows:
         single = " / ".join(spread(r[f"single_faults_{n}"]) for n in ("ks_gr", "best_two_decades", "top_two_decades")
@@ -184,8 +206,9 @@ def main(argv=None):
     rows = region_rows(s, summary.read(args.faults) if args.faults else None, float(s["attrs"]["level"]))
     out = Path(args.output)
     out.parent.mkdir(parents=True, exist_ok=True)
-    Path(f"{out}.json").write_text(json.dumps(rows, indent=1))      # (OUT + suffix: a dot in OUT is kept)
-    Path(f"{out}.md").write_text(table(rows) + "\n")
+    # (OUT + suffix: a dot in OUT is kept)
+    space.write_file(f"{out}.json", json.dumps(rows, indent=1), "the answer's numbers")
+    space.write_file(f"{out}.md", table(rows) + "\n", "the answer's table")
     print(table(rows))
     return 0
 

@@ -16,19 +16,26 @@ import json
 import math
 import re
 import sys
-
 import warnings
+from pathlib import Path
 
 import numpy as np
 
 from analysis import stats, summary
-from analysis.drawing import FONT, band
+from analysis.drawing import FONT, band, save
 from analysis.plot import plt
 from analysis.stats import centers
 
 REAL_B = 2 / 3       # GR b of a real catalog (about 1 in moment magnitude) in mu = log10 of the slip
 CRITICAL_KS = 0.05
-MERGE = 10           # R(mu) drawn in bins of 0.1: 10 of the summary's 0.01
+MIN_EVENTS = 1000    # events two decades need for a fit (answer.py's MIN_EVENTS)
+DRAWN_BIN = 0.1      # R(mu) drawn in bins of 0.1 (10 of the summary's 0.01), or the summary's own where coarser
+
+
+def merge_of(s):
+    """Bins of the summary merged into one drawn bin: DRAWN_BIN over the summary's width, at least 1."""
+    width = float(np.diff(s["bins/mu"]).mean())
+    return max(1, int(round(DRAWN_BIN / width)))
 RESAMPLES = 1000
 
 
@@ -44,7 +51,9 @@ def gr_line(edges, r, fit):
     lo, b = fit["lo"], fit["gr_b"]
     inside = (centers(edges) >= lo) & (centers(edges) < lo + 2)
     share = float(np.sum(r[inside] * np.diff(edges)[inside]))
-    mu = np.linspace(lo, lo + 2, 50)
+    # drawn where the region has events: a fit at the top of the magnitudes may reach past the last of them
+    reached = edges[1:][r > 0]
+    mu = np.linspace(lo, min(lo + 2, reached.max() if len(reached) else lo + 2), 50)
     k = b * math.log(10)
     return mu, share * k * np.exp(-k * (mu - lo)) / -math.expm1(-2 * k)
 
@@ -64,12 +73,16 @@ def region_panel(ax, s, i, row, merge, level, rng):
         units, lambda u: stats.density(u[:-1], edges, u[-1]), RESAMPLES, rng), level)
     band(ax, c, r, lo, hi, "the region (band: its faults resampled)", "C0", log=True, open_ends=True)
     fit = row["best_two_decades"]
-    mu, gr = gr_line(edges, r, fit)
-    ax.plot(mu, gr, color="C3", lw=1.5, label="GR law fitted to the best two decades", zorder=4)
-    ax.text(0.03, 0.03, f"best two decades: b = {fit['gr_b']:.2f}, KS = {fit['ks'][0]:.3f}",
-            transform=ax.transAxes, fontsize=FONT - 1)
-    ax.plot(mu, gr[0] * 10 ** (-REAL_B * (mu - mu[0])), color="k", ls="--", lw=1,
-            label="slope of a real catalog (b = 2/3)", zorder=4)
+    if np.isfinite(fit["ks"][0]):
+        mu, gr = gr_line(edges, r, fit)
+        ax.plot(mu, gr, color="C3", lw=1.5, label="GR law fitted to the best two decades", zorder=4)
+        ax.text(0.03, 0.03, f"best two decades: b = {fit['gr_b']:.2f}, KS = {fit['ks'][0]:.3f}",
+                transform=ax.transAxes, fontsize=FONT - 1)
+        ax.plot(mu, gr[0] * 10 ** (-REAL_B * (mu - mu[0])), color="k", ls="--", lw=1,
+                label="slope of a real catalog (b = 2/3)", zorder=4)
+    else:
+        ax.text(0.03, 0.03, f"no two decades with {MIN_EVENTS} events: no GR fit", transform=ax.transAxes,
+                fontsize=FONT - 1)
     ax.set_yscale("log")
     ax.set_ylim(1e-4, 5)
     ax.set_xlabel(r"magnitude $\mu$")
@@ -92,7 +105,7 @@ def ks_panel(ax, rows):
         ax.vlines(x + shift, est[:, 1], est[:, 2], color=color, lw=1.5, zorder=3)
         ax.plot(x + shift, est[:, 0], "o", color=color, label=f"region, {name} (95% over faults)", zorder=3)
         single = [r.get(f"single_faults_{key}") for r in rows]
-        if all(single):
+        if all(d and d["median"] is not None for d in single):     # (None: no fault had the events for it)
             ax.vlines(x + shift + 0.06, [d["p5"] for d in single], [d["p95"] for d in single], color="0.6", lw=3,
                       label="single faults' KS: 5-95%" if key == "best_two_decades" else None)
             ax.plot(x + shift + 0.06, [d["median"] for d in single], "_", color="k", ms=8,
@@ -119,7 +132,7 @@ def main(argv=None):
     regions = []
     for path, answer in zip(args.pairs[::2], args.pairs[1::2]):
         s = summary.read(path)
-        rows = json.loads(open(answer).read())
+        rows = json.loads(Path(answer).read_text())
         if [r["region"] for r in rows] != list(s["points/region_label"]):
             print(f"error: {answer} is not the answer of {path}'s regions", file=sys.stderr)
             return 2
@@ -127,11 +140,14 @@ def main(argv=None):
     panels = len(regions) + 1
     columns = args.columns or panels
     nrows = -(-panels // columns)
-    height = 4.3 * nrows + 1.1           # inches: the panels, and the legend beneath them
+    # the legend beneath the panels: its columns (about 4 inches each) as many as the figure's width holds
+    ncol = max(1, min(4, columns))
+    legend_rows = -(-7 // ncol)          # its entries: at most seven
+    height = 4.3 * nrows + 0.3 + 0.25 * legend_rows      # inches: the panels, and the legend beneath them
     fig, axes = plt.subplots(nrows, columns, figsize=(4.2 * columns, height), squeeze=False)
     axes = axes.ravel()
     for k, (ax, (s, i, row)) in enumerate(zip(axes, regions)):
-        region_panel(ax, s, i, row, MERGE, float(s["attrs"]["level"]), np.random.default_rng(k))
+        region_panel(ax, s, i, row, merge_of(s), float(s["attrs"]["level"]), np.random.default_rng(k))
         if k:
             ax.sharey(axes[0])
         if k % columns == 0:
@@ -141,14 +157,15 @@ def main(argv=None):
     for ax in axes[panels:]:
         ax.set_visible(False)
     h2, t2 = axes[len(regions)].get_legend_handles_labels()
-    fig.legend(handles + h2, texts + t2, loc="lower center", ncol=4, fontsize=FONT, bbox_to_anchor=(0.5, 0.0))
+    fig.legend(handles + h2, texts + t2, loc="lower center", ncol=ncol, fontsize=FONT, bbox_to_anchor=(0.5, 0.0))
     s0 = regions[0][0]
     names = ", ".join(path.rsplit("/", 1)[-1].removesuffix(".region.summary.h5") for path in args.pairs[::2])
     fig.suptitle(f"{names}: regions of {regions[0][2]['faults']} faults; l = {s0['points/l'][0]:g}, "
                  f"a = {s0['points/a'][0]:g}, c = {s0['points/c'][0]:g}, nu = {s0['points/nu'][0]:g}; "
-                 "R(mu) in bins of 0.1, bands: 95% bootstrap over faults", fontsize=FONT + 1)
-    fig.tight_layout(rect=(0, 1.1 / height, 1, 0.97))
-    fig.savefig(args.output, dpi=110)
+                 f"R(mu) in bins of {merge_of(s0) * float(np.diff(s0['bins/mu']).mean()):.2g}, bands: 95% "
+                 "bootstrap over faults", fontsize=FONT + 1, wrap=True)
+    fig.tight_layout(rect=(0, (0.3 + 0.25 * legend_rows) / height, 1, 0.95))
+    save(fig, args.output, dpi=110)
     print(f"wrote {args.output}")
     return 0
 
