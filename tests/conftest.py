@@ -134,8 +134,9 @@ def pytest_configure(config):
 # --dist loadfile --no-loadscope-reorder the workers take files in this order, so the long ones do not end the run
 # on one worker while the other idles. Only the order of the run; a stale list costs time, never a result.
 LONGEST_FIRST = ("test_slurm.py", "test_compiled.py", "test_attacks.py", "test_mpi.py", "test_faults.py",
-                 "test_reduction.py", "test_input_errors.py", "test_catalog_creep.py", "test_budget.py", "test_hard_cases.py", "test_branch.py",
-                 "test_populations.py", "test_figures.py", "test_laws.py", "test_cli.py", "test_export.py")
+                 "test_reduction.py", "test_input_errors.py", "test_catalog_creep.py", "test_budget.py",
+                 "test_hard_cases.py", "test_branch.py", "test_populations.py", "test_figures.py", "test_laws.py",
+                 "test_cli.py", "test_export.py")
 
 
 def pytest_collection_modifyitems(config, items):
