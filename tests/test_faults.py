@@ -448,3 +448,22 @@ def test_status_names_what_a_wrong_file_is(small, tmp_path):
         res = here("status", path)
         assert res.returncode == 1 and str(path) in res.stderr and words in res.stderr, res.stderr
         assert len(res.stderr.strip().splitlines()) == 1
+
+
+def test_a_rank_long_without_a_row_says_where_its_chain_is(tmp_path, monkeypatch):
+    """A task that makes no row for QUIET_SECONDS (a long event, a long creep episode) gets a line saying where its
+    chain is, then again after four times as long: no run goes quiet without saying why (N = 5, a = 100, b = 18
+    once sat minutes at one row with nothing said). Here the wait is shrunk to nothing and the kernel calls to a
+    few block-steps, so that calls end inside an event and inside a creep phase."""
+    from ensemble.run import worker
+    monkeypatch.setattr(worker, "QUIET_SECONDS", 1e-9)
+    monkeypatch.setattr(worker, "FIRST_BUDGET", 1)
+    monkeypatch.setattr(worker, "MIN_BUDGET", 1)
+    for model, words in (({"N": 60, "b": 20.0}, ": an event in progress, "),
+                         ({"N": 40, "b": 15.0}, " blocks creeping at model time ")):
+        cfg = write_config(tmp_path / f"quiet{model['b']:g}.toml", model=model,
+                           run={"events": 5, "transient": 0, "seeds": 1, "poll_seconds": 1e-6})
+        res = here("run", cfg, "-o", tmp_path / f"quiet{model['b']:g}.h5")
+        assert res.returncode == 0, res.stderr
+        notes = [line for line in res.stdout.splitlines() if line.startswith("note: rank 0: task 0: no row for ")]
+        assert any(words in line for line in notes), res.stdout[-3000:]

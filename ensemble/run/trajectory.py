@@ -12,8 +12,9 @@ import numpy as np
 from ..config import ConfigError, parse_section, section_lines
 from ..integrators import INTEGRATORS, kernel_params
 from ..model.chain import simulate
-from ..model.workspace import (D_DURATION, D_ENDING, D_FIRST, D_KIND, D_LAST, D_NSLIP, D_SLIP, NDIAG, OK, PAUSED,
-                               STATUS_TEXT, UNLIMITED, Workspace)
+from ..model.workspace import (CS_H, CS_NCREEP, CS_T_HI, CS_T_LO, D_DURATION, D_ENDING, D_FIRST, D_KIND, D_LAST,
+                               D_NSLIP, D_SLIP, EV_NA, EV_PHASE, EV_STEPS, EV_TAU, EV_VMAX, IN_EVENT, NDIAG, OK,
+                               PAUSED, STATUS_TEXT, UNLIMITED, Workspace)
 from ..store.checkpoint import Checkpoint, carries_creep
 from ..store.errors import CatalogError
 from .tasks import initial_state
@@ -50,6 +51,22 @@ class Trajectory:
         that of the same moment, Workspace.creep_state)."""
         force, psi, since, clock = self.ws.between_events(self.clock)
         return Checkpoint(force, psi, since, clock, self.done, self.ws.creep_state() if self.creeps else None)
+
+    def where(self):
+        """Where the chain is now, in words: the event in progress (kernel calls pause inside one) or the creep
+        phase, for a run that has gone long without a row (worker.py)."""
+        ev, cs, n = self.ws.arrays.event, self.ws.arrays.cstate, self.task.model.N
+        row = f"row {self.done}{' (transient)' if self.done < self.discarded else ''}"
+        if ev[EV_PHASE] == IN_EVENT:
+            return (f"{row}: an event in progress, {ev[EV_STEPS]:.3g} steps over a model time of {ev[EV_TAU]:.3g} "
+                    f"since its onset, {int(ev[EV_NA])} of {n} blocks sliding, largest velocity {ev[EV_VMAX]:.3g}; "
+                    f"it ends when every block is at rest, or fails at integrator.max_duration = "
+                    f"{self.integrator.max_duration:g}")
+        if cs[CS_NCREEP] > 0:
+            return (f"{row}: {int(cs[CS_NCREEP])} of {n} blocks creeping at model time "
+                    f"{cs[CS_T_HI] + cs[CS_T_LO]:.6g}, creep step {cs[CS_H]:.3g} (integrator.creep_tol = "
+                    f"{self.integrator.creep_tol:g}); the episode ends when they stop or an event starts")
+        return f"{row}: between events at model time {self.clock[0] + self.clock[1]:.6g}"
 
     def state(self):
         """(force, psi) of every block now (between events), c-free frame."""

@@ -23,6 +23,9 @@ from .trajectory import SimulationError, Trajectory, event_rows, integrator_text
 # block-step of the adaptive methods (benchmarks/results/step_budget_*); then sized by time
 FIRST_BUDGET = 250_000
 MIN_BUDGET = 1_000
+# a rank whose task has made no row for this long says where its chain is (an event in progress, a creep phase),
+# then again after four times as long, and so on: no run goes quiet without saying why
+QUIET_SECONDS = 60.0
 
 
 class TaskRunner:
@@ -154,6 +157,7 @@ class TaskRunner:
         last_flush = time.perf_counter()
         record_time = 0.0
         recorded_here = 0
+        quiet_since, quiet_note = time.perf_counter(), QUIET_SECONDS
 
         def flush():
             nonlocal buffer, buffered, written, last_flush
@@ -192,6 +196,12 @@ class TaskRunner:
                 buffer.append(event_rows(traj.task, *out))
                 buffered += k
             now = time.perf_counter()
+            if k:
+                quiet_since, quiet_note = now, QUIET_SECONDS
+            elif now - quiet_since >= quiet_note:
+                print(f"note: rank {self.coord.rank}: {traj.label}: no row for {now - quiet_since:.0f} s; "
+                      f"{traj.where()}", flush=True)
+                quiet_note *= 4
             if buffered >= cfg.output.batch or now - last_flush >= cfg.output.flush_seconds:
                 flush()
             self.progress.maybe_print()
