@@ -205,13 +205,15 @@ STOPPED = 2     # slid in this event and is at rest again
 UNLIMITED = 2**62
 
 # status codes of the kernels (all but OK and PAUSED are errors)
-OK, NONFINITE, UNSTABLE, TOO_LONG, PAUSED = 0, 1, 2, 3, 4
+OK, NONFINITE, UNSTABLE, TOO_LONG, PAUSED, STALLED = 0, 1, 2, 3, 4, 5
 STATUS_TEXT = {
     NONFINITE: "non-finite state or parameter (numerical blow-up, or NaN/inf in the input)",
     UNSTABLE: "step beyond the stability limit of RK4 (dt / theta > 2.785); reduce integrator.dt",
     TOO_LONG: "event exceeded integrator.max_duration (stable sliding? b below the block stiffness?)",
     PAUSED: "not an error: the work budget of the kernel call ran out in the middle of an event, "
             "which the next call continues",
+    STALLED: "the steps stopped advancing time: a block's start or stop was located at the start of the step again "
+             "and again (event.STALL_STEPS steps at one time); rerun with another integrator.method",
 }
 
 
