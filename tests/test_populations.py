@@ -387,6 +387,19 @@ def _gr_counts(b, lo, hi, n, edges):
     return n * np.diff(cdf)
 
 
+def _answer_and_figure(monkeypatch):
+    """answer.py and figure.py, their bootstraps cut to 10 resamples (only estimates are checked with them)."""
+    answer = _answer()
+    monkeypatch.setattr(answer, "RESAMPLES", 10)
+    sys.path.insert(0, str(__import__("pathlib").Path(answer.__file__).parent))
+    try:
+        import figure
+    finally:
+        sys.path.pop(0)
+    monkeypatch.setattr(figure, "RESAMPLES", 10)
+    return answer, figure
+
+
 def test_the_answers_two_decade_fit_recovers_a_gutenberg_richter_law():
     """answer.py's truncated-GR fit: exact GR counts give b back and KS 0; the best stretch of a GR law with a
     hump of large events is found below the hump; the top stretch, over the hump, is far from GR; a stack of
@@ -415,14 +428,7 @@ def test_the_answer_finds_a_region_of_gr_faults_critical_and_a_characteristic_on
     decades are the flat part below the hump: KS small, but with b near 0, which is why the b is reported too).
     The bootstraps over faults run 10 resamples: only their estimates are checked here (the intervals of the
     docs' tables are test_the_docs_tables_are_the_committed_summaries'). One figure draws both regions."""
-    answer = _answer()
-    monkeypatch.setattr(answer, "RESAMPLES", 10)
-    sys.path.insert(0, str(__import__("pathlib").Path(answer.__file__).parent))
-    try:
-        import figure
-    finally:
-        sys.path.pop(0)
-    monkeypatch.setattr(figure, "RESAMPLES", 10)
+    answer, figure = _answer_and_figure(monkeypatch)
     rng = np.random.default_rng(3)
     k = 0.7 * math.log(10)
 
@@ -460,14 +466,7 @@ def test_the_answer_and_its_figure_on_a_small_population_say_what_they_cannot_co
     region's events do (it ran past them)."""
     import json
     import warnings
-    answer = _answer()
-    monkeypatch.setattr(answer, "RESAMPLES", 10)
-    sys.path.insert(0, str(__import__("pathlib").Path(answer.__file__).parent))
-    try:
-        import figure
-    finally:
-        sys.path.pop(0)
-    monkeypatch.setattr(figure, "RESAMPLES", 10)
+    answer, figure = _answer_and_figure(monkeypatch)
     drawn = []
     monkeypatch.setattr(figure, "save", lambda fig, path, dpi: drawn.append(fig))
     rng = np.random.default_rng(5)
