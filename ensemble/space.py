@@ -7,6 +7,9 @@ file-size limit (RLIMIT_FSIZE) is compared with the catalog's size, and that man
 reserved (fallocate) in a scratch file beside the catalog and freed again. Only then is the catalog
 made (and its own blocks reserved, store/files.py: reserve_space). A resume reserves the blocks of the
 file it continues, which a run on a file system without fallocate never reserved.
+
+Every other file the project writes (summaries, figures, export tables, comparisons, Slurm jobs) is written by
+write_file: never through a link, its blocks reserved first (tests/test_writes.py holds every command to it).
 """
 import ctypes
 import errno
@@ -92,8 +95,11 @@ def write_file(path, data, what):
     quota or `ulimit -f` is an OSError naming `what` (NoSpace where it does not fit), and `path` is removed. HDF5
     files are built in memory first and written here (an HDF5 write that fails on a full disk leaves a file that
     may crash the process when closed)."""
-    parts = [data] if isinstance(data, (bytes, bytearray, memoryview, str)) else data
-    size = len(data.encode() if isinstance(data, str) else data) if parts is not data else None
+    if isinstance(data, str):
+        data = data.encode()
+    whole = isinstance(data, (bytes, bytearray, memoryview))
+    parts = [data] if whole else data
+    size = memoryview(data).nbytes if whole else None
     limit = size_limit()
     if size is not None and limit is not None and size > limit:
         raise NoSpace(errno.EFBIG, f"File too large: {what} needs {size / MiB:.1f} MiB and the file-size "

@@ -55,7 +55,8 @@ from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D
 
 # Steps in a row that leave the event's time where it was (a transition located at the step's start, cut to a step
 # of no length, again and again) before the event ends with STALLED: measured once with exp4 at N = 5, a = 100,
-# b = 18, where 4e7 such steps went by in 4 minutes before this guard (max_steps would have ended it after 20).
+# b = 18, where 4e7 such steps went by in 4 minutes before this guard (max_steps would have ended it after about
+# 20 minutes). workspace.STATUS_TEXT[STALLED] gives the number.
 # Counted within a kernel call; a legitimate cut at the step's start happens once, then the step goes on.
 STALL_STEPS = 10_000
 

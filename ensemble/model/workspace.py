@@ -213,7 +213,7 @@ STATUS_TEXT = {
     PAUSED: "not an error: the work budget of the kernel call ran out in the middle of an event, "
             "which the next call continues",
     STALLED: "the steps stopped advancing time: a block's start or stop was located at the start of the step again "
-             "and again (event.STALL_STEPS steps at one time); rerun with another integrator.method",
+             "and again (10000 steps at one time); rerun with another integrator.method",
 }
 
 
