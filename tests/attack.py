@@ -682,19 +682,21 @@ def creep_tol_out_of_reach(w):
 
 
 def steps_that_stop_advancing_time(w):
-    """N = 5, a = 100, b = 18 with exp4 (the aging law's default): task 1's event 130 located a block's stop at the
-    start of its step again and again, 4e7 steps at one time in 4 minutes, the progress line frozen and nothing
-    said (max_steps would have ended it after about 20). The task now fails in seconds with a line that says so and
-    names the method, the others finish, and a resume with another method completes the catalog."""
+    """N = 5, a = 100, b = 18 with exp4 (the aging law's default): task 1's event 130 had two blocks on their
+    thresholds within rounding take turns, one starting by loading at the start of a step cut to no length while
+    the other, just started, stopped; 4e7 steps at one time in 4 minutes, the progress line frozen and nothing said.
+    A block now cannot stop at the time it started (event.continue_event), and the run ends: every row, each
+    within the chain's physics (positive slips, a creep episode's or an event's duration)."""
     cfg = w.root / "stall.toml"
     cfg.write_text("[model]\nN = 5\na = 100.0\nb = 18.0\n[run]\nseeds = 2\nevents = 300\ntransient = 20\n")
     out = w.root / "stall.h5"
-    res = _python("ensemble", "run", cfg, "-o", out, timeout=300)     # 4-6 s here; the stall ran for minutes
-    assert res.returncode == 1, res.stdout + res.stderr
-    assert "task 1 event 130: the steps stopped advancing time" in res.stdout and "method=exp4" in res.stdout, \
-        res.stdout
-    res = _python("ensemble", "resume", out, "--set", 'integrator.method="ark4"', timeout=300)
+    res = _python("ensemble", "run", cfg, "-o", out, timeout=300)     # 6 s here; the stall ran for minutes
     assert res.returncode == 0 and "wrote " in res.stdout, res.stdout + res.stderr
+    events, _, _ = reader.read(out)
+    assert len(events["t"]) == 600, len(events["t"])
+    assert np.all(events["slip"] > 0) and np.all(np.isfinite(events["duration"])), events
+    # both kinds of row: the chain creeps (b below the stiffness 19) and ruptures
+    assert set(np.unique(events["kind"])) == {0, 1}, np.unique(events["kind"])
 
 
 def reduce_and_export_onto_a_full_disk(w):
@@ -766,7 +768,7 @@ ATTACKS = {
     "analysis reduce and export onto a full disk": reduce_and_export_onto_a_full_disk,
     "a creep_tol no creep step can honour is refused; a creeping task's failure names creep_tol":
         creep_tol_out_of_reach,
-    "steps that stop advancing time end the task in one line, and another method resumes it":
+    "two blocks on their thresholds within rounding do not take turns at one time for ever":
         steps_that_stop_advancing_time,
     **{f"mpi: {target} fails on rank {rank} ({writer})": one_rank_fails(target, rank, writer)
        for target, rank, writer in (

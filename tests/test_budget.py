@@ -167,7 +167,7 @@ def test_the_paused_event_is_saved_and_restored_by_name():
     """_keep puts each field of the record into its slot (field x into EV_X) and _resume reads it back
     from there, whatever the order of the record's fields: a record of distinct values comes back whole,
     and each value sits in the slot of its name (run as Python: the same code numba compiles)."""
-    counts = {"na", "nt", "far", "steps", "block_steps", "rejected", "cuts", "traced"}
+    counts = {"na", "nt", "far", "steps", "block_steps", "rejected", "cuts", "traced", "still"}
     values = {f: (k + 2 if f in counts else k + 2.5) for k, f in enumerate(PausedEvent._fields)}
     record = PausedEvent(**values)
     vector = np.full(workspace.NEVENT, np.nan)
@@ -182,3 +182,28 @@ def test_the_paused_event_is_saved_and_restored_by_name():
     calls = [node for node in ast.walk(tree)
              if isinstance(node, ast.Call) and getattr(node.func, "id", "") == "PausedEvent"]
     assert calls and all(not call.args and {k.arg for k in call.keywords} == set(PausedEvent._fields) for call in calls)
+
+
+# -- steps that stop advancing time --------------------------------------------------------------
+
+@pytest.mark.parametrize("budget", [UNLIMITED, 7])
+def test_steps_that_stop_advancing_time_end_the_event_over_any_budget(budget):
+    """The guard behind event.STALL_STEPS: an adaptive method whose largest step is 0 (the config refuses it;
+    here the record is built by hand) takes steps of no length after its first. The event ends with STALLED
+    after STALL_STEPS of them, counted over paused calls too: with a budget of 7 work units a call takes a few
+    steps, so a count that started again at every call would never get there (the task ran until max_steps)."""
+    model = MODELS["b = 20"]
+    params = kernel_params(model, Integrator(method="ark4"))._replace(max_step=0.0)
+    ws, clock = fresh(model)
+    out = outputs(1)
+    calls = 0
+    while True:
+        status, k = simulate(ws.arrays, clock, params, 1, budget, *out)
+        calls += 1
+        if status != PAUSED and not (status == OK and k == 0):
+            break
+        assert calls < 10 * event.STALL_STEPS, "the event never stalled"
+    assert (status, k) == (workspace.STALLED, 0)
+    steps = ws.arrays.event[workspace.EV_STEPS]
+    assert event.STALL_STEPS <= steps <= event.STALL_STEPS + 2, steps
+    assert calls == 1 if budget == UNLIMITED else calls > 100

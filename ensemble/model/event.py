@@ -49,15 +49,16 @@ from .undo import clear_log, log_block
 from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D_ENERGY_SCALE, D_FIRST, D_LAST,
                         D_LOAD_WORK, D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK, EV_BLOCK_STEPS,
                         EV_CUTS, EV_EPICENTER, EV_ERR_PREV, EV_FAR, EV_H_NEXT, EV_NA, EV_NT, EV_PHASE, EV_REJECTED,
-                        EV_SLIP_TIME, EV_STEPS, EV_T_FAR, EV_TAU, EV_TRACED, EV_VMAX, EV_WORK, EV_YREST, F0, HD0, CR_HB,
+                        EV_SLIP_TIME, EV_STEPS, EV_STILL, EV_T_FAR, EV_TAU, EV_TRACED, EV_VMAX, EV_WORK, EV_YREST, F0, HD0, CR_HB,
                         CR_V, CR_VN, HD1, IN_EVENT, NONFINITE, OK, P, P0, PAUSED, SLIDING, STALLED, STOPPED, TOO_LONG,
                         TR, TS, UNLIMITED, UNSTABLE, UNTOUCHED, V, V0, Y, Y0, YS, PausedEvent)
 
 # Steps in a row that leave the event's time where it was (a transition located at the step's start, cut to a step
-# of no length, again and again) before the event ends with STALLED: measured once with exp4 at N = 5, a = 100,
-# b = 18, where 4e7 such steps went by in 4 minutes before this guard (max_steps would have ended it after about
-# 20 minutes). workspace.STATUS_TEXT[STALLED] gives the number.
-# Counted within a kernel call; a legitimate cut at the step's start happens once, then the step goes on.
+# of no length, again and again) before the event ends with STALLED: a guard, not a regime. It was met once, with
+# exp4 at N = 5, a = 100, b = 18, where 4e7 such steps went by in 4 minutes (two blocks taking turns: see `started`
+# in continue_event, which ended that). Counted over paused calls too (EV_STILL), so it does not depend on the
+# budget; a legitimate cut at the step's start happens a few times at most, then the step goes on.
+# workspace.STATUS_TEXT[STALLED] gives the number.
 STALL_STEPS = 10_000
 
 # Stability limit of classical RK4 on the negative real axis: the state equation
@@ -195,7 +196,8 @@ def begin_handover(arrays, t0, n, epicenter, p):
 def _at_onset(na, nt, yrest, t_far, far, vmax, h_next):
     """The loop variables (PausedEvent) of an event at its onset: the blocks started, nothing integrated yet."""
     return PausedEvent(na=na, nt=nt, yrest=yrest, t_far=t_far, far=far, tau=0.0, work=0.0, slip_time=0.0, steps=0,
-                       block_steps=0, rejected=0, cuts=0, vmax=vmax, h_next=h_next, err_prev=1.0, traced=0)
+                       block_steps=0, rejected=0, cuts=0, vmax=vmax, h_next=h_next, err_prev=1.0, traced=0,
+                       still=0)
 
 
 @nb.njit(cache=True, inline="always")
@@ -218,6 +220,7 @@ def _keep(event, s):
     event[EV_H_NEXT] = s.h_next
     event[EV_ERR_PREV] = s.err_prev
     event[EV_TRACED] = s.traced
+    event[EV_STILL] = s.still
 
 
 @nb.njit(cache=True, inline="always")
@@ -229,7 +232,8 @@ def _resume(event):
                        slip_time=event[EV_SLIP_TIME], steps=int(event[EV_STEPS]),
                        block_steps=int(event[EV_BLOCK_STEPS]), rejected=int(event[EV_REJECTED]),
                        cuts=int(event[EV_CUTS]), vmax=event[EV_VMAX], h_next=event[EV_H_NEXT],
-                       err_prev=event[EV_ERR_PREV], traced=int(event[EV_TRACED]))
+                       err_prev=event[EV_ERR_PREV], traced=int(event[EV_TRACED]),
+                       still=int(event[EV_STILL]))
 
 
 @nb.njit(cache=True)
@@ -248,6 +252,7 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
     na, nt, yrest, t_far, far = s.na, s.nt, s.yrest, s.t_far, s.far
     tau, work, slip_time, vmax, h_next, err_prev = s.tau, s.work, s.slip_time, s.vmax, s.h_next, s.err_prev
     steps, block_steps, rejected, cuts, traced = s.steps, s.block_steps, s.rejected, s.cuts, s.traced
+    still = s.still     # steps in a row that left tau where it was (STALL_STEPS), over paused calls too
     status = OK
     v_limit = RK4_STABILITY / p.dt
     psi_limit = stiff_limit(p.law, v_limit)
@@ -257,12 +262,11 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
     # block started or stopped or the step was cut, and not at a call's first step (exact either way)
     unchanged = False
     at_last = (0.0, 0.0)
-    still = 0       # steps in a row that left tau where it was (STALL_STEPS)
     while na > 0:
         if used >= budget:
             _keep(event, PausedEvent(na=na, nt=nt, yrest=yrest, t_far=t_far, far=far, tau=tau, work=work,
                                      slip_time=slip_time, steps=steps, block_steps=block_steps, rejected=rejected,
-                                     cuts=cuts, vmax=vmax, h_next=h_next, err_prev=err_prev, traced=traced))
+                                     cuts=cuts, vmax=vmax, h_next=h_next, err_prev=err_prev, traced=traced, still=still))
             return PAUSED, used
         if steps >= p.max_steps or tau > p.max_duration:
             status = TOO_LONG
@@ -354,7 +358,11 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
         nstuck = 0
         for k in range(na):
             i = act[k]
-            started = i == who and (kind == ONSET_NEIGHBOUR or kind == ONSET_LOADING)
+            # a block that started at this very time (in this step, or in one before it cut to no length) has
+            # not slid for any time yet, so it cannot have stopped: without this, two blocks on their thresholds
+            # within rounding took turns, one starting by loading at the step's start (a cut to no length) while
+            # the other, not `pressed` by a rounding, stopped and was due at once again (exp4, N = 5, a = 100, b = 18)
+            started = W[i, TS] == tau
             if W[i, V] <= 0.0 and not started and not pressed(W, n, i, tau, p):
                 # Blocks never move backward: a block that started this step
                 # but could not move keeps its slip.
@@ -400,7 +408,7 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
     # the final values too, so that the vector does not depend on where the event was paused
     _keep(event, PausedEvent(na=na, nt=nt, yrest=yrest, t_far=t_far, far=far, tau=tau, work=work,
                              slip_time=slip_time, steps=steps, block_steps=block_steps, rejected=rejected, cuts=cuts,
-                             vmax=vmax, h_next=h_next, err_prev=err_prev, traced=traced))
+                             vmax=vmax, h_next=h_next, err_prev=err_prev, traced=traced, still=still))
     clear_log(W, event, arrays.undo)
     event[EV_PHASE] = BETWEEN
     return status, used

@@ -137,13 +137,14 @@ EV_H_NEXT = 17      # the next step size (adaptive methods; dt for RK4)
 EV_ERR_PREV = 18    # error norm of the last accepted step (PI control)
 EV_TRACED = 19      # rows of the step trace filled
 EV_NUNDO = 20       # entries of the undo log
-NEVENT = 21
+EV_STILL = 21       # steps in a row that left the event's time where it was (event.STALL_STEPS)
+NEVENT = 22
 # The loop variables of the event in progress (event.continue_event) as one record, saved into `event`
 # when a kernel call pauses and restored from it at the next, field by field and by name: field `x` in
 # slot EV_X (event._keep, event._resume). Built by keyword only, so the order of the fields below
 # matters nowhere; a new loop variable is one field here, its slot above and a line in each of the two.
 PausedEvent = namedtuple("PausedEvent", ["na", "nt", "yrest", "t_far", "far", "tau", "work", "slip_time", "steps",
-                                         "block_steps", "rejected", "cuts", "vmax", "h_next", "err_prev", "traced"])
+                                         "block_steps", "rejected", "cuts", "vmax", "h_next", "err_prev", "traced", "still"])
 # The creep phase (creep.py). Per block, the array `creep`: its first CR_KEEP columns are state
 # (a checkpoint keeps them), the others scratch of one creep step.
 CR_EP = 0       # 1 + the slot of the episode the block creeps in (0: not creeping)
