@@ -49,9 +49,9 @@ from .undo import clear_log, log_block
 from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D_ENERGY_SCALE, D_FIRST, D_LAST,
                         D_LOAD_WORK, D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK, EV_BLOCK_STEPS,
                         EV_CUTS, EV_EPICENTER, EV_ERR_PREV, EV_FAR, EV_H_NEXT, EV_NA, EV_NT, EV_PHASE, EV_REJECTED,
-                        EV_SLIP_TIME, EV_STEPS, EV_STILL, EV_T_FAR, EV_TAU, EV_TRACED, EV_VMAX, EV_WORK, EV_YREST, F0, HD0, CR_HB,
-                        CR_V, CR_VN, HD1, IN_EVENT, NONFINITE, OK, P, P0, PAUSED, SLIDING, STALLED, STOPPED, TOO_LONG,
-                        TR, TS, UNLIMITED, UNSTABLE, UNTOUCHED, V, V0, Y, Y0, YS, PausedEvent)
+                        EV_SLIP_TIME, EV_STEPS, EV_STILL, EV_T_FAR, EV_TAU, EV_TRACED, EV_VMAX, EV_WORK, EV_YREST, F0,
+                        HD0, CR_HB, CR_V, CR_VN, HD1, IN_EVENT, NONFINITE, OK, P, P0, PAUSED, SLIDING, STALLED,
+                        STOPPED, TOO_LONG, TR, TS, UNLIMITED, UNSTABLE, UNTOUCHED, V, V0, Y, Y0, YS, PausedEvent)
 
 # Steps in a row that leave the event's time where it was (a transition located at the step's start, cut to a step
 # of no length, again and again) before the event ends with STALLED: a guard, not a regime. It was met once, with
@@ -266,7 +266,8 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
         if used >= budget:
             _keep(event, PausedEvent(na=na, nt=nt, yrest=yrest, t_far=t_far, far=far, tau=tau, work=work,
                                      slip_time=slip_time, steps=steps, block_steps=block_steps, rejected=rejected,
-                                     cuts=cuts, vmax=vmax, h_next=h_next, err_prev=err_prev, traced=traced, still=still))
+                                     cuts=cuts, vmax=vmax, h_next=h_next, err_prev=err_prev, traced=traced,
+                                     still=still))
             return PAUSED, used
         if steps >= p.max_steps or tau > p.max_duration:
             status = TOO_LONG

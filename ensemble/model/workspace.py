@@ -144,7 +144,8 @@ NEVENT = 22
 # slot EV_X (event._keep, event._resume). Built by keyword only, so the order of the fields below
 # matters nowhere; a new loop variable is one field here, its slot above and a line in each of the two.
 PausedEvent = namedtuple("PausedEvent", ["na", "nt", "yrest", "t_far", "far", "tau", "work", "slip_time", "steps",
-                                         "block_steps", "rejected", "cuts", "vmax", "h_next", "err_prev", "traced", "still"])
+                                         "block_steps", "rejected", "cuts", "vmax", "h_next", "err_prev", "traced",
+                                         "still"])
 # The creep phase (creep.py). Per block, the array `creep`: its first CR_KEEP columns are state
 # (a checkpoint keeps them), the others scratch of one creep step.
 CR_EP = 0       # 1 + the slot of the episode the block creeps in (0: not creeping)
