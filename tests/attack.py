@@ -804,13 +804,18 @@ def main(words):
                 outcome, detail = "FAILED", f"{type(err).__name__}: {' / '.join(lines[:1] + lines[-3:])}"
             results.append((name, outcome, time.monotonic() - start, detail))
             print(f"{outcome:8s} {results[-1][2]:5.1f} s  {name}" + (f"  ({detail})" if detail else ""), flush=True)
+    print("\n" + "\n".join(table([(name, outcome, seconds) for name, outcome, seconds, _ in results])))
+    return 1 if any(outcome == "FAILED" for _, outcome, _, _ in results) else 0
+
+
+def table(results):
+    """The lines of the attacks' table from (name, outcome, seconds) rows: this script's and, for the attacks
+    `make test` runs, its summary's (tests/conftest.py)."""
     width = max(len(name) for name, *_ in results)
-    print(f"\n| {'attack':{width}s} | outcome | s |\n|{'-' * (width + 2)}|---------|---|")
-    for name, outcome, seconds, _ in results:
-        print(f"| {name:{width}s} | {outcome:7s} | {seconds:.0f} |")
-    failed = sum(outcome == "FAILED" for _, outcome, _, _ in results)
-    print(f"\n{len(results) - failed} of {len(results)} held or skipped; {failed} failed")
-    return 1 if failed else 0
+    lines = [f"| {'attack':{width}s} | outcome | s |", f"|{'-' * (width + 2)}|---------|---|"]
+    lines += [f"| {name:{width}s} | {outcome:7s} | {seconds:.0f} |" for name, outcome, seconds in results]
+    failed = sum(outcome == "FAILED" for _, outcome, _ in results)
+    return lines + ["", f"{len(results) - failed} of {len(results)} held or skipped; {failed} failed"]
 
 
 if __name__ == "__main__":

@@ -154,6 +154,31 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(skip)
 
 
+# the attacks' outcomes in this run (tests/test_attacks.py), for the table at its end: test id -> (outcome, seconds)
+_ATTACKS = {}
+_ATTACK_TEST = "test_attacks.py::test_attack_holds["
+_OUTCOME = {"passed": "held", "skipped": "skipped", "failed": "FAILED"}
+
+
+def pytest_runtest_logreport(report):
+    """Each attack's outcome (with xdist, the workers' reports reach this process too)."""
+    if _ATTACK_TEST in report.nodeid and (report.when == "call" or report.outcome != "passed"):
+        seconds = _ATTACKS.get(report.nodeid, ("", 0.0))[1] + report.duration
+        if report.nodeid not in _ATTACKS or report.outcome != "passed":
+            _ATTACKS[report.nodeid] = (_OUTCOME[report.outcome], seconds)
+
+
+def pytest_terminal_summary(terminalreporter):
+    """The attacks' table, as `python tests/attack.py` prints it, when the run had attacks (CI's log shows it)."""
+    if not _ATTACKS:
+        return
+    from tests.attack import table
+    rows = [(nodeid.split("[", 1)[1][:-1], outcome, seconds) for nodeid, (outcome, seconds) in _ATTACKS.items()]
+    terminalreporter.section("the attacks at the edges (tests/attack.py)")
+    for line in table(rows):
+        terminalreporter.write_line(line)
+
+
 def pytest_unconfigure(config):
     os.close(config.stash[_STDERR])
 
