@@ -28,9 +28,8 @@ import sys
 from ensemble import checks, filekind
 from ensemble.store.errors import CatalogError
 
-from . import merge, summary
-from .reduce import (CREEP_DURATION_BINS, CREEP_MU_BINS, LAYOUT, NUMBERS, SEIS_DISTANCE_BINS, SEIS_LONG, SEIS_NEAR,
-                     SEIS_RING, SEIS_SHORT, SEIS_TIME_BINS, Options, bin_edges, parse_bins)
+from . import merge, options, summary
+from .reduce import LAYOUT, NUMBERS, bin_edges
 
 # errors that reduce's rank 0 finds before the work starts and every rank then raises alike
 # (ensemble.run.abort.on_root), with their exit codes; any other error on any rank aborts them all
@@ -39,38 +38,14 @@ COLLECTIVE = {ValueError: 2, CatalogError: 1, summary.SummaryError: 1, OSError: 
 
 # Every numeric option of every command (argparse dest -> its check), applied to the options a
 # command has before it reads a file: argparse hands them over as text, so that "nan", "inf" and
-# "1e400" reach one check that names the option (checks.UsageError, exit 2). Magnitudes are
-# log10 of a float64 slip; a million bootstrap resamples or stretches per task is more than any
-# interval needs (and what they allocate together is checked by _memory once the tasks are known).
-MAGNITUDE = (-330.0, 310.0)
+# "1e400" reach one check that names the option (checks.UsageError, exit 2). The reduction's options
+# are declared by the statistics (analysis/options.py, each with its range); a regional reduction's
+# window is this command's own.
 NUMERIC = {
-    "mu_c": lambda v: checks.number("--mu-c", v, *MAGNITUDE),
-    "b_cut": lambda v: checks.number("--b-cut", v, *MAGNITUDE),
-    "mu_bins": lambda v: _bins("--mu-bins", v),
-    "tnu_bins": lambda v: _bins("--tnu-bins", v),
-    "creep_mu_bins": lambda v: _bins("--creep-mu-bins", v),
-    "creep_duration_bins": lambda v: _bins("--creep-duration-bins", v),
-    "seis_time_bins": lambda v: _bins("--seis-time-bins", v),
-    "seis_distance_bins": lambda v: _bins("--seis-distance-bins", v),
-    "seis_near": lambda v: checks.number("--seis-near", v, 0.0, 1e9),
-    "seis_ring": lambda v: checks.number("--seis-ring", v, 0.0, 1e9),
-    "seis_short": lambda v: checks.number("--seis-short", v, 0.0, 1e300),
-    "seis_long": lambda v: checks.number("--seis-long", v, 0.0, 1e300),
-    "window": lambda v: checks.count("--window", v, lo=0, hi=10 ** 9),
-    "bootstrap": lambda v: checks.count("--bootstrap", v, lo=1, hi=10 ** 6),
-    "level": lambda v: checks.number("--level", v, 0.0, 1.0, exclusive=True),
-    "blocks": lambda v: checks.count("--blocks", v, lo=1, hi=10 ** 6),
-    "seed": lambda v: checks.count("--seed", v, lo=0, hi=2 ** 63 - 1),   # stored as an HDF5 int64
-    "n_large": lambda v: checks.count("--n-large", v, lo=2, hi=10 ** 9),
-    "n_min": lambda v: checks.count("--n-min", v, lo=1, hi=10 ** 9),
+    **{name: (lambda v, o=o: options.check(o, v)) for name, o in options.every_option().items()},
     "region_span": lambda v: checks.number("--region-span", v, 0.0, 1e300, exclusive=True),
     "region_skip": lambda v: checks.number("--region-skip", v, 0.0, 1e300),
 }
-
-
-def _bins(option, text):
-    parse_bins(text, option)   # lo:hi:n, finite, at most reduce.MAX_BINS bins; kept as text
-    return text
 
 
 def check_numbers(args):
@@ -92,40 +67,9 @@ def _parser():
                                           ".summary.h5; required with several)")
     r.add_argument("--partial", action="store_true",
                    help="reduce unfinished runs as far as written (the summary and report say so)")
-    # the defaults of these four are the friction law's (model/laws: Law.scales), the aging law's
-    # being the paper's axes; catalogs of several laws need them given
-    r.add_argument("--mu-bins", help="magnitude bins lo:hi:n (default: the law's; aging 0:7:70)")
-    r.add_argument("--tnu-bins", help="T*nu bins lo:hi:n (default: the law's; aging 0:2000:80)")
-    r.add_argument("--creep-mu-bins", default=CREEP_MU_BINS,
-                   help=f"bins lo:hi:n of the creep episodes' mu = log10(slip) (default {CREEP_MU_BINS}; "
-                        "a negative lo after '=': --creep-mu-bins=-8:2:50)")
-    r.add_argument("--creep-duration-bins", default=CREEP_DURATION_BINS,
-                   help="bins lo:hi:n of the creep episodes' log10(duration nu), duration in units of the "
-                        f"loading time 1/nu (default {CREEP_DURATION_BINS})")
-    r.add_argument("--seis-time-bins", default=SEIS_TIME_BINS,
-                   help="seismicity around mainshocks (mu >= mu_c): bins lo:hi:n of the time T*nu from a mainshock's "
-                        f"onset, negative before it (default {SEIS_TIME_BINS}, for the aging law; a negative lo "
-                        "after '=')")
-    r.add_argument("--seis-distance-bins", default=SEIS_DISTANCE_BINS,
-                   help=f"its bins lo:hi:n of the distance from the epicenter, blocks (default {SEIS_DISTANCE_BINS})")
-    r.add_argument("--seis-near", default=SEIS_NEAR,
-                   help=f"its epicentral neighbourhood: distance < this, blocks (default {SEIS_NEAR:g})")
-    r.add_argument("--seis-ring", default=SEIS_RING,
-                   help=f"its ring: from --seis-near to this, blocks (default {SEIS_RING:g})")
-    r.add_argument("--seis-short", default=SEIS_SHORT,
-                   help=f"its 'just before' and 'just after' the onset, T*nu (default {SEIS_SHORT:g})")
-    r.add_argument("--seis-long", default=SEIS_LONG,
-                   help=f"its 'some time before': from -this to --seis-short, T*nu (default {SEIS_LONG:g})")
-    r.add_argument("--mu-c", help="large-event magnitude (default: the law's; aging 4)")
-    r.add_argument("--window", default=10, help="epicenter window in blocks (default 10)")
-    r.add_argument("--b-cut", help="magnitude cut of the GR b fit (default: the law's; aging 3)")
-    r.add_argument("--bootstrap", default=1000, help="bootstrap resamples (default 1000)")
-    r.add_argument("--level", default=0.95, help="interval coverage (default 0.95)")
-    r.add_argument("--blocks", default=20,
-                   help="stretches per task, resampled when a point has one seed (default 20)")
-    r.add_argument("--seed", default=0,
-                   help="seed of the bootstrap; a point's resamples are drawn from it and the "
-                        "point's parameters (default 0)")
+    # the options of the statistics and the engine (analysis/options.py); a LAW default is the friction law's
+    # (model/laws: Law.scales, the aging law's being the paper's axes): catalogs of several laws need them given
+    options.add_arguments(r, "reduce")
     r.add_argument("--region", action="store_true",
                    help="pool each population's faults into its region over a common window of loading, each fault "
                         "in proportion to its event rate; intervals resample faults (analysis/region.py)")
@@ -162,25 +106,18 @@ def _parser():
                                          "law-independent size axis (docs/laws.md)")
     cp.add_argument("catalogs", nargs="+", metavar="catalog")
     cp.add_argument("-o", "--output", required=True, help="directory of comparison.md, .json and the figures")
-    cp.add_argument("--n-large", default=50, help="large event: at least this many blocks slip (default 50)")
-    cp.add_argument("--n-min", default=1, help="smallest n of the power-law fit (default 1)")
-    cp.add_argument("--window", default=10, help="epicenter window in blocks (default 10)")
-    cp.add_argument("--bootstrap", default=1000, help="bootstrap resamples (default 1000)")
-    cp.add_argument("--level", default=0.95, help="interval coverage (default 0.95)")
-    cp.add_argument("--blocks", default=20, help="stretches per task when a point has fewer "
-                                                 "than 10 seeds (default 20)")
-    cp.add_argument("--seed", default=0, help="bootstrap seed (default 0)")
+    options.add_arguments(cp, "compare")
     cp.add_argument("--force", action="store_true", help="overwrite an existing comparison")
     return p
 
 
 def _compare(args):
-    from .compare import Options, check_output, compare, write
+    from .compare import check_output, compare, write
     check_numbers(args)
-    opt = Options(args.n_large, args.n_min, args.window, args.bootstrap, args.level, args.blocks, args.seed)
+    opt = options.make("compare", **options.given(args, "compare"))
     command = "python -m analysis compare " + " ".join(
         [str(c) for c in args.catalogs] + ["-o", args.output]
-        + [f"--{k.replace('_', '-')} {v}" for k, v in opt.__dict__.items() if v != getattr(Options, k)])
+        + [f"{options.declared('compare')[k].flag} {v}" for k, v in opt.changed().items()])
     check_output(args.output, args.force, args.catalogs)   # before the work
     for path in write(compare(args.catalogs, opt), opt, args.output, command, force=args.force,
                       inputs=args.catalogs):
@@ -205,27 +142,23 @@ def _default_output(catalogs):
     return name.removesuffix(".h5") + ".summary.h5"
 
 
-SCALE_OPTIONS = ("mu_bins", "mu_c", "b_cut", "tnu_bins")
-
-
 def _scales(args, inputs):
-    """--mu-bins, --mu-c, --b-cut, --tnu-bins as given, else the catalogs' friction law's."""
-    missing = [name for name in SCALE_OPTIONS if getattr(args, name) is None]
+    """The friction law's scales (Law.scales) of the catalogs, for the options whose default is the law's and that
+    were not given; None when every such option was given."""
+    missing = [o for o in options.declared("reduce").values()
+               if getattr(args, o.name) is None and options.default(o) is None]
     if not missing:
-        return {name: getattr(args, name) for name in SCALE_OPTIONS}
+        return None
     from ensemble.model import laws
     names = sorted({merge.law_name(law) for law in inputs.tasks["law"]})
     for name in names:
         if name not in laws.LAWS:
             raise ValueError(f"friction law {name!r} is unknown to this version: give "
-                             + ", ".join("--" + key.replace("_", "-") for key in missing))
+                             + ", ".join(o.flag for o in missing))
     if len({laws.get(name).scales for name in names}) > 1:
         raise ValueError(f"the catalogs hold points of several friction laws ({', '.join(names)}), whose "
-                         "magnitudes lie on different scales: give " + ", ".join(
-                             "--" + name.replace("_", "-") for name in missing))
-    law = laws.get(names[0]).scales
-    return {name: getattr(args, name) if getattr(args, name) is not None else getattr(law, name)
-            for name in SCALE_OPTIONS}
+                         "magnitudes lie on different scales: give " + ", ".join(o.flag for o in missing))
+    return laws.get(names[0]).scales
 
 
 def check_summary_output(out, catalogs, force):
@@ -239,18 +172,16 @@ def check_summary_output(out, catalogs, force):
 
 
 def _memory(opt, n_tasks):
-    """Refuse options whose arrays this machine cannot hold: rank 0 gathers every task's
-    (stretches, bins) counts and stacks them for the summary; a point's bootstrap keeps, per resample, its picks
-    of units (at most tasks x blocks), its numbers and its curves: R(mu) (n_mu bins), three arrays on the T nu bins
-    (the curves of all recurrences and of the interior ones, and the recurrence peaks' resampled counts: 3 x n_tnu)
-    and the two creep curves (n_creep bins)."""
-    n_mu, n_tnu = len(opt.mu_edges) - 1, len(opt.tnu_edges) - 1
-    n_creep = len(opt.creep_mu_edges) + len(opt.creep_duration_edges) - 2
+    """Refuse options whose arrays this machine cannot hold: rank 0 gathers every task's (stretches, entries) tables
+    and stacks them for the summary; a point's bootstrap keeps, per resample, its picks of units (at most tasks x
+    blocks), its numbers and its curves, and a statistic's extras about as much again as its curves (the recurrence
+    peaks' resampled counts)."""
     edges = bin_edges(opt)
     per_task = opt.blocks * sum(LAYOUT.width(name, edges) for name in LAYOUT.tables)
-    resamples = opt.bootstrap * (n_mu + 3 * n_tnu + n_creep + len(NUMBERS) + n_tasks * opt.blocks)
-    checks.memory(f"--blocks {opt.blocks}, --bootstrap {opt.bootstrap} and {n_mu} + 3 x {n_tnu} + {n_creep} bins "
-                  f"over {n_tasks} tasks", 8 * (2 * n_tasks * per_task + resamples))
+    curves = sum(len(edges[LAYOUT.tables[c.table].bins]) - 1 for c in LAYOUT.curves if c.values is None)
+    resamples = opt.bootstrap * (2 * curves + len(NUMBERS) + n_tasks * opt.blocks)
+    checks.memory(f"--blocks {opt.blocks}, --bootstrap {opt.bootstrap} and {curves} bins of curves over {n_tasks} "
+                  "tasks", 8 * (2 * n_tasks * per_task + resamples))
 
 
 def _prepare(args):
@@ -264,15 +195,7 @@ def _prepare(args):
     # (checks each file's kind first)
     inputs = merge.read(args.catalogs, allow_partial=args.partial, region=args.region, span=args.region_span,
                         skip=args.region_skip or 0.0)
-    scale = _scales(args, inputs)
-    opt = Options(parse_bins(scale["mu_bins"], "--mu-bins"), parse_bins(scale["tnu_bins"], "--tnu-bins"),
-                  scale["mu_c"], args.window, scale["b_cut"], args.bootstrap, args.level, args.blocks, args.seed,
-                  creep_mu_edges=parse_bins(args.creep_mu_bins, "--creep-mu-bins"),
-                  creep_duration_edges=parse_bins(args.creep_duration_bins, "--creep-duration-bins"),
-                  seis_time_edges=parse_bins(args.seis_time_bins, "--seis-time-bins"),
-                  seis_distance_edges=parse_bins(args.seis_distance_bins, "--seis-distance-bins"),
-                  seis_near=args.seis_near, seis_ring=args.seis_ring, seis_short=args.seis_short,
-                  seis_long=args.seis_long)
+    opt = options.make("reduce", _scales(args, inputs), **options.given(args, "reduce"))
     _memory(opt, len(inputs.tasks["point"]))
     return opt, out, inputs
 

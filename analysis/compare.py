@@ -23,7 +23,8 @@ event slips, n = 1..N, and on recurrence times divided by their mean:
   bin [0, SHARPNESS_BIN / 2)), a periodic one 1 / SHARPNESS_BIN.
 
 The comparison is a set of statistics of the one reduction (analysis/reduce.py, the engine): the magnitude
-distribution (statistics/magnitude.py: R(mu) on MU_EDGES, the events), the rupture lengths
+distribution (statistics/magnitude.py: R(mu) on --mu-bins, by default one axis spanning the
+laws' scales), the rupture lengths
 (statistics/rupture.py: counts per n on the chain's own bins 0..N, the size numbers and R(log10 n)) and the
 regularity (statistics/regularity.py: the recurrence times of the events with n >= n_large, a sample table,
 whose median and CV a resample computes from its values exactly). This module chooses the set, reads its
@@ -36,7 +37,6 @@ parameters). A point of one unit has no interval (the engine's rule).
 import json
 import math
 import os
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -44,7 +44,6 @@ from ensemble import checks, space
 
 from . import merge
 from .reduce import PARAMS, point_statistics
-from .reduce import Options as ReduceOptions
 from .statistics import Layout, of
 # F401: the comparison's estimators, reached as compare.<name> too (tests/test_compare.py)
 from .statistics.regularity import POISSON_SHARPNESS, SHARPNESS_BIN, recurrence_numbers  # noqa: F401
@@ -55,33 +54,13 @@ NUMBERS = ("n_events", "fraction_large", "dip", "tau", "ks_power_law", "n_recurr
 # each of the comparison's numbers (NUMBERS, its json's names) by its statistic's name in the engine
 ENGINE_NUMBERS = ("n_events", "fraction_large_n", "dip", "tau", "ks_power_law", "n_recurrences_n", "cv_n",
                   "sharpness")
-MU_EDGES = np.linspace(-4.0, 7.0, 111)                    # magnitude bins of the R(mu) figure
 LAYOUT = Layout(of("compare"))                            # the comparison's statistics
-
-
-@dataclass(frozen=True)
-class Options:
-    """The command's options (comparison.json's "options"); engine_options makes the engine's of them."""
-    n_large: int = 50
-    n_min: int = 1
-    window: int = 10
-    bootstrap: int = 1000
-    level: float = 0.95
-    blocks: int = 20
-    seed: int = 0
-
-
-def engine_options(opt):
-    """The reduction's options of a comparison: R(mu) on MU_EDGES, no T nu bins (no statistic of the set has
-    them), mu_c left at its default (magnitude's n_large and fraction_large: not reported here)."""
-    return ReduceOptions(MU_EDGES, np.array([0.0, 1.0]), window=opt.window, bootstrap=opt.bootstrap,
-                         level=opt.level, blocks=opt.blocks, seed=opt.seed, n_large=opt.n_large, n_min=opt.n_min)
 
 
 def compare_point(per_task, params, rows, opt):
     """A point's numbers (NUMBERS order, with lo and hi), R(log10 n), R(mu), recurrence times, from the engine."""
     n_blocks = int(params["N"])
-    result = point_statistics(per_task, rows, engine_options(opt), merge.bootstrap_rng(opt.seed, params),
+    result = point_statistics(per_task, rows, opt, merge.bootstrap_rng(opt.seed, params),
                               LAYOUT, n_blocks)
     names = [n.name for n in LAYOUT.numbers]
     x = result["numbers"][[names.index(name) for name in ENGINE_NUMBERS]]
@@ -102,7 +81,8 @@ def _check_memory(opt, n_tasks, n_blocks):
     """Refuse options whose arrays this machine cannot hold (checks.memory): the stretches of counts per n
     and per mu bin of every task, and each resample's picks and numbers."""
     units = n_tasks * opt.blocks
-    n_bytes = 8 * units * (n_blocks + 1 + len(MU_EDGES)) + 8 * opt.bootstrap * (units + len(MU_EDGES) + 2 * n_blocks)
+    n_mu = len(opt.mu_edges)
+    n_bytes = 8 * units * (n_blocks + 1 + n_mu) + 8 * opt.bootstrap * (units + n_mu + 2 * n_blocks)
     checks.memory(f"--blocks {opt.blocks} and --bootstrap {opt.bootstrap} over {n_tasks} tasks of {n_blocks} blocks",
                   n_bytes)
 
@@ -120,7 +100,7 @@ def compare(paths, opt):
             raise ValueError(f"--n-large {opt.n_large} exceeds the chain of {int(params['N'])} blocks")
     out = []
     for params, rows in inputs.points:   # a point's tasks reduced together, then dropped
-        per_task = merge.reduce_share(inputs, rows, engine_options(opt), LAYOUT)
+        per_task = merge.reduce_share(inputs, rows, opt, LAYOUT)
         result = compare_point(per_task, params, rows, opt)
         result.update(law=params["law"], params=params, label=label(params["law"], params))
         out.append(result)
@@ -180,6 +160,7 @@ def write(points, opt, out_dir, command, force=False, inputs=()):
                 **{name: [float(p["numbers"][j]), float(p["numbers_lo"][j]), float(p["numbers_hi"][j])]
                    for j, name in enumerate(NUMBERS)}} for p in points]
     space.write_file(os.path.join(out_dir, "comparison.json"),
-                     json.dumps({"options": opt.__dict__, "points": numbers}, indent=1), "the comparison numbers")
-    figures(points, opt, out_dir, MU_EDGES)
+                     json.dumps({"options": {k: np.asarray(v).tolist() for k, v in opt.values().items()},
+                                 "points": numbers}, indent=1), "the comparison numbers")
+    figures(points, opt, out_dir, opt.mu_edges)
     return [os.path.join(out_dir, n) for n in OUTPUTS]

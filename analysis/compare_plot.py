@@ -30,7 +30,7 @@ def _legend(ax):
 
 def figures(points, opt, out_dir, mu_edges):
     """size.png, magnitude.png and recurrence.png of the points; mu_edges: the magnitude bins of their
-    R(mu) (compare.MU_EDGES, passed in: compare.py imports this module)."""
+    R(mu) (the options' mu_edges, passed in)."""
     colors = _colors(len(points))
 
     fig, ax = plt.subplots(figsize=(9.6, 4.4))

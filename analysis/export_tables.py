@@ -26,7 +26,7 @@ TITLES = {   # table -> what its rows are (said in its file's header)
     "peaks": "one row per recurrence peak of a point",
     "seismicity": "one row per point, time bin and distance bin of the seismicity around its mainshocks",
 }
-SUMMARY_SETTINGS = ("mu_c", "window", "b_cut", "bootstrap", "level", "blocks", "seed", *summary.SEIS_ATTRS)
+SUMMARY_SETTINGS = summary.STORED_OPTIONS
 
 
 @dataclass

@@ -14,8 +14,6 @@ bootstrap: a few long trajectories, as in the paper's one seed per point, give
 many stretches but only a few seeds), which the summary says. Events within a
 trajectory are correlated, so resampling single events would understate the errors.
 """
-from dataclasses import dataclass, field
-
 import numpy as np
 
 from ensemble import checks, filekind
@@ -25,47 +23,11 @@ from ensemble.config import LAW_KEYS
 
 from . import stats
 from .recurrence import RecurrenceScanner
-from .statistics import Layout, Rows
+from .statistics import CRITERIA, Layout, Rows
 
 # the parameters that tell points apart: the chain's, and every friction law's keys (NaN where a
 # key is not of the task's law, so tasks of two laws never pool)
 PARAMS = ("N", "l", "nu", *LAW_KEYS)
-
-
-# default bins of the creep episodes (`reduce --creep-mu-bins`, `--creep-duration-bins`): measured
-# at N = 100, b = 8..18.5 (aging law), creep slips reach mu = -11 and durations 10^-6.4 / nu
-CREEP_MU_BINS = "-12:3:75"
-CREEP_DURATION_BINS = "-7:3:50"
-# default bins and regions of the seismicity around large events (analysis/statistics/seismicity.py), chosen
-# for the aging law at b = 20, N = 800 (inter-event times of about 37 T nu, large events recurring
-# after T nu ~ 530): time from the mainshock's onset (T nu) and distance from its epicenter (blocks)
-SEIS_TIME_BINS = "-1000:1000:40"
-SEIS_DISTANCE_BINS = "0:40:20"
-SEIS_NEAR, SEIS_RING, SEIS_SHORT, SEIS_LONG = 2.0, 10.0, 50.0, 500.0
-
-
-@dataclass(frozen=True)
-class Options:
-    mu_edges: np.ndarray
-    tnu_edges: np.ndarray
-    mu_c: float = 4.0
-    window: int = 10
-    b_cut: float = 3.0
-    bootstrap: int = 1000
-    level: float = 0.95
-    blocks: int = 20
-    seed: int = 0
-    chunk: int = 1 << 16
-    creep_mu_edges: np.ndarray = field(default_factory=lambda: parse_bins(CREEP_MU_BINS))
-    creep_duration_edges: np.ndarray = field(default_factory=lambda: parse_bins(CREEP_DURATION_BINS))
-    seis_time_edges: np.ndarray = field(default_factory=lambda: parse_bins(SEIS_TIME_BINS))
-    seis_distance_edges: np.ndarray = field(default_factory=lambda: parse_bins(SEIS_DISTANCE_BINS))
-    seis_near: float = SEIS_NEAR      # blocks: the epicentral neighbourhood is distance < seis_near
-    seis_ring: float = SEIS_RING      # blocks: the ring around it is seis_near <= distance < seis_ring
-    seis_short: float = SEIS_SHORT    # T nu: "just before" is [-seis_short, 0), "just after" [0, seis_short)
-    seis_long: float = SEIS_LONG      # T nu: "some time before" is [-seis_long, -seis_short)
-    n_large: int = 50                 # blocks: a large event by its rupture length, n_slipped >= n_large (compare)
-    n_min: int = 1                    # blocks: the smallest n_slipped of the rupture lengths' power law (compare)
 
 
 # every statistic of analysis/statistics/, laid out: its tables, numbers and curves in the registry's order
@@ -81,21 +43,11 @@ def bin_edges(opt, n_blocks=None, layout=LAYOUT):
             for name in layout.bins}
 
 
-# the criteria of a large event whose recurrences a statistic may need ("recurrences:<criterion>";
-# "recurrences" alone: mu): (the events' column, its threshold from the options), large where column >= threshold
-LARGE = {
-    "mu": ("mu", lambda opt: opt.mu_c),
-    "n_slipped": ("n_slipped", lambda opt: opt.n_large),
-}
-
-
 def _criteria(layout):
-    """The criteria whose recurrences the layout's statistics need, in order."""
+    """The criteria of a large event (statistics.CRITERIA, each declared by a statistic) whose recurrences the
+    layout's statistics need ("recurrences:<criterion>"; "recurrences" alone: mu), in order."""
     need = [n.partition(":")[2] or "mu" for s in layout.statistics for n in s.needs if n.startswith("recurrences")]
-    unknown = sorted(set(need) - set(LARGE))
-    if unknown:
-        raise ValueError(f"recurrences of an unknown criterion {unknown}: LARGE has {sorted(LARGE)}")
-    return list(dict.fromkeys(need))
+    return [CRITERIA[name] for name in dict.fromkeys(need)]
 
 
 MAX_BINS = 10 ** 6   # bins of a histogram: beyond a million, (tasks, stretches, bins) counts outgrow memory
@@ -126,7 +78,7 @@ def reduce_task(chunks, written, nu, n_blocks_chain, opt, rows=None, layout=LAYO
     k = opt.blocks
     out = layout.empty(k, bin_edges(opt, n_blocks_chain, layout))
     out.rows = 0
-    scanners = {c: RecurrenceScanner(n_blocks_chain, float(LARGE[c][1](opt)), opt.window)
+    scanners = {c: RecurrenceScanner(n_blocks_chain, float(getattr(opt, c.threshold)), getattr(opt, c.window))
                 for c in _criteria(layout)} if written else {}
     lo = row = 0
     t_before = np.nan
@@ -142,9 +94,9 @@ def reduce_task(chunks, written, nu, n_blocks_chain, opt, rows=None, layout=LAYO
             hi = lo + len(ev["t"])
             block = (np.arange(lo, hi) * k) // written
             for criterion, scanner in scanners.items():
-                values = np.asarray(ev[LARGE[criterion][0]], dtype=float)
+                values = np.asarray(ev[criterion.column], dtype=float)
                 src, T, interior = scanner.feed(ev["t"], ev["epicenter"], values, ev["boundary"])
-                scans[criterion] = ((src * k) // written, T * nu, interior)
+                scans[criterion.name] = ((src * k) // written, T * nu, interior)
             lo = hi
         seen = Rows(part, inertial, ev, block, creep, creep_block, scans.get("mu"), t_before, nu, opt, n_blocks_chain,
                     ev is not None and lo == written, scans)
@@ -204,7 +156,6 @@ def _inside(t, start, end):
 # -- per point ------------------------------------------------------------------------------
 
 NUMBERS = tuple(n.name for n in LAYOUT.numbers)
-CREEP_NUMBERS = tuple(n.name for s in LAYOUT.statistics if s.name == "creep" for n in s.numbers)   # the slow side's
 # Fewer resampling units than this and the bootstrap intervals are not to be trusted (a
 # percentile interval from a handful of seeds is too narrow and jumps with each one added).
 MIN_UNITS = 10

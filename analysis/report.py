@@ -2,7 +2,9 @@
 import numpy as np
 
 from . import reduce, summary
-from .reduce import CREEP_NUMBERS, LAYOUT, NUMBERS, PARAMS
+from .reduce import LAYOUT, NUMBERS, PARAMS
+
+CREEP_NUMBERS = tuple(n.name for s in LAYOUT.statistics if s.name == "creep" for n in s.numbers)   # the slow side's
 
 LABELS = {
     "n_events": "events", "n_large": "large", "fraction_large": "frac(mu>=mu_c)",

@@ -30,9 +30,9 @@
                 them) and configs (their stored configs, same order); config (the one catalog's
                 config, only when there is one); catalog (the catalog's path, or for several a
                 short description of them, for titles); partial ("" or the one-line statement of
-                an unfinished reduction: events reduced of expected, which catalogs); mu_c, window,
-                b_cut, bootstrap, level, blocks, seed, seis_near, seis_ring, seis_short, seis_long
-                (the options)
+                an unfinished reduction: events reduced of expected, which catalogs); the options
+                but the bins (STORED_OPTIONS: mu_c, window, b_cut, seis_near, seis_ring, seis_short,
+                seis_long, bootstrap, level, blocks, seed)
 
 The tasks of a point are its resampling units in the order of their streams, (seed_entropy,
 spawn_key); its bootstrap draws from SeedSequence(seed, spawn_key from its parameters)
@@ -41,7 +41,7 @@ which order they were given.
 
 `format` tells a summary from a catalog (ensemble/filekind.py); summaries written before it
 existed are known by their attributes and groups. Format 3 adds the creep episodes (the slow side:
-/bins/creep_*, /per_task/creep*, /points/creep_*, the numbers of reduce.CREEP_NUMBERS). Format 2
+/bins/creep_*, /per_task/creep*, /points/creep_*, the creep statistic's numbers). Format 2
 (GR b and its standard error, 9 per-task sums, peaks by prominence; catalogs, configs, partial and
 the /tasks columns catalog, catalog_task and catalog_point) still reads, without those datasets
 (`has_creep` is False: its creep episodes, if any, were not reduced); older ones do not: reduce
@@ -67,7 +67,7 @@ import numpy as np
 from ensemble import checks, filekind, space
 from ensemble.store import schema as catalog_schema
 
-from . import reduce
+from . import options, reduce
 from .reduce import MIN_UNITS, NUMBERS, PARAMS
 from .statistics import bin_names
 
@@ -88,7 +88,8 @@ ATTRS_CRC = "attrs_crc32"   # the file's attribute: _attrs_crc of all the others
 _POINTS = "(points,)"
 _INTERVAL = "(points, 3): estimate, lo, hi (lo, hi: the bootstrap interval at `level`, NaN with one unit)"
 _CURVE = "(points, {} bins)"   # the curve's variable
-SEIS_ATTRS = ("seis_near", "seis_ring", "seis_short", "seis_long")   # the regions of the seismicity's numbers
+# the options a summary stores as attributes (its bins are /bins/<name>), declared by the statistics and the engine
+STORED_OPTIONS = tuple(name for name, o in options.declared("reduce").items() if o.kind != "bins")
 LAYOUT = reduce.LAYOUT   # the statistics (analysis/statistics/): their tables, curves and numbers
 if LAYOUT.samples or LAYOUT.chain_bins:   # ragged per unit, or of a width per point: no /per_task dataset holds them
     raise ImportError(f"analysis/statistics: the summary stores no sample table nor bins of the chain's own "
@@ -96,14 +97,9 @@ if LAYOUT.samples or LAYOUT.chain_bins:   # ragged per unit, or of a width per p
 CURVES = {   # name -> (its bins, its variable, whose variable, the density's unit), in the curves' order
     c.name: (LAYOUT.tables[c.table].bins, c.variable, c.whose, c.unit) for c in LAYOUT.curves}
 NUMBER_MEANINGS = {n.name: (n.unit, n.meaning) for n in LAYOUT.numbers}   # in the order of reduce.NUMBERS
-_BINS = {   # name -> (unit, what its edges bin)
-    "mu": ("log10 model length", "magnitude bins"),
-    "tnu": ("model length", "T nu bins"),
-    "creep_mu": ("log10 model length", "creep episodes' mu bins (reduce --creep-mu-bins)"),
-    "creep_duration": ("log10(duration nu)", "creep episodes' log10(duration nu) bins (reduce --creep-duration-bins)"),
-    "seis_time": ("model length", "time (T nu) from a mainshock's onset, negative before it (reduce --seis-time-bins)"),
-    "seis_distance": ("blocks", "distance from a mainshock's epicenter (reduce --seis-distance-bins)"),
-}
+_BINS = {   # name -> (unit, what its edges bin): of the bins options (analysis/statistics/, Option)
+    o.bins: (o.unit, f"{o.help.replace(' lo:hi:n', '').split(' (')[0]} (reduce {o.flag})")
+    for o in options.declared("reduce").values() if o.kind == "bins"}
 
 
 def _table_entry(name):
@@ -232,10 +228,7 @@ def write(path, inputs, per_task, points, opt, force=False):
     # is one line, where an HDF5 write failing on it could crash the process when the file is closed
     image = io.BytesIO()
     with h5py.File(image, "w") as h5:
-        h5.attrs.update({"format": FORMAT, **_source_attrs(inputs),
-                         "mu_c": opt.mu_c, "window": opt.window, "b_cut": opt.b_cut,
-                         "bootstrap": opt.bootstrap, "level": opt.level, "blocks": opt.blocks,
-                         "seed": opt.seed, **{k: getattr(opt, k) for k in SEIS_ATTRS}})
+        h5.attrs.update({"format": FORMAT, **_source_attrs(inputs), **opt.stored()})
         edges = reduce.bin_edges(opt)
         for name, values in edges.items():
             h5[f"bins/{name}"] = values

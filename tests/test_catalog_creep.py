@@ -127,10 +127,10 @@ def test_reduce_counts_the_inertial_events_alone(creeping):
 def test_compare_counts_the_inertial_events_alone(creeping):
     """`analysis compare`'s tables (sizes, magnitudes, recurrences: the engine's, reduced with its set of
     statistics) read the kind-0 rows alone."""
-    from analysis import compare, reduce
+    from analysis import compare, options, reduce
     d, _ = creeping
     events, tasks, _ = reader.read(d / "full.h5")
-    opt = compare.engine_options(compare.Options(blocks=5, window=10, n_large=40, n_min=1))
+    opt = options.make("compare", blocks=5, window=10, n_large=40, n_min=1)
     ids = [int(k) for k in tasks_of(tasks, CREEPING)]
     per_task = reduce.reduce_tasks(str(d / "full.h5"), ids, opt, compare.LAYOUT)
     for k in ids:

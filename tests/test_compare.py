@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from analysis import compare as cmp
+from analysis import options
 from ensemble.store import reader, schema
 
 from .conftest import run_cli, write_config
@@ -179,7 +180,7 @@ def test_docs_show_the_committed_comparison():
     root = Path(__file__).resolve().parents[1]
     md = (root / "docs/laws/comparison.md").read_text()
     saved = json.loads((root / "docs/laws/comparison.json").read_text())
-    opt = cmp.Options(**saved["options"])
+    opt = options.make("compare", **saved["options"])
     points = [{"label": p["label"], **{key: np.array([p[name][j] for name in cmp.NUMBERS])
                                        for j, key in enumerate(("numbers", "numbers_lo", "numbers_hi"))}}
               for p in saved["points"]]
@@ -209,7 +210,7 @@ def test_reduce_takes_the_scales_of_the_catalogs_law(two_laws, tmp_path):
     res = analysis_here("reduce", cl, aging, "-o", tmp_path / "both.h5", "--mu-c", "1")
     assert res.returncode == 2 and res.stderr.count("\n") == 1
     assert "several friction laws (aging, carlson-langer)" in res.stderr
-    assert "give --mu-bins, --b-cut, --tnu-bins" in res.stderr and not (tmp_path / "both.h5").exists()
+    assert "give --mu-bins, --tnu-bins, --b-cut" in res.stderr and not (tmp_path / "both.h5").exists()
     res = analysis_here("reduce", cl, aging, "-o", tmp_path / "both.h5", "--mu-c", "1", "--mu-bins=-3:7:100",
                    "--b-cut", "0", "--tnu-bins", "0:4:40", "--bootstrap", "5")
     assert res.returncode == 0, res.stderr

@@ -14,14 +14,14 @@ points of two seeds), from the raw events and the definitions alone:
 import numpy as np
 import pytest
 
-from analysis import compare, merge, reduce, stats
+from analysis import compare, merge, options, reduce, stats
 from analysis.statistics.regularity import recurrence_numbers
 from analysis.statistics.rupture import dip, log_bins, power_law_ks, power_law_tau, size_density
 from ensemble.store import reader, schema
 
 from .test_summary_identity import CATALOG, gunzip
 
-OPT = compare.Options(n_large=5, window=3, bootstrap=60, blocks=4)
+OPT = options.make("compare", n_large=5, window=3, bootstrap=60, blocks=4)
 
 
 @pytest.fixture(scope="module")
@@ -45,7 +45,7 @@ def brute_units(path, opt):
             if later:
                 T[stretch[i]].append((ev["t"][later[0]] - ev["t"][i]) * nu)
         out[k] = [(np.bincount(ev["n_slipped"][stretch == s], minlength=n_blocks + 1),
-                   np.histogram(ev["mu"][stretch == s], compare.MU_EDGES)[0], np.array(T[s]))
+                   np.histogram(ev["mu"][stretch == s], OPT.mu_edges)[0], np.array(T[s]))
                   for s in range(opt.blocks)]
     return out
 
@@ -58,11 +58,11 @@ def brute_statistics(sizes, mu, T, opt):
     tau = power_law_tau(sizes, opt.n_min, opt.n_large)
     numbers = [total, sizes[opt.n_large:].sum() / total, dip(density, edges, opt.n_large), tau,
                power_law_ks(sizes, opt.n_min, tau), len(T), *recurrence_numbers(T)]
-    return np.array(numbers), density, mu / total / np.diff(compare.MU_EDGES)
+    return np.array(numbers), density, mu / total / np.diff(OPT.mu_edges)
 
 
 def test_the_engines_tables_of_the_comparison_are_the_events(catalog):
-    per_task = reduce.reduce_tasks(str(catalog), [0, 1, 2, 3], compare.engine_options(OPT), compare.LAYOUT)
+    per_task = reduce.reduce_tasks(str(catalog), [0, 1, 2, 3], OPT, compare.LAYOUT)
     for k, stretches in brute_units(catalog, OPT).items():
         for s, (sizes, mu, T) in enumerate(stretches):
             np.testing.assert_array_equal(per_task[k]["n_slipped"][s], sizes)

@@ -59,10 +59,11 @@ def test_recurrence_cv_and_inter_event_times_are_those_of_the_events(tmp_path):
 def test_every_statistic_is_the_same_whatever_the_chunks(tmp_path):
     """A task streamed in chunks of 7 rows gives every statistic's tables as in one chunk: what a statistic
     carries from chunk to chunk (the previous event's time, the pending recurrences) is carried."""
-    from analysis import reduce
+    from analysis import options, reduce
+    from ensemble.model import laws
     from ensemble.store import reader, schema
     cat = gunzip(CATALOG, tmp_path / "catalog.h5")
-    opt = reduce.Options(reduce.parse_bins("0:7:70"), reduce.parse_bins("0:2000:80"))
+    opt = options.make(scales=laws.get("aging").scales)
     with reader.Reader(str(cat)) as r:
         for k in range(len(r.tasks["N"])):
             args = (r.count(k, schema.KIND_EVENT), float(r.tasks["nu"][k]), int(r.tasks["N"][k]), opt,

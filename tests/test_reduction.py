@@ -17,7 +17,6 @@ square of a task's events): the catalogs hold 400 events a task where their edge
 where only their count of seeds or tasks matters.
 """
 import contextlib
-import functools
 import io
 import math
 import os
@@ -30,7 +29,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from analysis import cli, reduce, stats
+from analysis import cli, stats
+from analysis import options as reduce_options
 from ensemble.store import reader, schema
 from ensemble.config import loads
 from ensemble.sweep import task_list
@@ -48,11 +48,10 @@ OPT = {"mu_bins": (-1.0, 7.0, 32),     # width 0.25: magnitudes on the 0.25 grid
        "tnu_bins": (0.0, 40.0, 40),    # width 1: grid times give T nu on the edges
        "mu_c": 4.0, "window": 3, "b_cut": 3.0, "bootstrap": 100, "seed": 11}
 
-# `python -m analysis reduce` with the rows streamed in chunks of argv[1] events (reduce.Options.chunk
-# has no command-line option): small chunks make recurrences straddle them (reduce_here: the same in this
-# process)
-REDUCE = ("import sys; from functools import partial; from analysis import cli, reduce; "
-          "cli.Options = partial(reduce.Options, chunk=int(sys.argv[1])); sys.exit(cli.main(sys.argv[2:]))")
+# `python -m analysis reduce` with the rows streamed in chunks of argv[1] events (options.CHUNK has no
+# command-line option): small chunks make recurrences straddle them (reduce_here: the same in this process)
+REDUCE = ("import sys; from analysis import cli, options; "
+          "options.CHUNK = int(sys.argv[1]); sys.exit(cli.main(sys.argv[2:]))")
 
 
 def reduce_command(chunk, paths, out, level, blocks):
@@ -83,13 +82,13 @@ def reduce_here(chunk, paths, out, level, blocks, partial=True, check=True):
     if not partial:
         args.remove("--partial")
     stdout, stderr = io.StringIO(), io.StringIO()
-    options = cli.Options
-    cli.Options = functools.partial(reduce.Options, chunk=chunk)
+    default = reduce_options.CHUNK
+    reduce_options.CHUNK = chunk
     try:
         with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
             code = cli.main(args)
     finally:
-        cli.Options = options
+        reduce_options.CHUNK = default
     res = subprocess.CompletedProcess(args, code, stdout.getvalue(), stderr.getvalue())
     assert not check or code == 0, res.stderr
     return res
@@ -527,7 +526,6 @@ def test_peak_finder_reports_the_true_peaks_and_no_spurious_ones(case):
     would be, through the reduction's own peak step: exactly the true peaks, each within one bin
     and with an interval around it. The threshold (3 noise standard deviations) was chosen on such
     data: at 2 about 2-9% of histograms gained a spurious peak, at 3 and 4 none of 600."""
-    from analysis.reduce import Options
     from analysis.statistics.recurrence import peaks
     rng = np.random.default_rng(100 + case)
     edges = np.linspace(0.0, 2000.0, 81)
@@ -544,7 +542,7 @@ def test_peak_finder_reports_the_true_peaks_and_no_spurious_ones(case):
         else:
             x = rng.gamma(3.0, 250.0, n // 20)    # one broad maximum near 500
         units.append(np.histogram(x, edges)[0])
-    opt = Options(np.linspace(0, 7, 71), edges, bootstrap=300)
+    opt = reduce_options.make(mu_bins="0:7:70", tnu_bins=edges, bootstrap=300, mu_c=4.0, b_cut=3.0)
     rows = peaks({"tnu": np.array(units)}, opt, rng)["peaks"]
     # true positions, and how far a histogram's maximum may stray: 1.5 bins, or 0.3 standard
     # deviations of a broad peak (the gamma's sd is 433; its maximum is found up to ~90 away)

@@ -8,6 +8,7 @@ import h5py
 import numpy as np
 import pytest
 
+from analysis import options as reduce_options
 from analysis import reduce
 from analysis.statistics import seismicity
 from ensemble.model.workspace import KIND_EVENT
@@ -18,8 +19,8 @@ from .test_summary_identity import CATALOG, gunzip
 
 # bins narrow enough that the committed catalog (N = 60, inter-event times of a few hundred T nu) fills
 # cells on both sides of its mainshocks, near the epicenter and far from it
-OPT = dict(seis_time_edges=reduce.parse_bins("-2000:2000:16"), seis_distance_edges=reduce.parse_bins("0:30:10"),
-           seis_near=6.0, seis_ring=18.0, seis_short=250.0, seis_long=1000.0)
+OPT = dict(seis_time_bins="-2000:2000:16", seis_distance_bins="0:30:10", seis_near=6.0, seis_ring=18.0,
+           seis_short=250.0, seis_long=1000.0)
 
 
 def brute_force(t, epicenter, mu, nu, n_blocks, opt):
@@ -49,7 +50,8 @@ def brute_force(t, epicenter, mu, nu, n_blocks, opt):
 
 
 def options(**changes):
-    return reduce.Options(reduce.parse_bins("0:7:70"), reduce.parse_bins("0:2000:80"), **{**OPT, **changes})
+    return reduce_options.make(**{"mu_bins": "0:7:70", "tnu_bins": "0:2000:80", "mu_c": 4.0, "b_cut": 3.0, **OPT,
+                           **changes})
 
 
 def tables(chunks, written, nu, n_blocks, opt):
@@ -102,7 +104,7 @@ def hand_built(t, epicenter, mu, chunk):
 def test_a_hand_built_chain_gives_its_known_counts_and_exposures():
     # N = 10, nu = 1; one mainshock (mu 5) at t = 2, block 6; the task's span is [0, 10]
     t, epicenter, mu = [0, 1, 2, 3, 10], [5, 5, 6, 2, 5], [0, 0, 5, 0, 0]
-    opt = options(seis_time_edges=reduce.parse_bins("-4:4:8"), seis_distance_edges=reduce.parse_bins("0:5:5"),
+    opt = options(seis_time_bins="-4:4:8", seis_distance_bins="0:5:5",
                   seis_near=2.0, seis_ring=5.0, seis_short=2.0, seis_long=4.0, blocks=1)
     for chunk in (5, 2, 1):
         pairs, exposure, out = tables(hand_built(t, epicenter, mu, chunk), 5, 1.0, 10, opt)
@@ -152,8 +154,7 @@ def test_cut_windows_leave_the_rates_unbiased():
     n, n_blocks = 20000, 40
     t = np.sort(rng.uniform(0, 2000, n))
     epicenter, mu = rng.integers(0, n_blocks, n), np.where(rng.random(n) < 0.02, 5.0, 0.0)
-    opt = options(seis_time_edges=reduce.parse_bins("-1000:1000:4"), seis_distance_edges=reduce.parse_bins("0:40:2"),
-                  blocks=1)
+    opt = options(seis_time_bins="-1000:1000:4", seis_distance_bins="0:40:2", blocks=1)
     pairs, exposure, out = tables(hand_built(t, epicenter, mu, 4096), n, 1.0, n_blocks, opt)
     rate = pairs[0] / exposure[0]
     background = out["seismicity"][0, 1] / out["seismicity"][0, 2]
@@ -167,8 +168,7 @@ def test_cut_windows_leave_the_rates_unbiased():
 
 def test_report_plot_and_export_show_the_seismicity(tmp_path):
     cat, out = gunzip(CATALOG, tmp_path / "catalog.h5"), tmp_path / "summary.h5"
-    edges = [f"--{k.replace('_', '-').removesuffix('-edges')}{'-bins' if k.endswith('edges') else ''}="
-             + (f"{v[0]:g}:{v[-1]:g}:{len(v) - 1}" if k.endswith("edges") else f"{v:g}") for k, v in OPT.items()]
+    edges = [f"--{k.replace('_', '-')}={v}" for k, v in OPT.items()]
     for args in (["reduce", cat, "-o", out, *edges], ["plot", out, "--figure", "seismicity", "-o", tmp_path / "s.png"],
                  ["export", out, "-o", tmp_path / "tables"], ["report", out]):
         res = run_bounded([sys.executable, "-m", "analysis", *map(str, args)], 600, cwd=ROOT, env=child_env())

@@ -25,8 +25,13 @@ A statistic (a module of this package that defines STATISTIC) declares
 - its curves: densities of a histogram table (`table`), normalised by a count column (`total`), over
   the table's bins; or, with `values`, any curve of the summed tables (`values(u, opt, edges)`).
 - its recurrences (`needs`): "recurrences" for those of the large events mu >= mu_c, "recurrences:<criterion>"
-  for another criterion of a large event (reduce.LARGE: "n_slipped", n_slipped >= n_large); `rows.scans`
-  holds them by criterion.
+  for another criterion of a large event (`criteria`, a Criterion declared by some statistic: "n_slipped",
+  n_slipped >= n_large, is rupture.py's); `rows.scans` holds them by criterion.
+- its options (`options`, each an Option: name, kind, default, unit, help, range), declared once, by the
+  statistic that reads it; one that reads another's names it in `uses_options`, and the tables of other
+  statistics that its estimate reads in `uses_tables` (checked when the registry loads, and by a test that
+  watches what each estimate reads). analysis/options.py builds from them the options record, the command
+  line's arguments and their checks, and the summary's stored options.
 - its sets (`sets`): the commands that reduce with it, "reduce" (the summary) and "compare" (the friction-law
   comparison, analysis/compare.py); `Layout(of("compare"))` lays out a set.
 - optionally `extra(units, opt, rng)`: {name: array} per point beyond numbers and curves, computed after
@@ -48,6 +53,7 @@ The statistics today (the registry finds a module by its STATISTIC; this list is
     regularity.py         how periodic the large events by rupture length recur (the comparison's)
 """
 import importlib
+import math
 import pkgutil
 from dataclasses import dataclass, field
 from typing import Callable, Optional
@@ -92,10 +98,55 @@ class Curve:
     values: Optional[Callable] = None   # (summed tables, opt, edges) -> the curve, instead of the density
 
 
+LAW = "the friction law's"   # an Option's default that is the friction law's scale (Law.scales.<name>)
+OPTION_KINDS = ("number", "count", "bins")
+
+
+@dataclass(frozen=True)
+class Option:
+    """An option of the reduction, declared once, by the statistic that reads it first (others name it in
+    `uses_options`); analysis/options.py builds from these the options record, the command line's arguments and
+    their checks, the summary's stored options and compare's options.
+
+    kind: "number" (a finite float in [low, high]; in (low, high) if `exclusive`), "count" (an integer in [low,
+    high]) or "bins" ("lo:hi:n" text; the record also holds its edges as <name without _bins>_edges, and the
+    summary stores them as /bins/<that name> instead of an attribute). default: a value, or LAW (the friction
+    law's, Law.scales.<name>); defaults: {command: default} where a command other than reduce ("compare") takes
+    another. The command line's argument is --<name with dashes>."""
+    name: str
+    kind: str
+    default: object
+    unit: str
+    help: str
+    low: float = -math.inf
+    high: float = math.inf
+    exclusive: bool = False
+    defaults: dict = field(default_factory=dict)
+
+    @property
+    def flag(self):
+        return "--" + self.name.replace("_", "-")
+
+    @property
+    def bins(self):
+        """The bins' name of a bins option ("mu" of mu_bins), else ""."""
+        return self.name.removesuffix("_bins") if self.kind == "bins" else ""
+
+
+@dataclass(frozen=True)
+class Criterion:
+    """What makes an event large for the recurrences a statistic needs ("recurrences:<name>"): its `column` at
+    least option `threshold`; the next large event counts when its epicenter lies within option `window` blocks."""
+    name: str
+    column: str
+    threshold: str
+    window: str = "window"
+
+
 @dataclass(frozen=True)
 class Statistic:
     name: str
-    order: int                      # place among the statistics (their tables' columns, numbers, curves)
+    order: int                      # place among the statistics (report lines, numbers, curves)
     needs: tuple = ()               # "recurrences": the engine scans the task's recurrence times for it
     tables: tuple = ()
     numbers: tuple = ()
@@ -108,6 +159,10 @@ class Statistic:
     # opt -> {histogram table: the entries its numbers read}: a resample sums only those (default: all; the
     # others are NaN in the resample's tables, so reading one shows); the estimate of all units has every entry
     drawn: Optional[Callable] = None
+    options: tuple = ()             # the Options it declares
+    uses_options: tuple = ()        # the names of options other statistics declare that it reads
+    uses_tables: tuple = ()         # the tables of other statistics that its estimate reads (checked: registered)
+    criteria: tuple = ()            # the Criteria of a large event it declares (for any statistic's `needs`)
 
 
 def _discover():
@@ -120,10 +175,55 @@ def _discover():
     names = [s.name for s in found]
     if len(set(names)) != len(names):
         raise ImportError(f"analysis.statistics: two statistics share a name ({names})")
+    _check(found)
     return tuple(found)
 
 
+# The engine's own options (analysis/reduce.py: the resampling), which every command that reduces has
+ENGINE_OPTIONS = (
+    Option("bootstrap", "count", 1000, "1", "bootstrap resamples", 1, 10 ** 6),
+    Option("level", "number", 0.95, "1", "interval coverage", 0.0, 1.0, exclusive=True),
+    Option("blocks", "count", 20, "1", "stretches per task, resampled when a point has fewer than 10 seeds",
+           1, 10 ** 6),
+    Option("seed", "count", 0, "1", "seed of the bootstrap; a point's resamples are drawn from it and the point's "
+                                    "parameters", 0, 2 ** 63 - 1),     # stored as an HDF5 int64
+)
+
+
+def _check(found):
+    """What the statistics declare fits together (an ImportError naming the statistic otherwise): every option
+    declared once, of a known kind; every option, table and criterion a statistic uses declared by one."""
+    def fail(statistic, what):
+        raise ImportError(f"analysis/statistics/{statistic.name}.py: {what}")
+    options = {o.name: None for o in ENGINE_OPTIONS}
+    for st in found:
+        for o in st.options:
+            if o.name in options:
+                fail(st, f"option {o.name!r} is declared twice (once is enough: name it in uses_options)")
+            if o.kind not in OPTION_KINDS:
+                fail(st, f"option {o.name!r}: kind {o.kind!r} is none of {OPTION_KINDS}")
+            options[o.name] = st
+    criteria = {c.name: c for st in found for c in st.criteria}
+    for st in found:
+        for name in st.uses_options:
+            if name not in options:
+                fail(st, f"uses option {name!r}, which no statistic declares")
+        for c in st.criteria:
+            for name in (c.threshold, c.window):
+                if name not in options:
+                    fail(st, f"criterion {c.name!r}: option {name!r} is declared by no statistic")
+        for need in st.needs:
+            criterion = need.partition(":")[2] or "mu"
+            if need.startswith("recurrences") and criterion not in criteria:
+                fail(st, f"needs the recurrences of criterion {criterion!r}, which no statistic declares")
+        for table in st.uses_tables:
+            for command in st.sets:
+                if not any(table in (t.name for t in other.tables) for other in found if command in other.sets):
+                    fail(st, f"reads table {table!r}, which no statistic of its set {command!r} declares")
+
+
 STATISTICS = _discover()
+CRITERIA = {c.name: c for st in STATISTICS for c in st.criteria}    # name -> Criterion of a large event
 
 
 def of(name):
@@ -245,7 +345,7 @@ class Rows:
     recurrences closed in this chunk, or None when no statistic asks for them; t_before: the time of the
     task's last inertial event before this chunk (NaN before its first); nu, opt; n_blocks: N, the blocks of
     the chain; last: whether this chunk holds the task's last inertial event (none come after it); scans: the
-    recurrences by criterion of a large event (reduce.LARGE), those the statistics need.
+    recurrences by criterion of a large event (Criterion), those the statistics need.
     """
     part: dict
     inertial: np.ndarray

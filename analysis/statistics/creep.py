@@ -4,7 +4,7 @@ import numpy as np
 
 from ensemble.store import schema
 
-from . import Curve, Number, Statistic, Table
+from . import Curve, Number, Option, Statistic, Table
 
 
 def feed(acc, rows):
@@ -50,4 +50,12 @@ STATISTIC = Statistic(
                   "the creep episodes (/events/kind 1; mu = log10 of the slip creep released)", "1/mu"),
             Curve("creep_duration", "creep_duration", ("creep", "n_creep"), "log10(duration nu)",
                   "the creep episodes (duration in units of the loading time 1/nu)", "1/log10 unit")),
-    feed=feed, estimate=estimate)
+    feed=feed, estimate=estimate, uses_tables=("numbers",),
+    # the default bins: measured at N = 100, b = 8..18.5 (aging law), creep slips reach mu = -11 and durations
+    # 10^-6.4 / nu
+    options=(Option("creep_mu_bins", "bins", "-12:3:75", "log10 model length",
+                    "bins lo:hi:n of the creep episodes' mu = log10(slip) (a negative lo after '=': "
+                    "--creep-mu-bins=-8:2:50)"),
+             Option("creep_duration_bins", "bins", "-7:3:50", "log10(duration nu)",
+                    "bins lo:hi:n of the creep episodes' log10(duration nu), duration in units of the loading "
+                    "time 1/nu")))

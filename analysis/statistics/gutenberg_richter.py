@@ -1,7 +1,8 @@
 """The Gutenberg-Richter exponent of the inertial events above mu = b_cut (Aki's estimator), its standard
 error, and the Kolmogorov-Smirnov distance of the magnitudes from the fitted law."""
 from .. import stats
-from . import Number, Statistic, Table
+from . import LAW, Number, Option, Statistic, Table
+from .magnitude import MAGNITUDE
 
 
 def feed(acc, rows):
@@ -29,4 +30,5 @@ STATISTIC = Statistic(
              Number("gr_b_se", "1",
                     "Shi & Bolt standard error of gr_b (assumes independent events; trust the interval)"),
              Number("ks_gr", "1", "Kolmogorov-Smirnov distance of the binned mu >= b_cut from the fitted GR law")),
-    feed=feed, estimate=estimate)
+    feed=feed, estimate=estimate, uses_options=("mu_bins",), uses_tables=("mu",),
+    options=(Option("b_cut", "number", LAW, "log10 model length", "magnitude cut of the GR b fit", *MAGNITUDE),))

@@ -50,4 +50,4 @@ STATISTIC = Statistic(
                                                 "(onset to the next inertial event's onset)", "mean gap*nu"),
              Number("cv_gap", "1", "coefficient of variation of the whole chain's inter-event times",
                     "CV of gaps")),
-    feed=feed, estimate=estimate)
+    feed=feed, estimate=estimate, uses_tables=("numbers",))

@@ -1,7 +1,9 @@
 """The magnitude distribution R(mu) of the inertial events, and the share of large ones (mu >= mu_c)."""
 import numpy as np
 
-from . import Curve, Number, Statistic, Table
+from . import LAW, Criterion, Curve, Number, Option, Statistic, Table
+
+MAGNITUDE = (-330.0, 310.0)    # log10 of a float64 slip: every magnitude lies here
 
 
 def feed(acc, rows):
@@ -29,4 +31,11 @@ STATISTIC = Statistic(
              Number("n_large", "count", "large events (mu >= mu_c)"),
              Number("fraction_large", "1", "fraction of the events with mu >= mu_c")),
     curves=(Curve("mu", "mu", ("numbers", "n_events"), "mu", "all events", "1/mu"),),
-    feed=feed, estimate=estimate, sets=("reduce", "compare"))
+    feed=feed, estimate=estimate, sets=("reduce", "compare"),
+    options=(Option("mu_bins", "bins", LAW, "log10 model length", "magnitude bins lo:hi:n",
+                    # the comparison's laws have magnitudes on different scales: one axis spans them
+                    defaults={"compare": "-4:7:110"}),
+             Option("mu_c", "number", LAW, "log10 model length", "large-event magnitude", *MAGNITUDE,
+                    # only the share of large events reads it there, which the comparison does not report
+                    defaults={"compare": 4.0})),
+    criteria=(Criterion("mu", "mu", "mu_c"),))

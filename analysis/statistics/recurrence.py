@@ -3,7 +3,7 @@ recurrences and of those starting at an interior event, their means and mode, an
 import numpy as np
 
 from .. import stats
-from . import Curve, Number, Statistic, Table
+from . import LAW, Curve, Number, Option, Statistic, Table
 
 
 def feed(acc, rows):
@@ -77,5 +77,7 @@ STATISTIC = Statistic(
             Curve("tnu_interior", "tnu_interior", ("numbers", "n_rec_int"), "T nu",
                   "the recurrences starting at an interior event (boundary false)", "1/model length")),
     feed=feed, estimate=estimate, extra=peaks,
+    options=(Option("tnu_bins", "bins", LAW, "model length", "T*nu bins lo:hi:n"),
+             Option("window", "count", 10, "blocks", "epicenter window in blocks", 0, 10 ** 9)),
     extra_datasets={"peaks": ("model length", "(points, most peaks, 3): position, lo, hi; NaN rows pad",
                               "recurrence peaks of the T nu histogram, highest first (analysis/stats.py find_peaks)")})

@@ -1,5 +1,5 @@
 """How periodic the large events by rupture length recur (the comparison's, analysis/compare.py): the local
-recurrence times T of the events slipping n >= n_large blocks (reduce.LARGE "n_slipped"; the next such event
+recurrence times T of the events slipping n >= n_large blocks (rupture.py's criterion "n_slipped"; the next such event
 with epicenter within `window` blocks), their coefficient of variation and the sharpness of their peak.
 
 The sharpness scales T by its median, which is no function of sums: the recurrence times are a sample table

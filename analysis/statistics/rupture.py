@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from . import Curve, Number, Statistic, Table
+from . import Criterion, Curve, Number, Option, Statistic, Table
 
 LOG_BIN = 0.2                                             # width of the bins of P(n) in log10 n
 TAU_RANGE = (0.0, 10.0)
@@ -116,4 +116,7 @@ STATISTIC = Statistic(
              Number("tau", "1", "exponent of P(n) ~ n^-tau fitted to n_min <= n < n_large"),
              Number("ks_power_law", "1", "KS distance of the n >= n_min from that law continued to N")),
     curves=(Curve("size", "n_slipped", (), "log10 n", "all events", "1/log10 unit", values=density),),
-    feed=feed, estimate=estimate)
+    feed=feed, estimate=estimate,
+    options=(Option("n_large", "count", 50, "blocks", "large event: at least this many blocks slip", 2, 10 ** 9),
+             Option("n_min", "count", 1, "blocks", "smallest n of the power-law fit", 1, 10 ** 9)),
+    criteria=(Criterion("n_slipped", "n_slipped", "n_large"),))

@@ -29,7 +29,7 @@ import numpy as np
 
 import ensemble.model  # noqa: F401  (first: numba caches the kernel in the package's cache, ensemble/kernel_cache.py)
 
-from . import Number, Statistic, Table
+from . import Number, Option, Statistic, Table
 
 NAME = "seismicity"
 _EDGE = 1e-9    # a region's bound matches a bin edge within this share of the bin's width
@@ -234,7 +234,21 @@ STATISTIC = Statistic(
                                              "active ring)", "quiescence ratio"),
              Number("doughnut_ratio", "1", "the same ratio just before the onset, in [-seis_short, 0)",
                     "doughnut ratio")),
-    feed=feed, estimate=estimate, extra=rate_map, drawn=drawn,
+    feed=feed, estimate=estimate, extra=rate_map, drawn=drawn, uses_options=("mu_c",),
+    # the defaults: for the aging law at b = 20, N = 800 (inter-event times of about 37 T nu, large events
+    # recurring after T nu ~ 530)
+    options=(Option("seis_time_bins", "bins", "-1000:1000:40", "model length",
+                    "bins lo:hi:n of the time T*nu from a mainshock's onset, negative before it, of the seismicity "
+                    "around mainshocks (mu >= mu_c; a negative lo after '=')"),
+             Option("seis_distance_bins", "bins", "0:40:20", "blocks",
+                    "bins lo:hi:n of the distance from a mainshock's epicenter, blocks"),
+             Option("seis_near", "number", 2.0, "blocks", "its epicentral neighbourhood: distance < this",
+                    0.0, 1e9),
+             Option("seis_ring", "number", 10.0, "blocks", "its ring: from --seis-near to this", 0.0, 1e9),
+             Option("seis_short", "number", 50.0, "model length",
+                    "its 'just before' and 'just after' the onset, T*nu", 0.0, 1e300),
+             Option("seis_long", "number", 500.0, "model length",
+                    "its 'some time before': from -this to --seis-short, T*nu", 0.0, 1e300)),
     extra_datasets={"seismicity_rate": (RATE, "(points, seis_time bins, seis_distance bins)",
                                         "events per mainshock per block per unit T nu at (time from the mainshock's "
                                         "onset, distance from its epicenter); NaN where nothing was exposed")})
