@@ -165,7 +165,8 @@ def test_good_numbers_pass_and_are_converted(files, tmp_path, capsys):
     assert (args.mu_c, args.level, args.seed, args.window, args.bootstrap) == (3.5, 0.9, 2 ** 63 - 1, 0, None)
     # the options record: what was given, converted, and the declared defaults (the law's where so declared)
     opt = options.make(scales=laws.get("aging").scales, **options.given(args))
-    assert (opt.mu_c, opt.level, opt.seed, opt.window, opt.bootstrap, opt.b_cut) == (3.5, 0.9, 2 ** 63 - 1, 0, 1000, 3.0)
+    assert (opt.mu_c, opt.level, opt.seed, opt.window, opt.bootstrap, opt.b_cut) == (3.5, 0.9, 2 ** 63 - 1, 0, 1000,
+                                                                                    3.0)
     assert len(opt.tnu_edges) == 1000001 and list(opt.mu_edges[:2]) == [0.0, 0.1]
     assert cli.main(["reduce", str(files / "cat.h5"), "-o", str(tmp_path / "s.h5"), "--mu-c", "3.5",
                      "--bootstrap", "5", "--seed", str(2 ** 63 - 1)]) == 0
