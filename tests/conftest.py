@@ -41,6 +41,7 @@ QUICK = {
     "test_intervals.py": ["test_every_statistic_is_the_same_whatever_the_chunks"],
     "test_seismicity.py": ["test_a_hand_built_chain_gives_its_known_counts_and_exposures"],
     "test_new_statistic.py": ["test_a_statistic_is_one_file"],
+    "test_statistic_contract.py": ["test_every_statistic_touches_only_what_it_declares"],
     "test_summary_identity.py": ["test_a_reduction_gives_the_committed_summary"],
     "test_slip_law.py": ["test_two_blocks_at_the_paper_rate_alternate_without_small_events"],
     "test_creep_reference.py": ["test_quasi_static_creep_is_stable_exactly_while_its_matrix_is_positive_definite"],

@@ -1,0 +1,117 @@
+"""A statistic declares what it reads and writes (analysis/statistics/__init__.py), and this holds it to that.
+
+Every statistic of every set is fed the committed catalog of tests/test_summary_identity.py (both sides: the
+inertial events at b = 20 and the creep episodes at b = 15) and then estimated, through tables and options
+that watch what it touches: its feed writes only its own tables, its estimate (and its extras) reads only
+its own tables and those it names in `uses_tables`, and both read only the options it declares, those it
+names in `uses_options`, those of the criteria whose recurrences it needs, and the engine's. A statistic
+that reads what it does not declare would break when the one that declares it leaves its set, or change its
+numbers when that one's option is set; here it fails by name.
+"""
+import numpy as np
+import pytest
+
+from analysis import options, reduce
+from analysis.statistics import CRITERIA, ENGINE_OPTIONS, Layout, Tables, of
+from ensemble.model import laws
+from ensemble.store import reader, schema
+
+from .test_summary_identity import CATALOG, gunzip
+
+COMMANDS = ("reduce", "compare")
+
+
+class Watched:
+    """The options record, noting each option read."""
+
+    def __init__(self, opt):
+        self.opt, self.read = opt, set()
+
+    def __getattr__(self, name):
+        value = getattr(self.opt, name)
+        if name != "chunk":
+            self.read.add(name.removesuffix("_edges") + "_bins" if name.endswith("_edges") else name)
+        return value
+
+
+class WatchedTables(Tables):
+    """Tables noting each table read or written (by name, through every way in: [], column, add, count, append)."""
+
+    def __init__(self, layout, arrays, seen):
+        super().__init__(layout, arrays)
+        self.seen = seen
+
+    def __getitem__(self, name):
+        self.seen.add(name)
+        return super().__getitem__(name)
+
+
+def allowed_options(st):
+    names = {o.name for o in st.options} | set(st.uses_options) | {o.name for o in ENGINE_OPTIONS}
+    for need in st.needs:
+        if need.startswith("recurrences"):
+            c = CRITERIA[need.partition(":")[2] or "mu"]
+            names |= {c.threshold, c.window}
+    return names
+
+
+@pytest.fixture(scope="module")
+def catalog(tmp_path_factory):
+    return gunzip(CATALOG, tmp_path_factory.mktemp("contract") / "catalog.h5")
+
+
+@pytest.mark.parametrize("command", COMMANDS)
+def test_every_statistic_touches_only_what_it_declares(catalog, command):
+    opt = options.make(command, laws.get("aging").scales)
+    layout = Layout(of(command))
+    with reader.Reader(str(catalog)) as cat:
+        tasks = cat.tasks
+        parts = [next(iter(cat.task_events(k, 1 << 20))) for k in range(len(tasks["N"]))]
+    kinds = set()
+    for k, part in enumerate(parts):      # b = 20 (inertial events) and b = 15 (creep episodes beside them)
+        n_blocks, nu = int(tasks["N"][k]), float(tasks["nu"][k])
+        kinds |= set(np.unique(part["kind"]))
+        edges = reduce.bin_edges(opt, n_blocks, layout)
+        tables = reduce.reduce_task(iter([part]), int(np.count_nonzero(part["kind"] == schema.KIND_EVENT)), nu,
+                                    n_blocks, opt, len(part["t"]), layout)
+        for st in layout.statistics:
+            own, allowed = {t.name for t in st.tables}, allowed_options(st)
+            # feed: the task's rows as one chunk, into fresh tables
+            seen, watch = set(), Watched(opt)
+            st.feed(WatchedTables(layout, dict(layout.empty(opt.blocks, edges)), seen),
+                    _rows(part, opt.blocks, nu, watch, n_blocks, layout, opt))
+            assert seen <= own, f"{st.name}'s feed touches the tables {sorted(seen - own)} of others"
+            assert watch.read <= allowed, \
+                f"{st.name}'s feed reads the undeclared options {sorted(watch.read - allowed)}"
+            # estimate and extras: on the task's tables (summed over its stretches; the extras take them as units)
+            seen, watch = set(), Watched(opt)
+            summed = {name: np.concatenate(v) if name in layout.samples else v.sum(axis=0)
+                      for name, v in tables.items()}
+            st.estimate(WatchedTables(layout, summed, seen), watch)
+            if st.extra is not None:
+                st.extra(WatchedTables(layout, dict(tables), seen), watch, np.random.default_rng(0))
+            reads = own | set(st.uses_tables)
+            assert seen <= reads, \
+                f"{st.name}'s estimate reads the tables {sorted(seen - reads)}: name them in uses_tables"
+            assert watch.read <= allowed, \
+                f"{st.name}'s estimate reads the undeclared options {sorted(watch.read - allowed)}"
+    assert kinds == {schema.KIND_EVENT, schema.KIND_CREEP} and len(layout.statistics) >= 3
+
+
+def _rows(part, blocks, nu, opt, n_blocks, layout, real_opt):
+    """The Rows of one chunk, as reduce_task hands them to every statistic (its recurrences included)."""
+    from analysis.recurrence import RecurrenceScanner
+    from analysis.statistics import Rows
+    inertial = part["kind"] == schema.KIND_EVENT
+    creep = part["kind"] == schema.KIND_CREEP
+    ev = {name: column[inertial] for name, column in part.items()}
+    written = int(inertial.sum())
+    block = (np.arange(written) * blocks) // max(written, 1)
+    scans = {}
+    for c in reduce._criteria(layout):
+        scanner = RecurrenceScanner(n_blocks, float(getattr(real_opt, c.threshold)), getattr(real_opt, c.window))
+        src, T, interior = scanner.feed(ev["t"], ev["epicenter"], np.asarray(ev[c.column], dtype=float),
+                                        ev["boundary"])
+        scans[c.name] = ((src * blocks) // max(written, 1), T * nu, interior)
+    creep_block = np.minimum(((np.cumsum(inertial) - inertial)[creep] * blocks) // max(written, 1), blocks - 1)
+    return Rows(part, inertial, ev, block, creep, creep_block, scans.get("mu"), np.nan, nu, opt, n_blocks, True, scans)
