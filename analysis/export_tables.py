@@ -17,6 +17,8 @@ from ensemble.store import reader, schema
 from ensemble.store.errors import CatalogError
 
 from . import summary
+from .statistics import holds
+from .statistics.seismicity import STATISTIC as SEISMICITY
 
 TITLES = {   # table -> what its rows are (said in its file's header)
     "events": "one row per committed event",
@@ -213,7 +215,7 @@ def seismicity_table(s):
             "background rate is in numbers.csv",),
     }
     values = {name: np.zeros(0) for name in columns}
-    if summary.has_seismicity(s):
+    if holds(s, SEISMICITY):
         rate, te, de = s["points/seismicity_rate"], s["bins/seis_time"], s["bins/seis_distance"]
         point, j, k = (a.ravel() for a in np.meshgrid(np.arange(len(rate)), np.arange(len(te) - 1),
                                                        np.arange(len(de) - 1), indexing="ij"))

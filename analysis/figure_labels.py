@@ -3,9 +3,12 @@ that differ between them), and the figure's title (events per point, mu_c, windo
 and a line for each partial reduction)."""
 import os
 
+import numpy as np
+
 from . import summary as summary_file
 from .reduce import PARAMS
 from .report import count_text, level_text, partial_text, size_text
+from .statistics.creep import creeping
 
 def summary_name(path):
     """A summary's name in labels and titles: its file name without .summary.h5 (or .h5)."""
@@ -70,8 +73,7 @@ def _units(s):
 
 def _creep_sizes(summaries):
     """The creep episodes per point, over the points that have any: "15380-16492 creep episodes per point"."""
-    counts = [c for s in summaries if summary_file.has_creep(s)
-              for c, creeps in zip(s["points/numbers/n_creep"][:, 0], summary_file.creeping(s)) if creeps]
+    counts = [s["points/numbers/n_creep"][i, 0] for s in summaries for i in np.flatnonzero(creeping(s))]
     if not counts:
         return "no creep episodes"      # (the creep figure then stops with its one-line error)
     lo, hi = min(counts), max(counts)

@@ -25,6 +25,10 @@ from .drawing import (DPI, FONT, OPEN, OPEN_NOTE, band, grid, layout, legend_col
                       place_inset)
 from .figure_labels import legend_labels, points_of, summary_name, title_text
 from .report import count_text
+from .statistics import holds
+from .statistics.creep import STATISTIC as CREEP
+from .statistics.creep import creeping
+from .statistics.seismicity import STATISTIC as SEISMICITY
 from .stats import centers
 
 
@@ -133,7 +137,7 @@ def creep(summaries, fig, keys, labels, names):
     points = points_of(summaries)
     colors = palette(len(points))
     shown = [(s, i, label, color) for (s, i), label, color in zip(points, labels, colors)
-             if summary_file.creeping(s)[i]]
+             if creeping(s)[i]]
     if not shown:
         raise summary_file.SummaryError(
             f"{', '.join(map(str, names))}: no creep episodes in any point, no creep figure (a summary of "
@@ -153,7 +157,7 @@ def creep(summaries, fig, keys, labels, names):
     ax = axes[2]
     series = {}
     for s, i in points:
-        if summary_file.has_creep(s):
+        if holds(s, CREEP):
             group = ", ".join(f"{k} = {s[f'points/{k}'][i]:g}" for k in others)
             series.setdefault(group, []).append((s[f"points/{x_key}"][i], *s["points/numbers/aseismic_fraction"][i]))
     for n, (group, rows) in enumerate(series.items()):
@@ -182,7 +186,7 @@ def seismicity(summaries, fig, labels, names):
     """One map per point (the grid of the recurrence panels): log10 of the rate at (distance, time) over the
     point's background rate, white where nothing was exposed; the numbers' regions outlined (near and ring,
     just before and after, some time before)."""
-    points = [(s, i, label) for (s, i), label in zip(points_of(summaries), labels) if summary_file.has_seismicity(s)]
+    points = [(s, i, label) for (s, i), label in zip(points_of(summaries), labels) if holds(s, SEISMICITY)]
     if not points:
         raise summary_file.SummaryError(
             f"{', '.join(map(str, names))}: no seismicity around large events (a summary before format 5 did "

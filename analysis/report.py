@@ -2,19 +2,11 @@
 import numpy as np
 
 from . import reduce, summary
-from .reduce import LAYOUT, NUMBERS, PARAMS
+from .reduce import LAYOUT, PARAMS
+from .statistics import holds, number_lines
 
-CREEP_NUMBERS = tuple(n.name for s in LAYOUT.statistics if s.name == "creep" for n in s.numbers)   # the slow side's
-
-LABELS = {
-    "n_events": "events", "n_large": "large", "fraction_large": "frac(mu>=mu_c)",
-    "n_recurrences": "recurrences", "mean_tnu": "mean T*nu", "mode_tnu": "mode T*nu",
-    "mean_tnu_interior": "mean T*nu (int.)", "gr_b": "GR b", "gr_b_se": "GR b std. error",
-    "ks_gr": "KS to GR",
-    "n_creep": "creep episodes", "creep_share": "creep share (rows)", "taken_over_share": "taken over",
-    "aseismic_fraction": "aseismic fraction",
-    **{n.name: n.label for n in LAYOUT.numbers if n.label},   # the statistics' own labels
-}
+# every number's label in the report (the statistics': Number.label, else its name)
+LABELS = {n.name: n.label or n.name for n in LAYOUT.numbers}
 
 
 def level_text(level):
@@ -39,14 +31,6 @@ def point_label(s, i, keys=None, law=False):
 def unreliable(s, i):
     """A warning if point i's intervals rest on fewer than MIN_UNITS resampling units, else ''."""
     return reduce.unreliable(int(s["points/units"][i]), s["points/method"][i])
-
-
-def _fmt(est, lo, hi):
-    if not np.isfinite(est):
-        return "-"
-    if np.isfinite(lo):
-        return f"{est:.4g} [{lo:.4g}, {hi:.4g}]"
-    return f"{est:.4g}"
 
 
 def count_text(n):
@@ -87,27 +71,17 @@ def partial_text(s):
     return str(s["attrs"].get("partial", ""))
 
 
-def creep_lines(s, i):
-    """The slow side of point i: its creep numbers with intervals, one line saying it has no creep
-    episodes, or nothing for a summary that did not reduce them (format 2)."""
-    if not summary.has_creep(s):
-        return []
-    if not summary.creeping(s)[i]:
-        return [f"    {'creep episodes':>18s}  none"]
-    return [f"    {LABELS[name]:>18s}  {_fmt(*s[f'points/numbers/{name}'][i])}" for name in CREEP_NUMBERS]
-
-
 def table(s):
-    """The report; a partial reduction says so on its first line."""
+    """The report: the summary's line, each statistic's lines about the whole summary, then per point its line and
+    each statistic's lines (Statistic.report; by default its numbers with their intervals), in the statistics'
+    order, of those the summary holds. A partial reduction says so on its first line."""
     a = s["attrs"]
+    held = [st for st in LAYOUT.statistics if holds(s, st)]
     lines = [partial_text(s)] if partial_text(s) else []
     lines += [f"summary of {a['catalog']}: mu_c = {a['mu_c']}, window = {a['window']} blocks, "
               f"GR b above mu = {a['b_cut']}, {level_text(a['level'])} intervals from "
               f"{a['bootstrap']} bootstrap resamples"]
-    if summary.has_seismicity(s):
-        lines.append(f"seismicity around mainshocks (mu >= mu_c): near = distance < {a['seis_near']:g} blocks, ring = "
-                     f"up to {a['seis_ring']:g}; just before/after = {a['seis_short']:g} T*nu, some time before = "
-                     f"from -{a['seis_long']:g}; rates per mainshock per block per T*nu")
+    lines += [line for st in held if st.report_header is not None for line in st.report_header(s)]
     lines.append("")
     for i in range(len(s["points/N"])):
         if "points/region" in s:    # a regional reduction (analysis/region.py)
@@ -119,12 +93,8 @@ def table(s):
                          f"  (resampling {s['points/method'][i]}, {s['points/units'][i]} units)")
         if unreliable(s, i):
             lines.append(f"    WARNING: {unreliable(s, i)}")
-        for name in NUMBERS:
-            if name not in CREEP_NUMBERS and f"points/numbers/{name}" in s:   # (older summaries lack newer ones)
-                est, lo, hi = s[f"points/numbers/{name}"][i]
-                lines.append(f"    {LABELS[name]:>18s}  {_fmt(est, lo, hi)}")
-        peaks = [row for row in s["points/peaks"][i] if np.isfinite(row[0])]
-        lines.append(f"    {'T*nu peaks':>18s}  " + ("; ".join(_fmt(*row) for row in peaks) or "-"))
-        lines += creep_lines(s, i)
+        for st in LAYOUT.statistics:
+            # (a statistic a summary holds only in part, an older format's, shows the numbers it has)
+            lines += st.report(s, i) if st.report is not None and holds(s, st) else number_lines(st, s, i)
         lines.append("")
     return "\n".join(lines)

@@ -44,7 +44,7 @@ existed are known by their attributes and groups. Format 3 adds the creep episod
 /bins/creep_*, /per_task/creep*, /points/creep_*, the creep statistic's numbers). Format 2
 (GR b and its standard error, 9 per-task sums, peaks by prominence; catalogs, configs, partial and
 the /tasks columns catalog, catalog_task and catalog_point) still reads, without those datasets
-(`has_creep` is False: its creep episodes, if any, were not reduced); older ones do not: reduce
+(it holds no creep statistic, statistics.holds: its creep episodes, if any, were not reduced); older ones do not: reduce
 the catalogs again.
 
 Format 6 adds checksums: every dataset a `crc32` attribute (CRC-32 of its name and values), the file an
@@ -356,20 +356,3 @@ def point_units(s, i, merge=1):
             raise ValueError(f"{len(s['bins/mu']) - 1} bins of mu do not merge by {merge}")
         counts = counts.reshape(*counts.shape[:-1], len(edges) - 1, merge).sum(axis=-1)
     return edges, counts, events
-
-
-def has_creep(s):
-    """Whether summary `s` (read) holds the creep statistics (format 3; format 2 reduced none)."""
-    return "points/numbers/n_creep" in s
-
-
-def has_seismicity(s):
-    """Whether summary `s` (read) holds the seismicity around large events (format 5)."""
-    return "points/seismicity_rate" in s
-
-
-def creeping(s):
-    """(points,) bool: the points with creep episodes (none in a summary without the creep statistics)."""
-    if not has_creep(s):
-        return np.zeros(len(s["points/N"]), dtype=bool)
-    return s["points/numbers/n_creep"][:, 0] > 0

@@ -14,12 +14,15 @@ import numpy as np
 import pytest
 
 from analysis import export, plot, report, summary
+from analysis.statistics import creep as creep_statistic
+from analysis.statistics import holds
 from ensemble.store import reader, schema
 
 from .conftest import ROOT, run_cli, write_config
 from .processes import run_bounded
 from .test_figures import covered, crowded, small_text
 
+CREEP_NUMBERS = tuple(n.name for n in creep_statistic.STATISTIC.numbers)   # the slow side's
 CREEPING, STIFF = 14.0, 20.0        # model.b of the two points: below and above the block stiffness 19
 SEEDS, EVENTS = 2, 400
 NARROW_MU = "0:0.8:16"               # creep mu bins that leave episodes out on both sides
@@ -78,7 +81,7 @@ def test_aseismic_fraction_and_shares_are_the_catalogs(reduced):
         np.testing.assert_allclose(per_task[g, 2:], [ev["slip"][rows & creep].sum(), ev["slip"][rows & inertial].sum()],
                                    rtol=1e-12)
     print(f"\naseismic fraction at b = {CREEPING:g}, N = 50:",
-          report.creep_lines(s, point_of(s, CREEPING))[-1].strip())
+          creep_statistic.report(s, point_of(s, CREEPING))[-1].strip())
 
 
 def test_densities_integrate_to_the_share_of_episodes_in_their_bins(reduced):
@@ -115,11 +118,11 @@ def test_a_point_above_the_block_stiffness_has_no_creep(reduced):
     np.testing.assert_array_equal(s["points/numbers/aseismic_fraction"][i], [0, 0, 0])
     assert np.isnan(s["points/numbers/taken_over_share"][i]).all()
     assert np.isnan(s["points/creep_mu_density"][i]).all() and np.isnan(s["points/creep_duration_density"][i]).all()
-    assert list(summary.creeping(s)) == [b == CREEPING for b in s["points/b"]]
+    assert list(creep_statistic.creeping(s)) == [b == CREEPING for b in s["points/b"]]
     text = report.table(s).split("\npoint ")[1:]
     stiff, creeping = text[i], text[point_of(s, CREEPING)]
     assert "creep episodes  none" in stiff and "aseismic" not in stiff
-    for name in report.CREEP_NUMBERS:
+    for name in CREEP_NUMBERS:
         line = next(line for line in creeping.splitlines() if report.LABELS[name] in line)
         assert "[" in line, line      # with its interval
 
@@ -128,7 +131,7 @@ def test_bootstrap_intervals_contain_the_estimates(reduced):
     d, _, _ = reduced
     s = summary.read(d / "sum.h5")
     i = point_of(s, CREEPING)
-    for name in report.CREEP_NUMBERS:
+    for name in CREEP_NUMBERS:
         est, lo, hi = s[f"points/numbers/{name}"][i]
         assert lo <= est <= hi, name
     est, lo, hi = s["points/numbers/aseismic_fraction"][i]
@@ -143,7 +146,7 @@ def test_export_writes_the_creep_columns_and_curves_with_their_meanings(reduced,
     numbers = export.numbers(d / "sum.h5")
     columns = export.columns(d / "sum.h5", "numbers")
     s = summary.read(d / "sum.h5")
-    for name in report.CREEP_NUMBERS:
+    for name in CREEP_NUMBERS:
         for j, suffix in enumerate(("", "_lo", "_hi")):
             np.testing.assert_array_equal(numbers[name + suffix], s[f"points/numbers/{name}"][:, j])
             assert columns[name + suffix][1].startswith(summary.NUMBER_MEANINGS[name][1])
@@ -186,7 +189,7 @@ def test_a_summary_of_format_2_reads_reports_exports_without_creep(tmp_path):
     nothing, the export no creep column, and --figure creep is a one-line error (exit 1)."""
     s = summary.read(OLD)
     assert s["attrs"]["format"] == "bk-summary-2" != summary.FORMAT
-    assert not summary.has_creep(s) and not summary.creeping(s).any()
+    assert not holds(s, creep_statistic.STATISTIC) and not creep_statistic.creeping(s).any()
     assert "creep" not in report.table(s)
     assert not any("creep" in name or "aseismic" in name for name in export.numbers(OLD).dtype.names)
     assert set(export.curves(OLD)["curve"]) == {"mu", "tnu", "tnu_interior"}

@@ -323,16 +323,18 @@ def test_report_states_every_number_and_the_level(references, summaries):
         # 7 stretches < reduce.MIN_UNITS: the intervals are flagged, saying what is needed
         assert lines[1].strip().startswith("WARNING: intervals unreliable: 7 resampling units (blocks); "
                                            "at least 10 are needed: 10 seeds (run.seeds), or 10 stretches"), lines[1]
-        lines = [lines[0]] + lines[2:]
-        shown = ref.NUMBERS + ref.SEISMICITY_NUMBERS      # every number but the creep's, in order
-        for name, line in zip(shown, lines[1:]):
+        # each line: its label, two spaces, its value (labels and values hold single spaces only)
+        printed = dict(line.strip().split("  ", 1) for line in lines[2:] if line.strip())
+        for name in ref.NUMBERS + ref.SEISMICITY_NUMBERS:      # every number (the creep's: test_creep_statistics)
             est, lo, hi = exp[f"points/numbers/{name}"][i]
-            printed = line.split(report.LABELS[name], 1)[1]
             if math.isfinite(est):
-                same(printed, [est, lo, hi])
+                same(printed[report.LABELS[name]], [est, lo, hi])
             else:
-                assert printed.strip() == "-"
-        peaks = lines[1 + len(shown)].split("T*nu peaks", 1)[1]
+                assert printed[report.LABELS[name]].strip() == "-"
+        # the statistics' lines in their order: the recurrence peaks after the recurrence numbers
+        labels = list(printed)
+        assert labels.index("T*nu peaks") == labels.index(report.LABELS["mean_tnu_interior"]) + 1, labels
+        peaks = printed["T*nu peaks"]
         rows = [row for row in exp["points/peaks"][i] if math.isfinite(row[0])]
         assert (peaks.strip() == "-") == (not rows)
         for part, row in zip(peaks.split(";"), rows):

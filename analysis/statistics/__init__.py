@@ -163,6 +163,37 @@ class Statistic:
     uses_options: tuple = ()        # the names of options other statistics declare that it reads
     uses_tables: tuple = ()         # the tables of other statistics that its estimate reads (checked: registered)
     criteria: tuple = ()            # the Criteria of a large event it declares (for any statistic's `needs`)
+    # `analysis report`: its lines for point i of a summary (s, i) -> [lines] (default: number_lines, each number
+    # with its interval), and its lines under the report's first, about the whole summary (s) -> [lines]
+    report: Optional[Callable] = None
+    report_header: Optional[Callable] = None
+
+
+def holds(s, statistic):
+    """Whether summary `s` (as read) holds `statistic`: its numbers and extras (a summary of an older format lacks
+    the statistics that came after it, and shows none of their lines or figures)."""
+    return (all(f"points/numbers/{n.name}" in s for n in statistic.numbers)
+            and all(f"points/{name}" in s for name in statistic.extra_datasets))
+
+
+def number_text(est, lo, hi):
+    """A number as the report prints it: "0.84 [0.77, 0.91]", the estimate alone without an interval, "-" if NaN."""
+    if not np.isfinite(est):
+        return "-"
+    if np.isfinite(lo):
+        return f"{est:.4g} [{lo:.4g}, {hi:.4g}]"
+    return f"{est:.4g}"
+
+
+def report_line(label, text):
+    """One line of a point in the report: the label right-aligned, then the value."""
+    return f"    {label:>18s}  {text}"
+
+
+def number_lines(statistic, s, i):
+    """The report's lines of point i for each number of `statistic` the summary holds, with its interval."""
+    return [report_line(n.label or n.name, number_text(*s[f"points/numbers/{n.name}"][i])) for n in statistic.numbers
+            if f"points/numbers/{n.name}" in s]
 
 
 def _discover():

@@ -4,7 +4,7 @@ import numpy as np
 
 from ensemble.store import schema
 
-from . import Curve, Number, Option, Statistic, Table
+from . import Curve, Number, Option, Statistic, Table, holds, number_lines, report_line
 
 
 def feed(acc, rows):
@@ -29,6 +29,23 @@ def estimate(u, opt):
         return [n, n / (n + u.column("numbers", "n_events")), taken / n, slow / (slow + fast)]
 
 
+def creeping(s):
+    """(points,) bool: the points of summary `s` (as read) with creep episodes (none in a summary without them)."""
+    if not holds(s, STATISTIC):
+        return np.zeros(len(s["points/N"]), dtype=bool)
+    return s["points/numbers/n_creep"][:, 0] > 0
+
+
+def report(s, i):
+    """Point i's slow side: its numbers with intervals, one line saying it has no creep episodes, or nothing for a
+    summary that did not reduce them (format 2)."""
+    if not holds(s, STATISTIC):
+        return []
+    if not creeping(s)[i]:
+        return [report_line("creep episodes", "none")]
+    return number_lines(STATISTIC, s, i)
+
+
 STATISTIC = Statistic(
     "creep", 40,
     tables=(Table("creep_mu", "count",
@@ -39,18 +56,20 @@ STATISTIC = Statistic(
             Table("creep", "count or sum",
                   "counts and sums of the slow side (sum_slip_events: the inertial events' slip)",
                   columns=("n_creep", "n_creep_taken_over", "sum_slip_creep", "sum_slip_events"))),
-    numbers=(Number("n_creep", "count", "creep episodes (/events/kind 1, below the block stiffness 1 + 2 l^2)"),
-             Number("creep_share", "1", "share of the rows that are creep episodes: n_creep / (n_creep + n_events)"),
+    numbers=(Number("n_creep", "count", "creep episodes (/events/kind 1, below the block stiffness 1 + 2 l^2)",
+                    "creep episodes"),
+             Number("creep_share", "1", "share of the rows that are creep episodes: n_creep / (n_creep + n_events)",
+                    "creep share (rows)"),
              Number("taken_over_share", "1", "share of the creep episodes taken over by an inertial event "
-                                             "(/events/ending 2); NaN without creep episodes"),
+                                             "(/events/ending 2); NaN without creep episodes", "taken over"),
              Number("aseismic_fraction", "1", "aseismic slip fraction (1 - seismic coupling): the slip of the creep "
                                               "episodes over all slip (creep episodes and inertial events) after the "
-                                              "transient")),
+                                              "transient", "aseismic fraction")),
     curves=(Curve("creep_mu", "creep_mu", ("creep", "n_creep"), "mu",
                   "the creep episodes (/events/kind 1; mu = log10 of the slip creep released)", "1/mu"),
             Curve("creep_duration", "creep_duration", ("creep", "n_creep"), "log10(duration nu)",
                   "the creep episodes (duration in units of the loading time 1/nu)", "1/log10 unit")),
-    feed=feed, estimate=estimate, uses_tables=("numbers",),
+    feed=feed, estimate=estimate, uses_tables=("numbers",), report=report,
     # the default bins: measured at N = 100, b = 8..18.5 (aging law), creep slips reach mu = -11 and durations
     # 10^-6.4 / nu
     options=(Option("creep_mu_bins", "bins", "-12:3:75", "log10 model length",

@@ -3,7 +3,7 @@ recurrences and of those starting at an interior event, their means and mode, an
 import numpy as np
 
 from .. import stats
-from . import LAW, Curve, Number, Option, Statistic, Table
+from . import LAW, Curve, Number, Option, Statistic, Table, number_lines, number_text, report_line
 
 
 def feed(acc, rows):
@@ -63,20 +63,29 @@ def peaks(units, opt, rng):
     return {"peaks": np.array(rows)}
 
 
+def report(s, i):
+    """Its numbers, then the significant peaks of point i, each with its interval."""
+    peaks = [row for row in s["points/peaks"][i] if np.isfinite(row[0])]
+    return number_lines(STATISTIC, s, i) + [report_line("T*nu peaks", "; ".join(number_text(*row) for row in peaks)
+                                                        or "-")]
+
+
 STATISTIC = Statistic(
     "recurrence", 20, needs=("recurrences",),
     tables=(Table("tnu", "count", "recurrences per T nu bin, per task and stretch of their starting event", bins="tnu"),
             Table("tnu_interior", "count", "the same for the recurrences starting at an interior event", bins="tnu"),
             Table("numbers", "count or sum", "counts and sums of the recurrences",
                   columns=("n_rec", "sum_tnu", "n_rec_int", "sum_tnu_int"))),
-    numbers=(Number("n_recurrences", "count", "recurrences: large events closed by a later one within `window` blocks"),
-             Number("mean_tnu", "model length", "mean T nu of all recurrences"),
-             Number("mode_tnu", "model length", "centre of the highest T nu bin"),
-             Number("mean_tnu_interior", "model length", "mean T nu of the recurrences starting at an interior event")),
+    numbers=(Number("n_recurrences", "count", "recurrences: large events closed by a later one within `window` blocks",
+                    "recurrences"),
+             Number("mean_tnu", "model length", "mean T nu of all recurrences", "mean T*nu"),
+             Number("mode_tnu", "model length", "centre of the highest T nu bin", "mode T*nu"),
+             Number("mean_tnu_interior", "model length", "mean T nu of the recurrences starting at an interior event",
+                    "mean T*nu (int.)")),
     curves=(Curve("tnu", "tnu", ("numbers", "n_rec"), "T nu", "all recurrences", "1/model length"),
             Curve("tnu_interior", "tnu_interior", ("numbers", "n_rec_int"), "T nu",
                   "the recurrences starting at an interior event (boundary false)", "1/model length")),
-    feed=feed, estimate=estimate, extra=peaks,
+    feed=feed, estimate=estimate, extra=peaks, report=report,
     options=(Option("tnu_bins", "bins", LAW, "model length", "T*nu bins lo:hi:n"),
              Option("window", "count", 10, "blocks", "epicenter window in blocks", 0, 10 ** 9)),
     extra_datasets={"peaks": ("model length", "(points, most peaks, 3): position, lo, hi; NaN rows pad",

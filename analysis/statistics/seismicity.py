@@ -210,6 +210,14 @@ def rate_map(units, opt, rng):
         return {"seismicity_rate": np.where(exposure > 0, counts / exposure, np.nan)}
 
 
+def report_header(s):
+    """The regions of the numbers, once for the summary."""
+    a = s["attrs"]
+    return [f"seismicity around mainshocks (mu >= mu_c): near = distance < {a['seis_near']:g} blocks, ring = up to "
+            f"{a['seis_ring']:g}; just before/after = {a['seis_short']:g} T*nu, some time before = from "
+            f"-{a['seis_long']:g}; rates per mainshock per block per T*nu"]
+
+
 RATE = "1/(block model length)"   # events per mainshock per block per unit T nu
 STATISTIC = Statistic(
     NAME, 60,
@@ -234,7 +242,7 @@ STATISTIC = Statistic(
                                              "active ring)", "quiescence ratio"),
              Number("doughnut_ratio", "1", "the same ratio just before the onset, in [-seis_short, 0)",
                     "doughnut ratio")),
-    feed=feed, estimate=estimate, extra=rate_map, drawn=drawn, uses_options=("mu_c",),
+    feed=feed, estimate=estimate, extra=rate_map, drawn=drawn, uses_options=("mu_c",), report_header=report_header,
     # the defaults: for the aging law at b = 20, N = 800 (inter-event times of about 37 T nu, large events
     # recurring after T nu ~ 530)
     options=(Option("seis_time_bins", "bins", "-1000:1000:40", "model length",
