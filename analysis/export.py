@@ -7,8 +7,8 @@
     tk = export.tasks("my.h5")                   # one row per task: parameters, counts, status, ...
     cu = export.curves("my.summary.h5")          # one row per point, curve and bin: density, lo, hi
     nb = export.numbers("my.summary.h5")         # one row per point: parameters, every number, lo, hi
-    pk = export.peaks("my.summary.h5")           # one row per recurrence peak of a point
-    sm = export.seismicity("my.summary.h5")      # one row per point, time bin and distance bin of its map
+    pk = export.table("my.summary.h5", "peaks")  # a statistic's own table: one row per recurrence peak of a point
+    sm = export.table("my.summary.h5", "seismicity")   # one row per point, time bin and distance bin of its map
     df = export.numbers("my.summary.h5", frame=True)   # a pandas DataFrame (pandas is optional)
     export.columns("my.h5", "events")            # {column: (unit, meaning)}
     export.write("my.h5", "tables/")             # what `python -m analysis export my.h5 -o tables/` does
@@ -50,8 +50,8 @@ from ensemble.store.errors import CatalogError
 
 from . import merge, summary
 from .export_csv import write_csv
-from .export_tables import (SUMMARY_SETTINGS, curves_table, events_table, numbers_table, one_line, peaks_table,
-                            seismicity_table, tasks_table, whole)
+from .export_tables import (STATISTIC_EXPORTS, SUMMARY_SETTINGS, curves_table, events_table, numbers_table, one_line,
+                            statistic_table, tasks_table, whole)
 
 
 def _result(arr, frame):
@@ -94,19 +94,15 @@ def numbers(path, frame=False):
     return _result(numbers_table(summary.read(path)).parts[0], frame)
 
 
-def peaks(path, frame=False):
-    """The recurrence peaks of a summary: one row per peak of a point, highest first."""
-    return _result(peaks_table(summary.read(path)).parts[0], frame)
-
-
-def seismicity(path, frame=False):
-    """The seismicity around the large events of a summary: one row per point, time bin and distance bin,
-    with the rate of events per mainshock per block per unit T nu (none before summary format 5)."""
-    return _result(seismicity_table(summary.read(path)).parts[0], frame)
+def table(path, name, frame=False):
+    """Any table of a catalog or a summary by its name (CATALOG_TABLES, SUMMARY_TABLES: among them each
+    statistic's own, statistics.ExportTable: "peaks", the recurrence peaks of each point, highest first;
+    "seismicity", one row per point, time bin and distance bin of the rate around its mainshocks)."""
+    return _result(whole(_tables(path, [name])[0][name]), frame)
 
 
 def columns(path, table):
-    """{column: (unit, meaning)} of one table ("events", "tasks", "curves", "numbers", "peaks", "seismicity")."""
+    """{column: (unit, meaning)} of one table (CATALOG_TABLES, SUMMARY_TABLES)."""
     return dict(_tables(path, [table])[0][table].columns)
 
 
@@ -121,7 +117,7 @@ def as_dataframe(arr):
 
 
 CATALOG_TABLES = ("events", "tasks")
-SUMMARY_TABLES = ("curves", "numbers", "peaks", "seismicity")
+SUMMARY_TABLES = ("curves", "numbers", *STATISTIC_EXPORTS)
 
 
 def source_kind(path):
@@ -167,8 +163,8 @@ def _tables(path, names, chunk=schema.READ_CHUNK, partial=True):
         build = {"events": lambda: events_table(path, chunk), "tasks": lambda: tasks_table(path)}
         return {name: build[name]() for name in names}, statement
     s = summary.read(path)
-    build = {"curves": lambda: curves_table(s), "numbers": lambda: numbers_table(s), "peaks": lambda: peaks_table(s),
-             "seismicity": lambda: seismicity_table(s)}
+    build = {"curves": lambda: curves_table(s), "numbers": lambda: numbers_table(s),
+             **{name: (lambda e=e: statistic_table(s, e)) for name, e in STATISTIC_EXPORTS.items()}}
     a = s["attrs"]
     settings = (f"reduced from {a.get('catalog', '?')} with "
                 + ", ".join(f"{k} = {a[k]}" for k in SUMMARY_SETTINGS if k in a))
@@ -181,7 +177,7 @@ FORMATS = {"csv": (".csv", write_csv)}   # format -> (file suffix, writer(path, 
 
 
 def write(source, directory, fmt="csv", force=False, chunk=schema.READ_CHUNK, partial=False):
-    """Every table of a catalog (events, tasks) or a summary (curves, numbers, peaks, seismicity) into files
+    """Every table of a catalog (CATALOG_TABLES) or a summary (SUMMARY_TABLES) into files
     DIRECTORY/<table><suffix>; returns their paths.
 
     Refuses (checks.UsageError naming the path, nothing written) a directory that cannot be made

@@ -1,5 +1,6 @@
 """The tables of an export (analysis/export.py): what each table's columns are, and their rows as
-structured arrays, from a catalog (events, tasks) or a summary (curves, numbers, peaks, seismicity).
+structured arrays, from a catalog (events, tasks) or a summary (curves, numbers, and each statistic's own:
+statistics.ExportTable, the recurrence peaks and the seismicity's maps today).
 
 Units and meanings come from the tables that also describe the HDF5 datasets (ensemble/store/schema.py's
 and analysis/summary.py's DATASETS) and from where a key is declared (a friction law's keys, the
@@ -17,16 +18,16 @@ from ensemble.store import reader, schema
 from ensemble.store.errors import CatalogError
 
 from . import summary
-from .statistics import holds
-from .statistics.seismicity import STATISTIC as SEISMICITY
+from .reduce import LAYOUT
 
+# the statistics' own tables of a summary (statistics.ExportTable), by name
+STATISTIC_EXPORTS = {e.name: e for st in LAYOUT.statistics for e in st.exports}
 TITLES = {   # table -> what its rows are (said in its file's header)
     "events": "one row per committed event",
     "tasks": "one row per task",
     "curves": "one row per point, curve and bin",
     "numbers": "one row per parameter point",
-    "peaks": "one row per recurrence peak of a point",
-    "seismicity": "one row per point, time bin and distance bin of the seismicity around its mainshocks",
+    **{name: e.title for name, e in STATISTIC_EXPORTS.items()},
 }
 SUMMARY_SETTINGS = summary.STORED_OPTIONS
 
@@ -186,42 +187,9 @@ def curves_table(s):
     return Table(columns, [_structured(columns, values)])
 
 
-def peaks_table(s):
-    peaks = s["points/peaks"]
-    point, rank = np.nonzero(np.isfinite(peaks[..., 0]))
-    values = {"point": point.astype(np.int64), "peak": rank.astype(np.int64),
-              "tnu": peaks[point, rank, 0], "tnu_lo": peaks[point, rank, 1], "tnu_hi": peaks[point, rank, 2]}
-    unit, _ = _summary_column("points/peaks")
-    columns = {
-        "point": ("index", "parameter point (row of numbers.csv)"),
-        "peak": ("index", "0 for the highest peak of the point, 1 for the next, ..."),
-        "tnu": (unit, "T nu at the peak (centre of its bin in the smoothed histogram)"),
-        "tnu_lo": (unit, "lower end of its bootstrap interval (NaN with one unit or no match)"),
-        "tnu_hi": (unit, "upper end of its bootstrap interval (NaN with one unit or no match)"),
-    }
-    return Table(columns, [_structured(columns, values)])
-
-
-def seismicity_table(s):
-    """The maps of the seismicity around large events, long format (no rows for a summary before format 5)."""
-    columns = {
-        "point": ("index", "parameter point (row of numbers.csv)"),
-        "time_lo": ("model length", "lower edge of the time bin: T nu from the mainshock's onset, negative before it"),
-        "time_hi": ("model length", "upper edge of the time bin (bins are half-open)"),
-        "distance_lo": ("blocks", "lower edge of the distance bin: blocks from the mainshock's epicenter"),
-        "distance_hi": ("blocks", "upper edge of the distance bin (bins are half-open)"),
-        "rate": _summary_column("points/seismicity_rate")[:1] + (
-            "events per mainshock per block per unit T nu in the cell (NaN where nothing was exposed); the "
-            "background rate is in numbers.csv",),
-    }
-    values = {name: np.zeros(0) for name in columns}
-    if holds(s, SEISMICITY):
-        rate, te, de = s["points/seismicity_rate"], s["bins/seis_time"], s["bins/seis_distance"]
-        point, j, k = (a.ravel() for a in np.meshgrid(np.arange(len(rate)), np.arange(len(te) - 1),
-                                                       np.arange(len(de) - 1), indexing="ij"))
-        values = {"point": point.astype(np.int64), "time_lo": te[j], "time_hi": te[j + 1], "distance_lo": de[k],
-                  "distance_hi": de[k + 1], "rate": rate[point, j, k]}
-    values["point"] = values["point"].astype(np.int64)
+def statistic_table(s, export):
+    """A statistic's table of summary `s` (statistics.ExportTable)."""
+    columns, values = export.build(s)
     return Table(columns, [_structured(columns, values)])
 
 

@@ -349,7 +349,7 @@ MUTATIONS = (
              "            if os.path.exists(tmp):\n                os.remove(tmp)", "            pass",
              ("tests/test_export.py::test_api_streams_the_catalog_in_verified_chunks",),
              "an export that fails on a corrupt catalog leaves partial files behind"),
-    Mutation("export-peak-interval-swapped", "analysis/export_tables.py",
+    Mutation("export-peak-interval-swapped", "analysis/statistics/recurrence.py",
              '"tnu_lo": peaks[point, rank, 1], "tnu_hi": peaks[point, rank, 2]',
              '"tnu_lo": peaks[point, rank, 2], "tnu_hi": peaks[point, rank, 1]',
              ("tests/test_export.py::test_peaks_table_of_several_peaks_per_point",),

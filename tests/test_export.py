@@ -162,7 +162,7 @@ def test_api_curves_numbers_peaks_are_the_summarys(files):
     for name in summary.NUMBER_MEANINGS:
         for j, suffix in enumerate(("", "_lo", "_hi")):
             np.testing.assert_array_equal(nb[name + suffix], s[f"points/numbers/{name}"][:, j], err_msg=name + suffix)
-    pk = export.peaks(files / "cat.summary.h5")
+    pk = export.table(files / "cat.summary.h5", "peaks")
     found = np.isfinite(s["points/peaks"][..., 0])
     assert len(pk) == found.sum() >= 2 and not found[2].any()     # point 2 has no peak: no row
     np.testing.assert_array_equal(np.stack([pk["tnu"], pk["tnu_lo"], pk["tnu_hi"]], axis=1),
@@ -182,7 +182,7 @@ def test_peaks_table_of_several_peaks_per_point(files, tmp_path):
         del h5["points/peaks"]
         h5["points/peaks"] = peaks
         summary.seal(h5)        # (edited by hand: its checksums again)
-    pk = export.peaks(path)
+    pk = export.table(path, "peaks")
     assert list(zip(pk["point"], pk["peak"])) == [(0, 0), (0, 1), (1, 0), (3, 0), (3, 1), (3, 2)]
     np.testing.assert_array_equal(np.stack([pk["tnu"], pk["tnu_lo"], pk["tnu_hi"]], axis=1),
                                   peaks[np.isfinite(peaks[..., 0])])
@@ -251,7 +251,7 @@ def test_csv_holds_what_the_api_returns(files, source, directory, tables):
     """Same columns in the same order, same values (numbers read with numpy, text with csv)."""
     assert sorted(os.listdir(files / directory)) == sorted(f"{t}.csv" for t in tables)
     for table in tables:
-        want = getattr(export, table)(files / source)
+        want = export.table(files / source, table)
         path = files / directory / f"{table}.csv"
         names, rows = csv_rows(path)
         assert names == list(want.dtype.names) and len(rows) == len(want), table
@@ -363,7 +363,7 @@ def test_api_given_the_other_kind_says_so(files):
 def test_without_pandas_a_dataframe_is_a_clear_error(files, monkeypatch):
     monkeypatch.setitem(sys.modules, "pandas", None)     # import pandas now raises ImportError
     with pytest.raises(ImportError, match=r"pandas is not installed \(it is optional"):
-        export.peaks(files / "cat.summary.h5", frame=True)
+        export.table(files / "cat.summary.h5", "peaks", frame=True)
 
 
 def test_pandas_reads_the_csv_as_the_api_returns_it(files):
@@ -372,7 +372,7 @@ def test_pandas_reads_the_csv_as_the_api_returns_it(files):
     for source, directory, tables in (("cat.h5", "cat_csv", export.CATALOG_TABLES),
                                       ("cat.summary.h5", "sum_csv", export.SUMMARY_TABLES)):
         for table in tables:
-            want = getattr(export, table)(files / source, frame=True)
+            want = export.table(files / source, table, frame=True)
             assert isinstance(want, pandas.DataFrame)
             got = pandas.read_csv(files / directory / f"{table}.csv", comment="#")
             assert list(got.columns) == list(want.columns), table

@@ -144,6 +144,16 @@ class Criterion:
 
 
 @dataclass(frozen=True)
+class ExportTable:
+    """A table that `analysis export` writes of a summary for a statistic (a file <name>.csv, analysis/export.py).
+    build(s): of the summary `s` (as read), (columns {name: (unit, meaning)} in order, values {name: 1-d array});
+    a summary that does not hold the statistic gives the columns with no rows."""
+    name: str
+    title: str          # what its rows are (said in the file's header)
+    build: Callable
+
+
+@dataclass(frozen=True)
 class Statistic:
     name: str
     order: int                      # place among the statistics (report lines, numbers, curves)
@@ -167,6 +177,7 @@ class Statistic:
     # with its interval), and its lines under the report's first, about the whole summary (s) -> [lines]
     report: Optional[Callable] = None
     report_header: Optional[Callable] = None
+    exports: tuple = ()             # its ExportTables (`analysis export` of a summary)
 
 
 def holds(s, statistic):

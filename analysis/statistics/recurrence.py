@@ -3,7 +3,7 @@ recurrences and of those starting at an interior event, their means and mode, an
 import numpy as np
 
 from .. import stats
-from . import LAW, Curve, Number, Option, Statistic, Table, number_lines, number_text, report_line
+from . import LAW, Curve, ExportTable, Number, Option, Statistic, Table, number_lines, number_text, report_line
 
 
 def feed(acc, rows):
@@ -70,6 +70,24 @@ def report(s, i):
                                                         or "-")]
 
 
+def peaks_table(s):
+    """The peaks of every point, highest first (ExportTable.build)."""
+    from ..summary import DATASETS
+    peaks = s["points/peaks"]
+    point, rank = np.nonzero(np.isfinite(peaks[..., 0]))
+    values = {"point": point.astype(np.int64), "peak": rank.astype(np.int64),
+              "tnu": peaks[point, rank, 0], "tnu_lo": peaks[point, rank, 1], "tnu_hi": peaks[point, rank, 2]}
+    unit = DATASETS["points/peaks"][0]
+    columns = {
+        "point": ("index", "parameter point (row of numbers.csv)"),
+        "peak": ("index", "0 for the highest peak of the point, 1 for the next, ..."),
+        "tnu": (unit, "T nu at the peak (centre of its bin in the smoothed histogram)"),
+        "tnu_lo": (unit, "lower end of its bootstrap interval (NaN with one unit or no match)"),
+        "tnu_hi": (unit, "upper end of its bootstrap interval (NaN with one unit or no match)"),
+    }
+    return columns, values
+
+
 STATISTIC = Statistic(
     "recurrence", 20, needs=("recurrences",),
     tables=(Table("tnu", "count", "recurrences per T nu bin, per task and stretch of their starting event", bins="tnu"),
@@ -86,6 +104,7 @@ STATISTIC = Statistic(
             Curve("tnu_interior", "tnu_interior", ("numbers", "n_rec_int"), "T nu",
                   "the recurrences starting at an interior event (boundary false)", "1/model length")),
     feed=feed, estimate=estimate, extra=peaks, report=report,
+    exports=(ExportTable("peaks", "one row per recurrence peak of a point", peaks_table),),
     options=(Option("tnu_bins", "bins", LAW, "model length", "T*nu bins lo:hi:n"),
              Option("window", "count", 10, "blocks", "epicenter window in blocks", 0, 10 ** 9)),
     extra_datasets={"peaks": ("model length", "(points, most peaks, 3): position, lo, hi; NaN rows pad",

@@ -29,7 +29,7 @@ import numpy as np
 
 import ensemble.model  # noqa: F401  (first: numba caches the kernel in the package's cache, ensemble/kernel_cache.py)
 
-from . import Number, Option, Statistic, Table
+from . import ExportTable, Number, Option, Statistic, Table, holds
 
 NAME = "seismicity"
 _EDGE = 1e-9    # a region's bound matches a bin edge within this share of the bin's width
@@ -218,6 +218,29 @@ def report_header(s):
             f"-{a['seis_long']:g}; rates per mainshock per block per T*nu"]
 
 
+def map_table(s):
+    """The maps, long format: one row per point, time bin and distance bin (ExportTable.build; no rows for a
+    summary before format 5)."""
+    columns = {
+        "point": ("index", "parameter point (row of numbers.csv)"),
+        "time_lo": ("model length", "lower edge of the time bin: T nu from the mainshock's onset, negative before it"),
+        "time_hi": ("model length", "upper edge of the time bin (bins are half-open)"),
+        "distance_lo": ("blocks", "lower edge of the distance bin: blocks from the mainshock's epicenter"),
+        "distance_hi": ("blocks", "upper edge of the distance bin (bins are half-open)"),
+        "rate": (RATE, "events per mainshock per block per unit T nu in the cell (NaN where nothing was exposed); the "
+                       "background rate is in numbers.csv"),
+    }
+    values = {name: np.zeros(0) for name in columns}
+    if holds(s, STATISTIC):
+        rate, te, de = s["points/seismicity_rate"], s["bins/seis_time"], s["bins/seis_distance"]
+        point, j, k = (a.ravel() for a in np.meshgrid(np.arange(len(rate)), np.arange(len(te) - 1),
+                                                       np.arange(len(de) - 1), indexing="ij"))
+        values = {"point": point, "time_lo": te[j], "time_hi": te[j + 1], "distance_lo": de[k],
+                  "distance_hi": de[k + 1], "rate": rate[point, j, k]}
+    values["point"] = values["point"].astype(np.int64)
+    return columns, values
+
+
 RATE = "1/(block model length)"   # events per mainshock per block per unit T nu
 STATISTIC = Statistic(
     NAME, 60,
@@ -243,6 +266,8 @@ STATISTIC = Statistic(
              Number("doughnut_ratio", "1", "the same ratio just before the onset, in [-seis_short, 0)",
                     "doughnut ratio")),
     feed=feed, estimate=estimate, extra=rate_map, drawn=drawn, uses_options=("mu_c",), report_header=report_header,
+    exports=(ExportTable("seismicity", "one row per point, time bin and distance bin of the seismicity around its "
+                                       "mainshocks", map_table),),
     # the defaults: for the aging law at b = 20, N = 800 (inter-event times of about 37 T nu, large events
     # recurring after T nu ~ 530)
     options=(Option("seis_time_bins", "bins", "-1000:1000:40", "model length",
