@@ -80,10 +80,9 @@ def _parser():
     pl.add_argument("summaries", nargs="+", metavar="summary",
                     help="one or more summaries: their points in one figure, labelled by the "
                          "parameters that differ between them")
-    pl.add_argument("--figure", choices=("magnitude", "recurrence", "creep", "seismicity"), required=True,
-                    help="creep: the creep episodes' size and duration densities and the aseismic slip "
-                         "fraction (points with creep episodes; an error if none has any); seismicity: the "
-                         "rate of events around mainshocks by distance and time, one map per point")
+    figures = [f for st in LAYOUT.statistics for f in st.figures]     # each statistic's (statistics.Figure)
+    pl.add_argument("--figure", choices=[f.name for f in figures], required=True,
+                    help="; ".join(f"{f.name}: {f.help}" for f in figures))
     pl.add_argument("-o", "--output", required=True, help="FILE.png or FILE.pdf")
     pl.add_argument("--title", default=None)
     pl.add_argument("--force", action="store_true", help="overwrite an existing figure")

@@ -3,12 +3,9 @@ that differ between them), and the figure's title (events per point, mu_c, windo
 and a line for each partial reduction)."""
 import os
 
-import numpy as np
-
 from . import summary as summary_file
 from .reduce import PARAMS
-from .report import count_text, level_text, partial_text, size_text
-from .statistics.creep import creeping
+from .report import level_text, partial_text, size_text
 
 def summary_name(path):
     """A summary's name in labels and titles: its file name without .summary.h5 (or .h5)."""
@@ -71,29 +68,20 @@ def _units(s):
         for n in [[int(u) for u, k in zip(s["points/units"], s["points/method"]) if k == m]]))
 
 
-def _creep_sizes(summaries):
-    """The creep episodes per point, over the points that have any: "15380-16492 creep episodes per point"."""
-    counts = [s["points/numbers/n_creep"][i, 0] for s in summaries for i in np.flatnonzero(creeping(s))]
-    if not counts:
-        return "no creep episodes"      # (the creep figure then stops with its one-line error)
-    lo, hi = min(counts), max(counts)
-    return f"{count_text(lo)}{'' if lo == hi else f'-{count_text(hi)}'} creep episodes per point"
-
-
-def title_text(summaries, names, title=None, kind=None):
+def title_text(summaries, names, title=None, figure=None):
     """The figure's title: `title` (then the description below) or by default the description
-    alone: the friction law(s), events per point, mu_c, window and the bands (never the file names; for the creep
-    figure the creep episodes per point and the bands); then one line for each partial reduction
-    (events reduced of expected), whatever the title."""
+    alone: the friction law(s), what the figure rests on (statistics.Figure.describe; by default the events per
+    point, mu_c and window) and the bands (never the file names); then one line for each partial reduction
+    (events reduced of expected), whatever the title. figure: the statistics.Figure drawn (None: the default)."""
     levels = " / ".join(dict.fromkeys(level_text(s["attrs"]["level"]) for s in summaries))
     bands = f"bands: {levels} bootstrap over {_values(_units(s) for s in summaries)}"
-    if kind == "seismicity":   # a map has no band: its numbers (analysis report) have the intervals
+    if figure is not None and not figure.bands:   # a map has no band: its numbers (analysis report) have the intervals
         bands = (f"\nmaps without intervals; the numbers' {levels} intervals (analysis report) over "
                  f"{_values(_units(s) for s in summaries)}")
     # the friction law(s) first: a slip-law figure must not pass for the paper's aging law
     laws = f"{_values(str(law) for s in summaries for law in summary_file.point_laws(s))} law: "
-    if kind == "creep":
-        description = f"{laws}{_creep_sizes(summaries)}; {bands}"
+    if figure is not None and figure.describe is not None:
+        description = f"{laws}{figure.describe(summaries)}; {bands}"
     else:
         description = (f"{laws}{_values(size_text(s) for s in summaries)}, "
                        f"mu_c = {_values((s['attrs']['mu_c'] for s in summaries), '{:g}')}, "

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from matplotlib.text import Text
 
-from analysis import plot, summary
+from analysis import drawing, plot, summary
 
 ROOT = Path(__file__).resolve().parents[1]
 PANELS = ("fig1_b", "fig1_a", "fig1_c", "fig2", "large_b", "all")
@@ -185,7 +185,7 @@ def test_the_check_sees_the_old_inset(monkeypatch):
         inset = ax.inset_axes([0.55, 0.35, 0.4, 0.35])
         draw(inset)
         return inset
-    monkeypatch.setattr(plot, "place_inset", old)
+    monkeypatch.setattr(drawing, "place_inset", old)   # (the recurrence figure takes it from there as it draws)
     fig = plot.figure(load("fig2"), "recurrence")
     try:
         found = covered(fig)
@@ -206,7 +206,7 @@ def test_log_band_reaching_zero_is_its_upper_end():
     fig = plot.figure(s, "magnitude")
     try:
         ax = fig.axes[0]
-        marks = [line for line in ax.lines if line.get_marker() == plot.OPEN]
+        marks = [line for line in ax.lines if line.get_marker() == drawing.OPEN]
         assert len(marks) == 1
         x, y = marks[0].get_data()
         c = 0.5 * (s["bins/mu"][1:] + s["bins/mu"][:-1])
@@ -218,7 +218,7 @@ def test_log_band_reaching_zero_is_its_upper_end():
                 # no band over the dip's bins
                 inner = (p.vertices[:, 0] > c[dip].min() + 1e-9) & (p.vertices[:, 0] < c[dip].max() - 1e-9)
                 assert not inner.any()
-        assert plot.OPEN_NOTE in [t.get_text() for t in ax.get_legend().get_texts()]
+        assert drawing.OPEN_NOTE in [t.get_text() for t in ax.get_legend().get_texts()]
         _check(fig)
     finally:
         plot.plt.close(fig)

@@ -144,6 +144,23 @@ class Criterion:
 
 
 @dataclass(frozen=True)
+class Figure:
+    """A figure that `analysis plot --figure <name>` draws for a statistic, of the points of one or more summaries
+    (analysis/plot.py). draw(summaries, fig, keys, labels, names, title): draws into the empty matplotlib figure
+    `fig`, sized size(n) inches for n points, with the points' legend `labels`, the parameters `keys` that vary
+    between them and the summaries' `names`, and lays it out under the `title` text (analysis/drawing.py helps).
+    describe(summaries): the title's words on what the figure rests on (default: the events per point, mu_c and
+    window); bands: whether its curves carry bootstrap bands (else the title says where the intervals are).
+    A figure imports matplotlib when it draws, not before: a reduction under MPI never loads it."""
+    name: str
+    help: str
+    size: Callable
+    draw: Callable
+    describe: Optional[Callable] = None
+    bands: bool = True
+
+
+@dataclass(frozen=True)
 class ExportTable:
     """A table that `analysis export` writes of a summary for a statistic (a file <name>.csv, analysis/export.py).
     build(s): of the summary `s` (as read), (columns {name: (unit, meaning)} in order, values {name: 1-d array});
@@ -178,6 +195,7 @@ class Statistic:
     report: Optional[Callable] = None
     report_header: Optional[Callable] = None
     exports: tuple = ()             # its ExportTables (`analysis export` of a summary)
+    figures: tuple = ()             # its Figures (`analysis plot --figure NAME`)
 
 
 def holds(s, statistic):

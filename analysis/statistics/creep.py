@@ -1,10 +1,12 @@
 """The slow side: the creep episodes (/events/kind 1, below the block stiffness), their size and duration
 densities, their share of the rows, the share taken over by an inertial event, and the aseismic slip fraction."""
+import math
+
 import numpy as np
 
 from ensemble.store import schema
 
-from . import Curve, Number, Option, Statistic, Table, holds, number_lines, report_line
+from . import Curve, Figure, Number, Option, Statistic, Table, holds, number_lines, report_line
 
 
 def feed(acc, rows):
@@ -46,6 +48,84 @@ def report(s, i):
     return number_lines(STATISTIC, s, i)
 
 
+PANELS = (   # curve, x label, y label
+    ("creep_mu", r"creep episode size $\mu = \log_{10}$ slip", r"density of $\mu$"),
+    ("creep_duration", r"creep episode duration $\log_{10}(\mathrm{duration}\;\nu)$", "density"),
+)
+
+
+def _legend_rows(n):
+    return math.ceil((n + 1) / 4)
+
+
+def figure_size(n):
+    return 13, 4.6 + 0.25 * _legend_rows(n)
+
+
+def describe(summaries):
+    """The title's words: the creep episodes per point, over the points that have any."""
+    from ..report import count_text
+    counts = [s["points/numbers/n_creep"][i, 0] for s in summaries for i in np.flatnonzero(creeping(s))]
+    if not counts:
+        return "no creep episodes"      # (the figure then stops with its one-line error)
+    lo, hi = min(counts), max(counts)
+    return f"{count_text(lo)}{'' if lo == hi else f'-{count_text(hi)}'} creep episodes per point"
+
+
+def draw(summaries, fig, keys, labels, names, title):
+    """Three panels: the creep episodes' size and duration densities of every point that has any (overlaid, bands),
+    and the aseismic slip fraction of every point of a summary that reduced the creep episodes against the first
+    varying parameter (b if it varies), with its interval."""
+    from matplotlib.lines import Line2D
+
+    from ..drawing import FONT, OPEN, OPEN_NOTE, band, layout, palette
+    from ..figure_labels import points_of
+    from ..stats import centers
+    from ..summary import SummaryError
+    points = points_of(summaries)
+    colors = palette(len(points))
+    shown = [(s, i, label, color) for (s, i), label, color in zip(points, labels, colors) if creeping(s)[i]]
+    if not shown:
+        raise SummaryError(f"{', '.join(map(str, names))}: no creep episodes in any point, no creep figure (a summary "
+                           "of format 2 did not reduce them: reduce its catalogs again)")
+    axes = fig.subplots(1, 3)
+    opened = False
+    for ax, (curve, xlabel, ylabel) in zip(axes, PANELS):
+        for s, i, label, color in shown:
+            opened |= band(ax, centers(s[f"bins/{curve}"]), s[f"points/{curve}_density"][i],
+                           s[f"points/{curve}_lo"][i], s[f"points/{curve}_hi"][i], label, color,
+                           log=True, open_ends=True)
+        ax.set_yscale("log")
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(ylabel)
+    x_key = "b" if "b" in keys else keys[0]
+    others = [k for k in keys if k != x_key]
+    ax = axes[2]
+    series = {}
+    for s, i in points:
+        if holds(s, STATISTIC):
+            group = ", ".join(f"{k} = {s[f'points/{k}'][i]:g}" for k in others)
+            series.setdefault(group, []).append((s[f"points/{x_key}"][i], *s["points/numbers/aseismic_fraction"][i]))
+    for n, (group, rows) in enumerate(series.items()):
+        x, y, lo, hi = np.array(sorted(rows)).T
+        err = np.where(np.isfinite(lo), [y - lo, hi - y], 0.0)
+        ax.errorbar(x, y, yerr=err, fmt="o-", color=f"C{n % 10}", ms=4, capsize=3, lw=1.2, clip_on=False,
+                    label=group or None)
+    ax.set_ylim(0, ax.get_ylim()[1])
+    ax.set_xlabel(x_key)
+    ax.set_ylabel("aseismic slip fraction")
+    ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 3))
+    if len(series) > 1:
+        ax.legend(fontsize=FONT, loc="upper center", bbox_to_anchor=(0.5, -0.22), frameon=False)
+    handles, texts = axes[0].get_legend_handles_labels()
+    if opened:
+        handles.append(Line2D([], [], marker=OPEN, color="0.3", mfc="none", ls="none"))
+        texts.append(OPEN_NOTE)
+    fig.legend(handles, texts, title="varying " + ", ".join(keys), loc="lower center", fontsize=FONT,
+               title_fontsize=FONT + 1, ncol=min(len(texts), 4), frameon=False)
+    layout(fig, title, 0.45 + 0.2 * _legend_rows(len(labels)))   # the figure legend below the panels
+
+
 STATISTIC = Statistic(
     "creep", 40,
     tables=(Table("creep_mu", "count",
@@ -70,6 +150,9 @@ STATISTIC = Statistic(
             Curve("creep_duration", "creep_duration", ("creep", "n_creep"), "log10(duration nu)",
                   "the creep episodes (duration in units of the loading time 1/nu)", "1/log10 unit")),
     feed=feed, estimate=estimate, uses_tables=("numbers",), report=report,
+    figures=(Figure("creep", "the creep episodes' size and duration densities and the aseismic slip fraction "
+                             "(points with creep episodes; an error if none has any)", figure_size, draw,
+                    describe=describe),),
     # the default bins: measured at N = 100, b = 8..18.5 (aging law), creep slips reach mu = -11 and durations
     # 10^-6.4 / nu
     options=(Option("creep_mu_bins", "bins", "-12:3:75", "log10 model length",

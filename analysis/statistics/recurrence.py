@@ -3,7 +3,8 @@ recurrences and of those starting at an interior event, their means and mode, an
 import numpy as np
 
 from .. import stats
-from . import LAW, Curve, ExportTable, Number, Option, Statistic, Table, number_lines, number_text, report_line
+from . import (LAW, Curve, ExportTable, Figure, Number, Option, Statistic, Table, number_lines, number_text,
+               report_line)
 
 
 def feed(acc, rows):
@@ -88,6 +89,74 @@ def peaks_table(s):
     return columns, values
 
 
+def _zoom(s, i, x, peak):
+    """A drawing function: point i's curves within 6 bins of `peak`."""
+    from matplotlib.ticker import MaxNLocator
+
+    from ..drawing import FONT, band
+
+    def draw_inset(inset):
+        w = 6 * (x[1] - x[0])
+        near = (x > peak - w) & (x < peak + w)
+        band(inset, x[near], s["points/tnu_density"][i][near], s["points/tnu_lo"][i][near],
+             s["points/tnu_hi"][i][near], None, "C0")
+        band(inset, x[near], s["points/tnu_interior_density"][i][near],
+             s["points/tnu_interior_lo"][i][near], s["points/tnu_interior_hi"][i][near],
+             None, "C3", style="--")
+        inset.tick_params(labelsize=FONT)
+        inset.xaxis.set_major_locator(MaxNLocator(4))
+        inset.yaxis.set_major_locator(MaxNLocator(3))
+        inset.set_title(f"highest peak, T$\\nu$ = {peak:g}", fontsize=FONT)
+    return draw_inset
+
+
+def interval_text(est, lo, hi):
+    """'0.84 [0.77, 0.91]' (or the estimate alone, or 'n/a')."""
+    if not np.isfinite(est):
+        return "n/a"
+    return f"{est:.2f} [{lo:.2f}, {hi:.2f}]" if np.isfinite(lo) and np.isfinite(hi) else f"{est:.2f}"
+
+
+def figure_size(n):
+    from ..drawing import grid
+    rows, cols = grid(n)
+    return 5.5 * cols, 4 * rows + 0.4
+
+
+def draw(summaries, fig, keys, labels, names, title):
+    """One panel per point: the distribution of all recurrences and of those starting at an interior event, with
+    bands, its CV in the title; after the layout, each panel's highest peak (the first of the report's `T*nu
+    peaks`: the highest significant peak of the smoothed histogram, which may differ from `mode T*nu`, the highest
+    bin) enlarged in an inset where the data are low (drawing.place_inset)."""
+    from ..drawing import FONT, band, grid, layout, place_inset
+    from ..figure_labels import points_of
+    from ..stats import centers
+    points = points_of(summaries)
+    rows, cols = grid(len(points))
+    for k, ((s, i), label) in enumerate(zip(points, labels)):
+        x = centers(s["bins/tnu"])
+        ax = fig.add_subplot(rows, cols, k + 1)
+        band(ax, x, s["points/tnu_density"][i], s["points/tnu_lo"][i], s["points/tnu_hi"][i],
+             "all large events", "C0")
+        band(ax, x, s["points/tnu_interior_density"][i], s["points/tnu_interior_lo"][i],
+             s["points/tnu_interior_hi"][i], "interior events (the rupture reaches neither end)", "C3", style="--")
+        if "points/numbers/cv_tnu" in s:       # (summaries before format 4 have no intervals statistic)
+            label += "\nCV of $T\\nu$ " + interval_text(*s["points/numbers/cv_tnu"][i])
+        ax.set_title(label, fontsize=FONT + 1)
+        ax.set_xlabel(r"$T\nu$")
+        ax.set_ylabel(r"$P(T\nu)$")
+        ax.set_xlim(s["bins/tnu"][0], s["bins/tnu"][-1])
+        ax.set_ylim(0, ax.get_ylim()[1])
+    handles, texts = fig.axes[0].get_legend_handles_labels()
+    fig.legend(handles, texts, loc="lower center", ncol=2, fontsize=FONT + 1, frameon=False)
+    layout(fig, title, 0.35)      # the figure legend below the panels
+    renderer = fig.canvas.get_renderer()
+    for ax, (s, i) in zip(fig.axes, points):
+        peak = s["points/peaks"][i][0][0]
+        if np.isfinite(peak):
+            place_inset(ax, _zoom(s, i, centers(s["bins/tnu"]), peak), renderer)
+
+
 STATISTIC = Statistic(
     "recurrence", 20, needs=("recurrences",),
     tables=(Table("tnu", "count", "recurrences per T nu bin, per task and stretch of their starting event", bins="tnu"),
@@ -105,6 +174,8 @@ STATISTIC = Statistic(
                   "the recurrences starting at an interior event (boundary false)", "1/model length")),
     feed=feed, estimate=estimate, extra=peaks, report=report,
     exports=(ExportTable("peaks", "one row per recurrence peak of a point", peaks_table),),
+    figures=(Figure("recurrence", "the recurrence-time distributions, one panel per point, each with its highest "
+                                  "peak enlarged in an inset", figure_size, draw),),
     options=(Option("tnu_bins", "bins", LAW, "model length", "T*nu bins lo:hi:n"),
              Option("window", "count", 10, "blocks", "epicenter window in blocks", 0, 10 ** 9)),
     extra_datasets={"peaks": ("model length", "(points, most peaks, 3): position, lo, hi; NaN rows pad",

@@ -29,7 +29,7 @@ import numpy as np
 
 import ensemble.model  # noqa: F401  (first: numba caches the kernel in the package's cache, ensemble/kernel_cache.py)
 
-from . import ExportTable, Number, Option, Statistic, Table, holds
+from . import ExportTable, Figure, Number, Option, Statistic, Table, holds
 
 NAME = "seismicity"
 _EDGE = 1e-9    # a region's bound matches a bin edge within this share of the bin's width
@@ -241,6 +241,57 @@ def map_table(s):
     return columns, values
 
 
+DECADES = 2   # the colour scale of the maps: rate / background from 10^-2 to 10^2
+
+
+def figure_size(n):
+    from ..drawing import grid
+    rows, cols = grid(n)
+    return 5.2 * cols + 1.2, 4.2 * rows + 0.8
+
+
+def draw(summaries, fig, keys, labels, names, title):
+    """One map per point (the grid of the recurrence panels): log10 of the rate at (distance, time) over the
+    point's background rate, white where nothing was exposed; the numbers' regions outlined (near and ring,
+    just before and after, some time before)."""
+    from ..drawing import FONT, grid
+    from ..figure_labels import points_of
+    from ..report import count_text
+    from ..summary import SummaryError
+    points = [(s, i, label) for (s, i), label in zip(points_of(summaries), labels) if holds(s, STATISTIC)]
+    if not points:
+        raise SummaryError(f"{', '.join(map(str, names))}: no seismicity around large events (a summary before "
+                           "format 5 did not reduce it: reduce its catalogs again)")
+    fig.subplots_adjust(left=0.09, right=0.86, bottom=(0.55 + 0.3) / fig.get_figheight(),
+                        top=1 - 1.1 / fig.get_figheight(), hspace=0.55, wspace=0.3)
+    rows, cols = grid(len(points))
+    mesh = None
+    for k, (s, i, label) in enumerate(points):
+        ax = fig.add_subplot(rows, cols, k + 1)
+        background = s["points/numbers/background_rate"][i][0]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            relative = np.log10(s["points/seismicity_rate"][i] / background)
+        relative = np.where(np.isfinite(relative), relative, np.where(relative == -np.inf, -DECADES, np.nan))
+        mesh = ax.pcolormesh(s["bins/seis_distance"], s["bins/seis_time"], np.ma.masked_invalid(relative),
+                             cmap="RdBu_r", vmin=-DECADES, vmax=DECADES, shading="flat")
+        a = s["attrs"]
+        for (d0, d1), (t0, t1), style in ((((0, a["seis_near"]), (-a["seis_short"], a["seis_short"]), "-")),
+                                          ((a["seis_near"], a["seis_ring"]), (-a["seis_long"], 0), ":")):
+            ax.plot([d0, d1, d1, d0, d0], [t0, t0, t1, t1, t0], style, color="k", lw=0.9)
+        ax.axhline(0.0, color="k", lw=0.5, alpha=0.5)
+        ax.set_title(f"{label}\n{count_text(s['points/numbers/n_large'][i][0])} mainshocks "
+                     f"(mu >= {a['mu_c']:g})", fontsize=FONT + 1)
+        ax.set_xlabel("distance from the mainshock's epicenter (blocks)")
+        ax.set_ylabel(r"time from its onset, $T\nu$")
+        ax.tick_params(labelsize=FONT)
+    bar = fig.colorbar(mesh, cax=fig.add_axes([0.89, 0.2, 0.015, 0.6]))
+    bar.set_label(r"$\log_{10}$(rate / background rate)", fontsize=FONT + 1)
+    bar.ax.tick_params(labelsize=FONT)
+    fig.text(0.01, 0.01, "solid: near the epicenter, just before and after the onset; dotted: the ring, "
+             "some time before to the onset; white: not observed", fontsize=FONT)
+    fig.suptitle(title, fontsize=FONT + 1, wrap=True)
+
+
 RATE = "1/(block model length)"   # events per mainshock per block per unit T nu
 STATISTIC = Statistic(
     NAME, 60,
@@ -266,6 +317,8 @@ STATISTIC = Statistic(
              Number("doughnut_ratio", "1", "the same ratio just before the onset, in [-seis_short, 0)",
                     "doughnut ratio")),
     feed=feed, estimate=estimate, extra=rate_map, drawn=drawn, uses_options=("mu_c",), report_header=report_header,
+    figures=(Figure("seismicity", "the rate of events around mainshocks by distance and time, one map per point",
+                    figure_size, draw, bands=False),),
     exports=(ExportTable("seismicity", "one row per point, time bin and distance bin of the seismicity around its "
                                        "mainshocks", map_table),),
     # the defaults: for the aging law at b = 20, N = 800 (inter-event times of about 37 T nu, large events
