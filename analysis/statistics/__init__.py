@@ -363,6 +363,11 @@ class Tables(dict):
     def column(self, table, name):
         return self[table][..., self.layout.column(table, name)]
 
+    def __reduce__(self):
+        """For pickle (a rank's tables go to rank 0): the arrays and the rows read, without the layout, whose
+        statistics may hold what pickle cannot (a lambda); rank 0 reads the arrays by name."""
+        return _unpickled, (dict(self), getattr(self, "rows", None))
+
     def add(self, table, name, block, values):
         """Add `values` to column `name` of `table` at stretches `block` (unbuffered, repeated indices add, one
         after the other in their order: the sums do not depend on how a task is cut into chunks)."""
@@ -387,6 +392,13 @@ class Tables(dict):
         """Append `values` to sample `table`, each to the list of its stretch (`block`), in order."""
         for b in np.unique(block):
             self[table][b].append(np.asarray(values, dtype=float)[block == b])
+
+
+def _unpickled(arrays, rows):
+    tables = Tables(None, arrays)
+    if rows is not None:
+        tables.rows = rows
+    return tables
 
 
 @nb.njit(cache=True)
