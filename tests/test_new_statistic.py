@@ -17,8 +17,8 @@ import numpy as np
 from .processes import ROOT, child_env, run_bounded
 from .test_summary_identity import CATALOG, gunzip
 
-ONE_BLOCK = '''"""The share of the inertial events that slip at most `small_n` blocks (a test's new statistic), with its own
-option, report line, figure and export table."""
+ONE_BLOCK = '''"""The share of the inertial events that slip at most `small_n` blocks (a test's new statistic),
+with its own option, report line, figure and export table."""
 import numpy as np
 
 from . import ExportTable, Figure, Number, Option, Statistic, Table
