@@ -115,3 +115,12 @@ def _rows(part, blocks, nu, opt, n_blocks, layout, real_opt):
         scans[c.name] = ((src * blocks) // max(written, 1), T * nu, interior)
     creep_block = np.minimum(((np.cumsum(inertial) - inertial)[creep] * blocks) // max(written, 1), blocks - 1)
     return Rows(part, inertial, ev, block, creep, creep_block, scans.get("mu"), np.nan, nu, opt, n_blocks, True, scans)
+
+
+@pytest.mark.parametrize("command", COMMANDS)
+def test_the_stored_columns_do_not_follow_the_statistics_order(command):
+    """The columns of a table shared by several statistics sit where the summaries store them (STORED_COLUMNS),
+    whatever the statistics' places: the registry in the reverse order lays them out the same."""
+    forward, backward = Layout(of(command)), Layout(tuple(reversed(of(command))))
+    assert forward.columns == backward.columns
+    assert Layout().columns["numbers"][:3] == ["n_events", "n_large", "n_rec"]

@@ -173,7 +173,7 @@ class ExportTable:
 @dataclass(frozen=True)
 class Statistic:
     name: str
-    order: int                      # place among the statistics (report lines, numbers, curves)
+    order: int                      # place among the statistics (report lines, numbers, curves; not on disk)
     needs: tuple = ()               # "recurrences": the engine scans the task's recurrence times for it
     tables: tuple = ()
     numbers: tuple = ()
@@ -291,9 +291,19 @@ def of(name):
     return tuple(s for s in STATISTICS if name in s.sets)
 
 
+# The order of the columns of a table that several statistics share, as the summaries store them (formats 2 to 6):
+# those of these that the statistics declare come first, in this order, then any other in the statistics' order.
+# So no place among the statistics (Statistic.order) moves a stored column; a new column goes after these, and
+# another order is a new summary format (and its readers).
+STORED_COLUMNS = {
+    "numbers": ("n_events", "n_large", "n_rec", "sum_tnu", "n_rec_int", "sum_tnu_int", "n_gr", "sum_mu_gr",
+                "sum_mu2_gr"),
+}
+
+
 class Layout:
     """Where every table and column lives: the tables in the statistics' order, columns of shared tables
-    concatenated (first declaration first), and the numbers and curves in order."""
+    concatenated (STORED_COLUMNS first, then by first declaration), and the numbers and curves in order."""
 
     def __init__(self, statistics=None):
         self.statistics = of("reduce") if statistics is None else statistics
@@ -312,6 +322,9 @@ class Layout:
                     if clash:
                         raise ValueError(f"table {t.name}: columns {sorted(clash)} declared twice")
                     self.columns[t.name] += list(t.columns)
+        for name, columns in self.columns.items():
+            stored = [c for c in STORED_COLUMNS.get(name, ()) if c in columns]
+            self.columns[name] = stored + [c for c in columns if c not in stored]
         self.numbers = [n for s in self.statistics for n in s.numbers]
         self.curves = [c for s in self.statistics for c in s.curves]
         self.bins = list(dict.fromkeys(name for t in self.tables.values() if t.bins for name in bin_names(t)))
