@@ -19,7 +19,8 @@ Events join tasks on `task`; curves and peaks join numbers on `point` (the row o
 same (export_tables.py builds the tables, export_csv.py writes them). Text is returned on one line
 (newlines as spaces); a task's [integrator] is split into typed columns integrator_<key>.
 
-CSV (the only format so far; FORMATS maps a format to its writer, `--format` chooses). Each file
+CSV (the only format so far; FORMATS maps a format to its writer, found in analysis/export_<format>.py,
+`--format` chooses). Each file
 starts with comment lines: the first says how many there are and how to read the file with pandas
 or numpy, one line per column follows, "# column: unit, meaning"; then one row of column names,
 then the rows. numpy.genfromtxt(names=True) takes the names from the first line even when it is a
@@ -42,14 +43,15 @@ and each task's checksum after its last chunk); the files of an export are writt
 names and renamed into place only when all are complete, so an export that fails writes nothing.
 """
 import contextlib
+import importlib
 import os
+import pkgutil
 
 from ensemble import checks, filekind
 from ensemble.store import reader, schema
 from ensemble.store.errors import CatalogError
 
 from . import merge, summary
-from .export_csv import write_csv
 from .export_tables import (STATISTIC_EXPORTS, SUMMARY_SETTINGS, curves_table, events_table, numbers_table, one_line,
                             statistic_table, tasks_table, whole)
 
@@ -173,7 +175,20 @@ def _tables(path, names, chunk=schema.READ_CHUNK, partial=True):
     return {name: build[name]() for name in names}, settings
 
 
-FORMATS = {"csv": (".csv", write_csv)}   # format -> (file suffix, writer(path, name, table, source, settings))
+def _formats():
+    """{format: (file suffix, writer(path, name, table, source, settings))}: every module analysis/export_<format>.py
+    that defines FORMAT (export_csv.py: csv)."""
+    import analysis
+    found = {}
+    for info in pkgutil.iter_modules(analysis.__path__):
+        if info.name.startswith("export_"):
+            module = importlib.import_module(f"analysis.{info.name}")
+            if hasattr(module, "FORMAT"):
+                found[info.name.removeprefix("export_")] = module.FORMAT
+    return found
+
+
+FORMATS = _formats()
 
 
 def write(source, directory, fmt="csv", force=False, chunk=schema.READ_CHUNK, partial=False):

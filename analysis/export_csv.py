@@ -1,4 +1,8 @@
-"""CSV files of an export's tables (analysis/export.py: FORMATS["csv"]; the format is described there)."""
+"""CSV files of an export's tables (analysis/export.py: FORMATS["csv"]; the format is described there).
+
+An export format is one module analysis/export_<name>.py that defines FORMAT = (file suffix, writer), the
+writer(path, name, table, source, settings) writing one table (export_tables.Table) into `path`, through
+ensemble.space.write_file; export.py finds it, and `analysis export --format <name>` takes it."""
 from ensemble import __version__, space
 
 from .export_tables import TITLES
@@ -52,3 +56,6 @@ def write_csv(path, name, table, source, settings=""):
                 cells = [_cells(part, n) for n in names]
                 yield "\n".join(map(",".join, zip(*cells))) + "\n"
     space.write_file(path, text(), f"the table {name}")
+
+
+FORMAT = (".csv", write_csv)

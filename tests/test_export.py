@@ -458,3 +458,44 @@ def test_the_parallel_writer_describes_every_dataset(tmp_path):
     assert set(descriptions(path)) == set(UNBRANCHED)
     _, tasks, _ = reader.read_tasks(path)
     assert len(tasks["point"]) == len(task_list(loads(text)))
+
+
+TSV = '''"""Tab-separated tables (a test's export format): a row of column names, then the rows."""
+from ensemble import space
+
+
+def write_tsv(path, name, table, source, settings=""):
+    def text():
+        yield "\\t".join(table.columns) + "\\n"
+        for part in table.parts:
+            for row in part.tolist():
+                yield "\\t".join(map(str, row)) + "\\n"
+    space.write_file(path, text(), f"the table {name}")
+
+
+FORMAT = (".tsv", write_tsv)
+'''
+
+
+def test_an_export_format_is_one_file(files, tmp_path):
+    """A copy of the package with one new module, analysis/export_tsv.py: `export --format tsv` writes every table
+    of the catalog and of the summary as .tsv files holding what the API returns; without the file, `--format tsv`
+    is refused (exit 2)."""
+    tree = tmp_path / "tree"
+    for name in ("analysis", "ensemble"):
+        shutil.copytree(ROOT / name, tree / name, ignore=shutil.ignore_patterns("__pycache__"))
+    (tree / "analysis" / "export_tsv.py").write_text(TSV)
+
+    def in_tree(*args):
+        return subprocess.run([sys.executable, "-m", "analysis", *map(str, args)], capture_output=True, text=True,
+                              env={**env(), "PYTHONPATH": str(tree)}, cwd=tree, timeout=TIMEOUT)
+    for source, tables, name in ((files / "cat.h5", export.CATALOG_TABLES, "tasks"),
+                                 (files / "cat.summary.h5", export.SUMMARY_TABLES, "numbers")):
+        out = tmp_path / source.name
+        ok(in_tree("export", source, "--format", "tsv", "-o", out, "--partial"))
+        assert sorted(os.listdir(out)) == sorted(f"{t}.tsv" for t in tables)
+        want = export.table(source, name)
+        lines = (out / f"{name}.tsv").read_text().splitlines()
+        assert lines[0].split("\t") == list(want.dtype.names) and len(lines) == 1 + len(want)
+    res = analysis("export", files / "cat.h5", "--format", "tsv", "-o", tmp_path / "none")
+    assert res.returncode == 2 and "tsv" in res.stderr and not (tmp_path / "none").exists()
