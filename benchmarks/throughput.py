@@ -1,6 +1,6 @@
 """Events per second of a developed chain, one core.
 
-    python benchmarks/throughput.py [--N 800] [--b 20] [--dt 1e-3] [--method rk4|ark3|ark4|ark5|exp4]
+    python benchmarks/throughput.py [--N 800] [--b 20] [--dt 1e-3] [--method NAME]
                                     [--rtol 1e-5] [--transient 1000] [--events 2000]
                                     [--law carlson-langer --alpha 2 --sigma 0.01 | --law slip --a 0] [--per-row]
 
@@ -19,6 +19,7 @@ import numpy as np
 from ensemble import energy
 from ensemble.config import Config, Integrator, Model, Run
 from ensemble.events import relative_energy_residual
+from ensemble.integrators import INTEGRATORS
 from ensemble.model.workspace import (D_BLOCK_STEPS, D_DURATION, D_ENERGY_SCALE, D_KIND, D_NSLIP, D_RESIDUAL, D_SLIP,
                                       D_STEPS, KIND_CREEP, KIND_EVENT)
 from ensemble.run.trajectory import Trajectory
@@ -36,7 +37,7 @@ def main():
     p.add_argument("--nu", type=float, default=Model().nu)
     p.add_argument("--dt", type=float, default=1e-3)
     p.add_argument("--method", default="rk4",
-                   help="rk4, ark3, ark4, ark5 or exp4 (the registry, ensemble/model/methods.py)")
+                   help=f"one of {', '.join(INTEGRATORS)} (the registry, ensemble/model/methods.py)")
     p.add_argument("--rtol", type=float, default=Integrator().rtol,
                    help="tolerance of the adaptive methods (default: the config default)")
     p.add_argument("--transient", type=int, default=1000)

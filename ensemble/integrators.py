@@ -15,6 +15,7 @@ if the kernels read it).
 from dataclasses import dataclass
 
 from .model import laws
+from .model.exponential import ExponentialScheme
 from .model.methods import METHODS as INTEGRATORS
 from .model.params import KernelParams
 
@@ -41,6 +42,13 @@ class Key:
         return f"adaptive methods: {self.meaning}" if self.adaptive else self.meaning
 
 
+def _kind(method):
+    """A method in a few words, from its tableau (the registry's entries, model/methods.py)."""
+    if not method.adaptive:
+        return "fixed step"
+    return f"adaptive {'exponential' if isinstance(method.tableau, ExponentialScheme) else 'IMEX'}"
+
+
 # integrator.rtol's default: the fastest ark4 tolerance whose magnitudes and recurrence times are
 # indistinguishable from rtol 1e-7's at 1e5 events per point (b = 20 and 50, N = 800); 1e-3's
 # recurrence times at b = 50 are not (benchmarks/statistics.py --catalogs, docs/benchmarks.md).
@@ -48,8 +56,9 @@ class Key:
 # (Law.method: exp4 for the aging law, ark4 for the others; config.from_dict).
 CREEP_TOL_FLOOR = 1e-12
 KEYS = {
-    "method": Key("ark4", "text", "event integrator (exp4 exponential in the aging law's state, its default; "
-                                  "ark4, ark3, ark5 adaptive IMEX; rk4 fixed step)"),
+    "method": Key("ark4", "text", "event integrator: "
+                  + ", ".join(f"{name} ({_kind(m)})" for name, m in INTEGRATORS.items())
+                  + "; a config without it takes its law's (exp4 for the aging law, ark4 for the others)"),
     "dt": Key(1e-3, "model time", "step of rk4; first step of the adaptive methods",
               lambda x: 0 < x <= 1, "in (0, 1]"),
     "rtol": Key(1e-4, "1", "relative tolerance of the local error per step", lambda x: 0 < x < 1, "in (0, 1)",
