@@ -3,6 +3,7 @@
     __main__.py       `python -m analysis`
     cli.py            the command line: reduce, plot, report, paper, export, compare
     statistics/       the statistics as plug-ins, one module each, and their registry (statistics/__init__.py)
+    options.py        a reduction's options, from what the statistics declare: the record, the arguments, the checks
     merge.py          catalogs -> the one task table a reduction works on: which tasks pool, in which order
     region.py         `reduce --region`: the faults of a population pooled as one region observes them
     reduce.py         catalog -> per-task tables (streamed) -> per-point statistics with bootstrap intervals
@@ -18,5 +19,5 @@
     compare_plot.py   the comparison's figures
     export.py         catalogs and summaries as tables: numpy structured arrays, pandas DataFrames, CSV files
     export_tables.py  what each exported table's columns are, and their rows
-    export_csv.py     CSV files of an export's tables
+    export_csv.py     CSV files of an export's tables (a format is one module export_<name>.py)
 """
