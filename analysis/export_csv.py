@@ -3,7 +3,8 @@
 An export format is one module analysis/export_<name>.py that defines FORMAT = (file suffix, writer), the
 writer(path, name, table, source, settings) writing one table (export_tables.Table) into `path`, through
 ensemble.space.write_file; export.py finds it, and `analysis export --format <name>` takes it."""
-from ensemble import __version__, space
+from ensemble import space
+from ensemble.version import __version__
 
 from .export_tables import TITLES
 

@@ -9,6 +9,8 @@ Its packages, each listing its own modules in its __init__.py:
 
 and the modules the commands and packages share:
 
+    api.py          the Python front door: load_config (a path, a TOML text or a dict), simulate (in this process)
+    version.py      the package's version
     __main__.py     `python -m ensemble`
     cli.py          the command line: run, resume, validate, status, slurm
     config.py       TOML config -> validated frozen dataclasses (the one source of parameter truth)
@@ -26,4 +28,16 @@ and the modules the commands and packages share:
     kernel_cache.py where numba keeps the compiled kernels: one place for every entry point
     pipes.py        `python -m ensemble status X | head -1` ends quietly: stdout's reader going away is no error
 """
-__version__ = "0.1.0"
+from .version import __version__
+
+# the Python front door (api.py, docs/api.md): `ensemble.simulate(config, "out.h5")`, `ensemble.load_config()`;
+# found when first asked for, so that `import ensemble` stays light
+API = ("RunError", "load_config", "simulate")
+__all__ = ["__version__", *API]
+
+
+def __getattr__(name):
+    if name in API:
+        from . import api
+        return getattr(api, name)
+    raise AttributeError(f"module 'ensemble' has no attribute {name!r}")

@@ -9,7 +9,7 @@ import os
 import signal
 import sys
 
-from . import __version__
+from .version import __version__
 from .run.abort import abort
 from .store.errors import CatalogError
 from .store.files import partial_path

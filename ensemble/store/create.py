@@ -7,7 +7,7 @@ HDF5's creation calls and attribute writes are collective (files.create_file ope
 import h5py
 import numpy as np
 
-from .. import __version__
+from ..version import __version__
 from ..model import laws
 from ..sweep import spinups as spinup_points
 from . import tables

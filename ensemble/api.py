@@ -1,0 +1,75 @@
+"""The package's Python front door (docs/api.md): run a config in this process and get its catalog.
+
+(The function is `simulate`: `ensemble.run` is the package that runs it, ensemble/run/.)
+
+    import ensemble
+    path = ensemble.simulate({"model": {"N": 50}, "run": {"seeds": 2, "events": 500}}, "small.h5")
+
+(`import analysis` reads it: analysis.events(path), analysis.reduce(path), docs/api.md.)
+
+`python -m ensemble run` is the same run (ensemble.run.runner.run) with the command line's log and exit codes;
+here a run that cannot start raises (ConfigError for a bad config, RunError otherwise) and a run whose tasks
+failed raises RunError naming the catalog, which keeps what they wrote (resume it with `python -m ensemble
+resume`, or simulate(..., resume=True)).
+"""
+import copy
+import os
+from pathlib import Path
+
+from .config import ConfigError, from_dict, load, loads, replace
+
+__all__ = ["RunError", "load_config", "simulate"]
+
+
+class RunError(RuntimeError):
+    """A run that was refused, stopped or whose tasks failed; the message says which and names the catalog."""
+
+
+def load_config(source, overrides=()):
+    """A validated config (ensemble.config.Config) from a TOML file's path, a TOML text or a dict of sections
+    ({"model": {"N": 50, "b": 20.0}, ...}); overrides: "section.key=value" texts, as `--set` takes them."""
+    if isinstance(source, dict):
+        from .config import _apply_overrides, parse_override
+        raw = copy.deepcopy(source)
+        return from_dict(raw, _apply_overrides(raw, [(o, parse_override(o)) for o in overrides]))
+    if isinstance(source, os.PathLike) or (isinstance(source, str) and "\n" not in source
+                                            and source.strip().endswith(".toml")):
+        return load(source, overrides)
+    if isinstance(source, (str, bytes)):
+        return loads(source, overrides)
+    raise ConfigError(f"a config is a path, a TOML text or a dict of sections, not {type(source).__name__}")
+
+
+def simulate(source, output=None, *, overrides=(), force=False, resume=False, log=None, comm=None):
+    """Run every task of the config `source` (load_config()'s) into one event catalog and return its path.
+
+    output: the catalog's path (default: the config's output.path); force: replace an existing catalog; resume:
+    continue an interrupted run from its checkpoints. log: a print-like function for the run's lines (default:
+    silent). comm: the MPI communicator whose ranks share the tasks (default: MPI.COMM_WORLD; one process, a
+    serial run). Raises RunError when the run is refused, stopped by a signal, or some of its tasks failed."""
+    from mpi4py import MPI
+
+    from .run.context import RunContext
+    from .run.decision import Refused
+    from .run.lock import LockError
+    from .run.runner import EXIT_INTERRUPTED, run as run_tasks
+    cfg = load_config(source, overrides)
+    if output is not None:
+        cfg = replace(cfg, "output", path=str(output))
+    inputs = (str(source),) if isinstance(source, (str, os.PathLike)) and not str(source).count("\n") else ()
+    try:
+        code = run_tasks(RunContext(cfg, cfg.output.path, comm or MPI.COMM_WORLD, log=log or _silent, resume=resume,
+                                    force=force, command="ensemble.simulate(...)", inputs=inputs))
+    except (LockError, Refused) as err:
+        raise RunError(str(err)) from None
+    if code == EXIT_INTERRUPTED:
+        raise RunError(f"{cfg.output.path}: the run was stopped by a signal and checkpointed; "
+                       "simulate(..., resume=True) continues it")
+    if code != 0:
+        raise RunError(f"{cfg.output.path}: some tasks failed (their errors are in the catalog's task table, "
+                       "ensemble.tasks); the others finished")
+    return Path(cfg.output.path)
+
+
+def _silent(*args, **kwargs):
+    pass
