@@ -20,4 +20,16 @@
     export.py         catalogs and summaries as tables: numpy structured arrays, pandas DataFrames, CSV files
     export_tables.py  what each exported table's columns are, and their rows
     export_csv.py     CSV files of an export's tables (a format is one module export_<name>.py)
+    reduction.py      a reduction as one call: catalogs -> summary on the ranks of a communicator
+    api.py            the Python front door: summarize (catalogs -> Summary), Summary, events, tasks
 """
+# the Python front door (api.py, docs/api.md), found when first asked for: `import analysis` stays light
+API = ("Summary", "events", "summarize", "tasks")
+__all__ = list(API)
+
+
+def __getattr__(name):
+    if name in API:
+        from . import api
+        return getattr(api, name)
+    raise AttributeError(f"module 'analysis' has no attribute {name!r}")

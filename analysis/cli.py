@@ -22,19 +22,13 @@ paths (an existing output without --force, as in `python -m ensemble run`; and t
 trajectory given twice). Under mpirun an error on one rank aborts all.
 """
 import argparse
-import os
 import sys
 
-from ensemble import checks, filekind
+from ensemble import checks
 from ensemble.store.errors import CatalogError
 
-from . import merge, options, summary
-from .reduce import LAYOUT, NUMBERS, bin_edges
-
-# errors that reduce's rank 0 finds before the work starts and every rank then raises alike
-# (ensemble.run.abort.on_root), with their exit codes; any other error on any rank aborts them all
-# (merge.MergeError is a ValueError: exit 2)
-COLLECTIVE = {ValueError: 2, CatalogError: 1, summary.SummaryError: 1, OSError: 1}
+from . import options, summary
+from .reduce import LAYOUT
 
 # Every numeric option of every command (argparse dest -> its check), applied to the options a
 # command has before it reads a file: argparse hands them over as text, so that "nan", "inf" and
@@ -128,125 +122,14 @@ def _reduce(args):
     from mpi4py import MPI
 
     from ensemble.run.abort import run_guarded
-    comm = MPI.COMM_WORLD
-    return run_guarded(comm, lambda: _reduce_on(comm, args), COLLECTIVE)
 
-
-def _default_output(catalogs):
-    if len(catalogs) > 1:
-        raise ValueError("reducing several catalogs into one summary: give its path with -o")
-    name = str(catalogs[0])
-    if name.endswith(".partial"):   # X.h5.partial -> X.partial.summary.h5, beside the final one's name
-        return name.removesuffix(".partial").removesuffix(".h5") + ".partial.summary.h5"
-    return name.removesuffix(".h5") + ".summary.h5"
-
-
-def _scales(args, inputs):
-    """The friction law's scales (Law.scales) of the catalogs, for the options whose default is the law's and that
-    were not given; None when every such option was given."""
-    missing = [o for o in options.declared("reduce").values()
-               if getattr(args, o.name) is None and options.default(o) is None]
-    if not missing:
-        return None
-    from ensemble.model import laws
-    names = sorted({merge.law_name(law) for law in inputs.tasks["law"]})
-    for name in names:
-        if name not in laws.LAWS:
-            raise ValueError(f"friction law {name!r} is unknown to this version: give "
-                             + ", ".join(o.flag for o in missing))
-    if len({laws.get(name).scales for name in names}) > 1:
-        raise ValueError(f"the catalogs hold points of several friction laws ({', '.join(names)}), whose "
-                         "magnitudes lie on different scales: give " + ", ".join(o.flag for o in missing))
-    return laws.get(names[0]).scales
-
-
-def check_summary_output(out, catalogs, force):
-    """The summary's path (checks.output: before any file is read); --force replaces a summary,
-    never anything else (a catalog, a config)."""
-    checks.output(out, inputs=catalogs, force=force, what="summary")
-    checks.output(f"{out}.partial", inputs=catalogs, force=True, what="summary")   # written first, then renamed
-    if os.path.exists(out) and filekind.identify(out)[0] != "summary":
-        raise checks.UsageError(f"{out} {filekind.describe(out)}; --force replaces only a reduction summary")
-    return out
-
-
-def _memory(opt, n_tasks):
-    """Refuse options whose arrays this machine cannot hold: rank 0 gathers every task's (stretches, entries) tables
-    and stacks them for the summary; a point's bootstrap keeps, per resample, its picks of units (at most tasks x
-    blocks), its numbers and its curves, and a statistic's extras about as much again as its curves (the recurrence
-    peaks' resampled counts)."""
-    edges = bin_edges(opt)
-    per_task = opt.blocks * sum(LAYOUT.width(name, edges) for name in LAYOUT.tables)
-    curves = sum(len(edges[LAYOUT.tables[c.table].bins]) - 1 for c in LAYOUT.curves if c.values is None)
-    resamples = opt.bootstrap * (2 * curves + len(NUMBERS) + n_tasks * opt.blocks)
-    checks.memory(f"--blocks {opt.blocks}, --bootstrap {opt.bootstrap} and {curves} bins of curves over {n_tasks} "
-                  "tasks", 8 * (2 * n_tasks * per_task + resamples))
-
-
-def _prepare(args):
-    """Options, output path, and the catalogs' task table (merge.Inputs); every check before the work."""
+    from .reduction import COLLECTIVE, Request, reduce_on
     check_numbers(args)                      # every option before any file is read
-    out = check_summary_output(args.output or _default_output(args.catalogs), args.catalogs, args.force)
-    for given in ("region_span", "region_skip"):
-        if getattr(args, given) is not None and not args.region:
-            raise checks.UsageError(f"--{given.replace('_', '-')} sets the window of a regional reduction: "
-                                    f"give --region too")
-    # (checks each file's kind first)
-    inputs = merge.read(args.catalogs, allow_partial=args.partial, region=args.region, span=args.region_span,
-                        skip=args.region_skip or 0.0)
-    opt = options.make("reduce", _scales(args, inputs), **options.given(args, "reduce"))
-    _memory(opt, len(inputs.tasks["point"]))
-    return opt, out, inputs
-
-
-def _check_counts(inputs, per_task):
-    """Every rank reduced as many rows as rank 0 read from the commit rows (a run still writing
-    the catalog could have committed more in between)."""
-    for g, h in per_task.items():
-        if h.rows != int(inputs.tasks["events_written"][g]):
-            path = inputs.paths[inputs.tasks["catalog"][g]]
-            raise CatalogError(f"{path}: task {inputs.tasks['catalog_task'][g]}: its event count "
-                               "changed while it was reduced (is a run still writing it?)")
-
-
-def _reduce_on(comm, args):
-    from ensemble.run.abort import abort_on_error, on_root
-
-    from .reduce import MIN_UNITS, point_statistics, unreliable
-    rank, size = comm.Get_rank(), comm.Get_size()
-    opt, out, inputs = on_root(comm, lambda: _prepare(args), tuple(COLLECTIVE))
-    mine = [g for g in range(len(inputs.tasks["point"])) if g % size == rank]
-    with abort_on_error(comm):   # rank 0 waits in gather for every other rank's part
-        parts = comm.gather(merge.reduce_share(inputs, mine, opt), root=0)
-    if rank != 0:
-        return 0
-    per_task = {k: h for part in parts for k, h in part.items()}
-    _check_counts(inputs, per_task)
-    points = []
-    for params, ids in inputs.points:
-        result = point_statistics(per_task, ids, opt, merge.bootstrap_rng(opt.seed, params),
-                                  whole="faults" if args.region else "seeds")
-        result["params"] = params
-        points.append(result)
-    for line in inputs.warnings:
-        print(f"warning: {line}", file=sys.stderr)
-    summary.write(out, inputs, per_task, points, opt, force=args.force)
-    if inputs.partial:
-        print(inputs.partial)
-    for i, p in enumerate(points):
-        why = unreliable(p["units"], p["method"])
-        if why:
-            what = (f"region {i} ({p['params']['region']})" if args.region else f"point {i} ({p['params']['law']}: "
-                    f"{', '.join(f'{k} = {v:g}' for k, v in p['params'].items() if k != 'law' and v == v)})")
-            print(f"warning: {what}: {why}", file=sys.stderr)
-    methods = sorted({p["method"] for p in points})
-    print(f"wrote {out}: {len(points)} {'regions' if args.region else 'parameter points'}, {len(per_task)} tasks"
-          + (f" from {len(inputs.paths)} catalogs" if len(inputs.paths) > 1 else "")
-          + "; intervals from "
-          f"{opt.bootstrap} bootstrap resamples over {' / '.join(methods)}"
-          + (f" (fewer than {MIN_UNITS} seeds per point: block bootstrap over stretches of each trajectory)"
-             if "blocks" in methods else ""))
-    return 0
+    request = Request(args.catalogs, args.output, partial=args.partial, force=args.force, region=args.region,
+                      region_span=args.region_span, region_skip=args.region_skip,
+                      given=options.given(args, "reduce"))
+    comm = MPI.COMM_WORLD
+    return run_guarded(comm, lambda: reduce_on(comm, request), COLLECTIVE)
 
 
 def _plot(args):

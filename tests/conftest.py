@@ -110,6 +110,8 @@ QUICK = {
     "test_writes.py": ["test_no_module_writes_a_file_around_the_helper"],
 }
 NOT_QUICK = {   # test files with no test in the quick tier, and why
+    "test_api.py": "the worked example of docs/api.md is a run and two reductions, checked against the commands' "
+                   "(25 s)",
     "test_sequences.py": "every test needs a serial catalog and a full-chain reference (10 s and more)",
     "test_hard_cases.py": "hard cases at their own sizes (N = 6400, t = 1e15): tens of seconds each",
     "test_kernel_identity.py": "compiles the kernels of a reference commit first (about 15 s, more under load)",
