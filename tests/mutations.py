@@ -199,7 +199,7 @@ MUTATIONS = (
              'points.append(({**dict(zip(PARAMS, key)), "law": law}, sorted(rows)))',
              ("tests/test_reduction.py", "tests/test_analysis.py"),
              "a pooled point's intervals change with the order in which its catalogs are given"),
-    Mutation("merge-bootstrap-by-point-index", "analysis/cli.py",
+    Mutation("merge-bootstrap-by-point-index", "analysis/reduction.py",
              "merge.bootstrap_rng(opt.seed, params)",
              "merge.np.random.default_rng(merge.np.random.SeedSequence(opt.seed, spawn_key=(len(points),)))",
              ("tests/test_reduction.py", "tests/test_analysis.py"),
