@@ -178,11 +178,10 @@ def _tables(path, names, chunk=schema.READ_CHUNK, partial=True):
 def _formats():
     """{format: (file suffix, writer(path, name, table, source, settings))}: every module analysis/export_<format>.py
     that defines FORMAT (export_csv.py: csv)."""
-    import analysis
     found = {}
-    for info in pkgutil.iter_modules(analysis.__path__):
+    for info in pkgutil.iter_modules([os.path.dirname(__file__)]):
         if info.name.startswith("export_"):
-            module = importlib.import_module(f"analysis.{info.name}")
+            module = importlib.import_module(f"{__package__}.{info.name}")
             if hasattr(module, "FORMAT"):
                 found[info.name.removeprefix("export_")] = module.FORMAT
     return found
