@@ -347,7 +347,7 @@ MUTATIONS = (
              "a catalog exported a whole task at a time, however large"),
     Mutation("export-failure-leaves-files", "analysis/export.py",
              "            if os.path.exists(tmp):\n                os.remove(tmp)", "            pass",
-             ("tests/test_export.py::test_api_streams_the_catalog_in_verified_chunks",),
+             ("tests/test_export.py::test_an_export_that_fails_at_a_later_table_leaves_nothing",),
              "an export that fails on a corrupt catalog leaves partial files behind"),
     Mutation("export-peak-interval-swapped", "analysis/statistics/recurrence.py",
              '"tnu_lo": peaks[point, rank, 1], "tnu_hi": peaks[point, rank, 2]',

@@ -499,3 +499,18 @@ def test_an_export_format_is_one_file(files, tmp_path):
         assert lines[0].split("\t") == list(want.dtype.names) and len(lines) == 1 + len(want)
     res = analysis("export", files / "cat.h5", "--format", "tsv", "-o", tmp_path / "none")
     assert res.returncode == 2 and "tsv" in res.stderr and not (tmp_path / "none").exists()
+
+
+def test_an_export_that_fails_at_a_later_table_leaves_nothing(files, tmp_path, monkeypatch):
+    """The first table written whole, the second failing (a disk filling up between them): neither the first
+    table's file (written beside its name) nor the folder the export made is left."""
+    suffix, write_csv = export.FORMATS["csv"]
+
+    def fails_at_the_tasks(path, name, table, source, settings=""):
+        if name == "tasks":
+            raise OSError(28, "No space left on device")
+        write_csv(path, name, table, source, settings)
+    monkeypatch.setitem(export.FORMATS, "csv", (suffix, fails_at_the_tasks))
+    with pytest.raises(OSError, match="No space left"):
+        export.write(files / "cat.h5", tmp_path / "out", partial=True)
+    assert not (tmp_path / "out").exists()
