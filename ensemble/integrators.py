@@ -1,6 +1,6 @@
 """Event integrators as the config names them: the [integrator] keys, and the kernels' parameter record.
 
-The registry itself, `INTEGRATORS` (config name -> model.methods.Method: tableau, stages, control
+The registry itself, `INTEGRATORS` (config name -> model.methods.Method: scheme, stages, control
 exponent, description), lives beside the kernels in model/methods.py, since it decides what they
 compile; adding a method is one entry there. All run through the same event kernel
 (ensemble.model.event.integrate_event), which locates sticks and onsets inside a step the same way
@@ -15,7 +15,6 @@ if the kernels read it).
 from dataclasses import dataclass
 
 from .model import laws
-from .model.exponential import ExponentialScheme
 from .model.methods import METHODS as INTEGRATORS
 from .model.params import KernelParams
 
@@ -42,13 +41,6 @@ class Key:
         return f"adaptive methods: {self.meaning}" if self.adaptive else self.meaning
 
 
-def _kind(method):
-    """A method in a few words, from its tableau (the registry's entries, model/methods.py)."""
-    if not method.adaptive:
-        return "fixed step"
-    return f"adaptive {'exponential' if isinstance(method.tableau, ExponentialScheme) else 'IMEX'}"
-
-
 # integrator.rtol's default: the fastest ark4 tolerance whose magnitudes and recurrence times are
 # indistinguishable from rtol 1e-7's at 1e5 events per point (b = 20 and 50, N = 800); 1e-3's
 # recurrence times at b = 50 are not (benchmarks/statistics.py --catalogs, docs/benchmarks.md).
@@ -57,7 +49,7 @@ def _kind(method):
 CREEP_TOL_FLOOR = 1e-12
 KEYS = {
     "method": Key("ark4", "text", "event integrator: "
-                  + ", ".join(f"{name} ({_kind(m)})" for name, m in INTEGRATORS.items())
+                  + ", ".join(f"{name} ({m.kind})" for name, m in INTEGRATORS.items())
                   + "; a config without it takes its law's (exp4 for the aging law, ark4 for the others)"),
     "dt": Key(1e-3, "model time", "step of rk4; first step of the adaptive methods",
               lambda x: 0 < x <= 1, "in (0, 1]"),

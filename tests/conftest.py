@@ -116,6 +116,7 @@ NOT_QUICK = {   # test files with no test in the quick tier, and why
     "test_hard_cases.py": "hard cases at their own sizes (N = 6400, t = 1e15): tens of seconds each",
     "test_kernel_identity.py": "compiles the kernels of a reference commit first (about 15 s, more under load)",
     "test_third_law.py": "compiles a copy of the package with a third law (about a minute)",
+    "test_new_integrator.py": "compiles a copy of the package with a sixth integrator (about a minute and a half)",
     "test_export.py": "every test reads the module's catalog and summary (8 s to make); export is in the quick tier "
                       "through test_creep_statistics.py",
     "test_attacks.py": "every attack starts from a catalog of its own (7 s and more); the quick tier's flipped byte "

@@ -7,6 +7,8 @@
   blocks on a read; it waits on conditions (`wait_for`) and for the exit (`wait`), each with a
   deadline, and leaving its `with` block kills whatever is left.
 - `wait_for`: poll a condition until a deadline, instead of sleeping a guessed length.
+- `package_copy`: the packages copied into a folder, for a test that adds a file to them, and the
+  environment of a command run on the copy.
 - `ensemble_here`: `python -m ensemble ...` in this process, for a command that needs no process of
   its own (no signal, kill or crash, no mpiexec): a process costs ~2.5 s of imports and kernel
   loading, more than a test's small run.
@@ -14,6 +16,7 @@
 Every command gets no standard input (CI has none; a read must not wait for a terminal).
 """
 import os
+import shutil
 import signal
 import subprocess
 import threading
@@ -36,6 +39,15 @@ def child_env(**extra):
     env.update(OMP_NUM_THREADS="1", NUMBA_NUM_THREADS="1")
     env.update(extra)
     return env
+
+
+def package_copy(tree, *packages, own_cache=False):
+    """Copy this checkout's `packages` ("ensemble", "analysis") into the folder `tree`, for a test that adds a
+    file to the copy; returns the environment of a command run on the copy (own_cache: a numba cache of its
+    own in the tree, for a copy whose kernel sources differ)."""
+    for name in packages:
+        shutil.copytree(ROOT / name, tree / name, ignore=shutil.ignore_patterns("__pycache__"))
+    return child_env(PYTHONPATH=str(tree), **({"NUMBA_CACHE_DIR": str(tree / ".numba_cache")} if own_cache else {}))
 
 
 def _children():

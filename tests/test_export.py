@@ -24,6 +24,7 @@ from ensemble.store.errors import CatalogError
 from ensemble.config import loads
 from ensemble.sweep import task_list
 
+from .processes import package_copy
 from .test_reduction import CONFIG, N_CHAIN, ROOT, write_catalog
 
 TIMEOUT = 300    # seconds for one subprocess (each takes a few)
@@ -482,8 +483,7 @@ def test_an_export_format_is_one_file(files, tmp_path):
     of the catalog and of the summary as .tsv files holding what the API returns; without the file, `--format tsv`
     is refused (exit 2)."""
     tree = tmp_path / "tree"
-    for name in ("analysis", "ensemble"):
-        shutil.copytree(ROOT / name, tree / name, ignore=shutil.ignore_patterns("__pycache__"))
+    package_copy(tree, "analysis", "ensemble")
     (tree / "analysis" / "export_tsv.py").write_text(TSV)
 
     def in_tree(*args):

@@ -8,13 +8,12 @@ option and show the rest, and the summary stores the table, the number and the o
 and its estimate and interval are those of the events themselves.
 """
 import re
-import shutil
 import sys
 
 import h5py
 import numpy as np
 
-from .processes import ROOT, child_env, run_bounded
+from .processes import child_env, package_copy, run_bounded
 from .test_summary_identity import CATALOG, gunzip
 
 ONE_BLOCK = '''"""The share of the inertial events that slip at most `small_n` blocks (a test's new statistic),
@@ -63,8 +62,7 @@ STATISTIC = Statistic(
 
 def _tree(tmp_path, with_statistic):
     tree = tmp_path / ("tree" if with_statistic else "without")
-    for name in ("analysis", "ensemble"):
-        shutil.copytree(ROOT / name, tree / name, ignore=shutil.ignore_patterns("__pycache__"))
+    package_copy(tree, "analysis", "ensemble")
     if with_statistic:
         (tree / "analysis" / "statistics" / "one_block.py").write_text(ONE_BLOCK)
     return tree

@@ -9,7 +9,6 @@ half a period, having slipped 2 drop / k (k = 1 + 2 l^2 inside the chain, 1 + l^
 Slow by nature (the slower tier, `make slow`, which CI runs): the copy's kernels compile for the new law,
 about a minute and a half.
 """
-import shutil
 import sys
 
 import numpy as np
@@ -17,7 +16,7 @@ import pytest
 
 from ensemble.store import reader
 
-from .processes import child_env, run_bounded
+from .processes import package_copy, run_bounded
 
 COULOMB = '''"""Coulomb friction: static threshold 1, dynamic 1 - drop, no state (a test's third law)."""
 from collections import namedtuple
@@ -83,13 +82,11 @@ LAW = Law(
 @pytest.fixture(scope="module")
 def copy_with_a_third_law(tmp_path_factory):
     root = tmp_path_factory.mktemp("third_law")
-    src = __import__("ensemble").__path__[0]
-    shutil.copytree(src, root / "ensemble", ignore=shutil.ignore_patterns("__pycache__"))
+    env = package_copy(root, "ensemble", own_cache=True)
     (root / "ensemble/model/laws/coulomb.py").write_text(COULOMB)
     (root / "cfg.toml").write_text('[model]\nN = 40\nl = 3.0\nnu = 0.01\nlaw = "coulomb"\ndrop = 0.05\n\n'
                                    '[run]\nseeds = 2\nevents = 400\ntransient = 100\n\n'
                                    '[integrator]\nmethod = "ark4"\nrtol = 1e-8\n')
-    env = child_env(PYTHONPATH=str(root), NUMBA_CACHE_DIR=str(root / ".numba_cache"))
     return root, env
 
 

@@ -1,4 +1,4 @@
-"""One event of the chain, integrated on the active set (fixed-step RK4 or adaptive IMEX).
+"""One event of the chain, integrated on the active set by the chosen method (methods.py).
 
 Only sliding blocks are integrated. Blocks at rest that neighbour a sliding
 block are checked for onset after every step; all other blocks at rest can only

@@ -38,12 +38,27 @@ class ExponentialScheme(NamedTuple):
     order: int
     embedded_order: int
     c: tuple                 # nodes (the fifth is the new state)
-    error_weights: tuple     # b - bhat at z = 0 (the slip's and velocity's; methods.error_weights)
+    b_minus_bhat: tuple      # at z = 0 (the slip's and velocity's; methods.error_weights)
+    kind = "adaptive exponential"
+
+    def stepper(self):
+        """exp_step, written out below for this scheme."""
+        return exp_step
+
+    def error_weights(self):
+        return np.array(self.b_minus_bhat)
+
+    def refusal(self, law):
+        """Why the scheme cannot integrate `law` (laws.Law), or None: the state must be linear in theta."""
+        if law.has_state and law.linear_state is None:
+            return (f"needs a state equation linear in theta = exp(psi) (Law.linear_state), which "
+                    f"model.law = {law.name!r} does not have")
+        return None
 
 
 ETDRK4_KROGSTAD = ExponentialScheme("ETDRK4 (Krogstad) with an embedded order 3", 4, 3,
                                     c=(0.0, 0.5, 0.5, 1.0, 1.0),
-                                    error_weights=(0.0, 0.0, 0.0, 1.0 / 6.0, -1.0 / 6.0))
+                                    b_minus_bhat=(0.0, 0.0, 0.0, 1.0 / 6.0, -1.0 / 6.0))
 
 # classical RK4 rows (the exponential tableau at z = 0), and its weights
 _A = ((0.0, 0.0, 0.0, 0.0), (0.5, 0.0, 0.0, 0.0), (0.0, 0.5, 0.0, 0.0), (0.0, 0.0, 1.0, 0.0),

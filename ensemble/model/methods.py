@@ -1,9 +1,16 @@
 """Event integrators: the registry (config name -> Method), and the calls through which the kernel steps.
 
-An entry's tableau decides the rest: an IMEX pair of tableaux.py gives an adaptive method (its
-stages, its step-size control exponent from the embedded order, its error weights), an
-exponential scheme of exponential.py the adaptive exponential integrator written out there
-(_STEPPERS: the stepper of each kind of tableau), None the classical RK4 at the fixed step dt.
+An entry is a name, a scheme and a description. The scheme decides the rest; it is any record with
+
+    c                 its nodes (their number is the right-hand sides per block and step)
+    embedded_order    the order q of its embedded method (None: a fixed step, not controlled)
+    kind              a few words ("adaptive IMEX"; the config's description of integrator.method)
+    stepper()         its numba step, with take_step's arguments and returns (below)
+    error_weights()   b - bhat as floats, what steppers.block_error weighs the stages in W with
+    refusal(law)      why it cannot integrate a friction law (laws.Law), or None
+
+as an IMEX pair of tableaux.py (one stepper for every pair), the exponential scheme of
+exponential.py and classical RK4 (steppers.ClassicalRK4) are.
 
 The kernels receive the method as a record (KernelParams.method, a MethodRecord) of one type for every
 method, so numba compiles them once per friction law and every method is in that one compilation:
@@ -14,8 +21,8 @@ is the same code, with the same arithmetic, as when the kernels were compiled on
 The registry lives beside the kernels because it decides what they compile: the numba cache is
 keyed on the sources of this package (model/__init__.py).
 
-Adding a method: its pair in tableaux.py, one entry in METHODS. A method may refuse a friction law
-(Method.refusal: exp4 needs a state linear in theta = exp(psi)).
+Adding a method: its scheme and stepper (a new pair is only its coefficients in tableaux.py), one
+entry in METHODS (tests/test_new_integrator.py adds Heun's method in a copy of the package).
 """
 import functools
 from dataclasses import dataclass
@@ -25,9 +32,9 @@ import numba as nb
 import numpy as np
 from numba.extending import overload
 
-from .exponential import ETDRK4_KROGSTAD, ExponentialScheme, exp_step
-from .steppers import ark_step, rk4_step
-from .tableaux import ARK324, ARK436, ARK548, ArkPair
+from .exponential import ETDRK4_KROGSTAD
+from .steppers import ClassicalRK4
+from .tableaux import ARK324, ARK436, ARK548
 from .workspace import ARK_STAGES
 
 
@@ -43,28 +50,33 @@ class MethodRecord(NamedTuple):
 class Method:
     """An event integrator as the config names it."""
     name: str             # the value of integrator.method
-    tableau: object       # an adaptive method's pair: IMEX (tableaux.ArkPair) or exponential
-                          # (exponential.ExponentialScheme); None: classical RK4
+    scheme: object        # its scheme (the module's docstring): tableaux.ArkPair,
+                          # exponential.ExponentialScheme, steppers.ClassicalRK4
     description: str      # one paragraph, for the docs and `validate`
 
     def __post_init__(self):
-        if self.tableau is not None and len(self.tableau.c) > ARK_STAGES:
-            raise ValueError(f"{self.name}: {len(self.tableau.c)} stages, the work array holds "
+        if len(self.scheme.c) > ARK_STAGES:
+            raise ValueError(f"{self.name}: {len(self.scheme.c)} stages, the work array holds "
                              f"{ARK_STAGES} (workspace.ARK_STAGES)")
 
     @property
     def adaptive(self):
-        return self.tableau is not None
+        return self.scheme.embedded_order is not None
 
     @property
     def stages(self):
         """Right-hand-side evaluations per block and step."""
-        return len(self.tableau.c) if self.adaptive else 4
+        return len(self.scheme.c)
 
     @property
     def control_exponent(self):
         """-1 / (q + 1), q the order of the embedded method (0 for RK4, which has none)."""
-        return -1.0 / (self.tableau.embedded_order + 1) if self.adaptive else 0.0
+        return -1.0 / (self.scheme.embedded_order + 1) if self.adaptive else 0.0
+
+    @property
+    def kind(self):
+        """The method in a few words."""
+        return self.scheme.kind
 
     def kernel_params(self):
         """The method's record for the kernels (KernelParams.method)."""
@@ -74,16 +86,14 @@ class Method:
     def refusal(self, law):
         """Why this method cannot integrate the friction law `law` (laws.Law), one line naming the
         keys; None if it can."""
-        if isinstance(self.tableau, ExponentialScheme) and law.has_state and law.linear_state is None:
-            return (f"integrator.method = {self.name!r} needs a state equation linear in theta = exp(psi) "
-                    f"(Law.linear_state), which model.law = {law.name!r} does not have: choose another "
-                    f"integrator.method")
-        return None
+        reason = self.scheme.refusal(law)
+        return None if reason is None else (f"integrator.method = {self.name!r} {reason}: choose another "
+                                            f"integrator.method")
 
 
 METHODS = {m.name: m for m in (
-    Method("rk4", None, "classical fourth-order Runge-Kutta with fixed step integrator.dt "
-                        "(the paper's method); stable only while dt / theta < 2.785"),
+    Method("rk4", ClassicalRK4(), "classical fourth-order Runge-Kutta with fixed step integrator.dt "
+                                  "(the paper's method); stable only while dt / theta < 2.785"),
     Method("ark3", ARK324, "adaptive IMEX Runge-Kutta ARK3(2)4L[2]SA: explicit in slip and "
                            "velocity, L-stable implicit in the state; step controlled by "
                            "integrator.rtol / atol, at most integrator.max_step"),
@@ -100,38 +110,11 @@ METHODS = {m.name: m for m in (
 )}
 
 
-def _ark_stepper(pair):
-    c, ae, ai, bw, bd, gamma = pair.kernel_arrays()
-
-    def step(W, act, na, n, tau, h, p, yrest, first, at_first):
-        work, slip_time, err = ark_step(W, act, na, n, tau, h, p, yrest, c, ae, ai, bw, bd, gamma)
-        return work, slip_time, err, _NO_SUMS, _NO_SUMS
-    return nb.njit(error_model="numpy")(step)
-
-
-_NO_SUMS = (0.0, 0.0)   # a stepper that evaluates every stage passes on no sums (take_step)
-
-
-@nb.njit(error_model="numpy")
-def _rk4_stepper(W, act, na, n, tau, h, p, yrest, first, at_first):
-    work, slip_time, err = rk4_step(W, act, na, n, tau, h, p, yrest)
-    return work, slip_time, err, _NO_SUMS, _NO_SUMS
-
-
-# the stepper of each kind of tableau, and its error weights (b - bhat) for steppers.block_error
-_STEPPERS = {
-    ArkPair: (_ark_stepper, lambda pair: pair.kernel_arrays()[4]),
-    ExponentialScheme: (lambda scheme: exp_step, lambda scheme: np.array(scheme.error_weights)),
-}
-
-
 @functools.cache
 def _stepper(method):
     """The numba function that takes one step of `method` (compiled once a process; not inlined:
     one copy however often the kernel steps, with steppers.py's error model)."""
-    if not method.adaptive:
-        return _rk4_stepper
-    return _STEPPERS[type(method.tableau)][0](method.tableau)
+    return method.scheme.stepper()
 
 
 _STEP_ARGS = "W, act, na, n, tau, h, p, yrest, first, at_first"
@@ -154,9 +137,9 @@ def _dispatch():
 
 
 def _error_weight_rows():
-    """(rows, lengths): row k of `rows` holds b - bhat of method k's pair (METHODS' order; none for rk4),
+    """(rows, lengths): row k of `rows` holds b - bhat of method k's scheme (METHODS' order; none for rk4),
     its first lengths[k] entries; the rest are zero."""
-    weights = [_STEPPERS[type(m.tableau)][1](m.tableau) if m.adaptive else np.zeros(0) for m in METHODS.values()]
+    weights = [np.asarray(m.scheme.error_weights(), dtype=float) for m in METHODS.values()]
     rows = np.zeros((len(weights), max(len(w) for w in weights)))
     for k, w in enumerate(weights):
         rows[k, :len(w)] = w

@@ -10,7 +10,8 @@ The event loop calls them through methods.take_step, which also says where the s
 is (`first`, one of FIRST_* below) and returns the sums of the friction power and of the total slip
 at the step's first and last evaluation: a stepper whose last evaluation is at the new state
 (exponential.exp_step) reuses it as the next step's first (FSAL), and a retry from the same start
-reuses its first stage. The steppers here evaluate every stage (methods.py adapts their calls).
+reuses its first stage. The steppers here evaluate every stage (rk4_stepper and ark_stepper give them
+take_step's arguments and returns).
 
 - rk4_step: classical RK4, the paper's method; stable only while h / theta < 2.785.
 - ark_step: a step of an additive (IMEX) Runge-Kutta pair of tableaux.py, such as ARK3(2)4L[2]SA,
@@ -20,7 +21,10 @@ reuses its first stage. The steppers here evaluate every stage (methods.py adapt
   block, solved by the law's implicit_state. Order p with an embedded estimate of order p - 1 for
   step-size control. Each method of the registry (methods.py) runs it with its own tableau.
 """
+from typing import NamedTuple
+
 import numba as nb
+import numpy as np
 
 from .geometry import left, right, spring_force
 from .laws import friction, has_state, implicit_state, loader_moves, state_rate
@@ -78,6 +82,43 @@ def stage_columns(W, act, na, n, tau, p, yrest, s, weight, with_state, keep_stat
         if keep_state:
             W[i, ARK_G + s] = W[i, KP]
     return pw + weight * power, ys + weight * ysum
+
+
+NO_SUMS = (0.0, 0.0)   # a stepper that evaluates every stage passes on no sums (methods.take_step)
+
+
+class ClassicalRK4(NamedTuple):
+    """Classical RK4 at the fixed step integrator.dt, as the registry sees a scheme (methods.Method):
+    no embedded pair (embedded_order None: the step is not controlled), no error weights."""
+    name: str = "classical RK4"
+    c: tuple = (0.0, 0.5, 0.5, 1.0)
+    embedded_order: object = None
+    kind = "fixed step"
+
+    def stepper(self):
+        return rk4_stepper
+
+    def error_weights(self):
+        return np.zeros(0)
+
+    def refusal(self, law):
+        return None
+
+
+@nb.njit(error_model="numpy")
+def rk4_stepper(W, act, na, n, tau, h, p, yrest, first, at_first):
+    """rk4_step with methods.take_step's arguments and returns."""
+    work, slip_time, err = rk4_step(W, act, na, n, tau, h, p, yrest)
+    return work, slip_time, err, NO_SUMS, NO_SUMS
+
+
+def ark_stepper(c, ae, ai, bw, bd, gamma):
+    """ark_step with the pair's arrays (tableaux.ArkPair.kernel_arrays) frozen in, with
+    methods.take_step's arguments and returns: one compiled copy per pair."""
+    def step(W, act, na, n, tau, h, p, yrest, first, at_first):
+        work, slip_time, err = ark_step(W, act, na, n, tau, h, p, yrest, c, ae, ai, bw, bd, gamma)
+        return work, slip_time, err, NO_SUMS, NO_SUMS
+    return nb.njit(error_model="numpy")(step)
 
 
 @nb.njit(cache=True, error_model="numpy")
@@ -139,7 +180,7 @@ def rk4_step(W, act, na, n, tau, h, p, yrest):
 @nb.njit(cache=True, error_model="numpy", inline="always")
 def ark_step(W, act, na, n, tau, h, p, yrest, c, ae, ai, bw, bd, gamma):
     """One step of the IMEX pair (c, ae, ai, gamma; weights bw, error weights bd = b - bhat), as
-    tableaux.ArkPair.kernel_arrays gives them (methods.py compiles one copy per pair).
+    tableaux.ArkPair.kernel_arrays gives them (ark_stepper compiles one copy per pair).
 
     Stage s: slip and velocity explicit from the earlier stages' rates, psi
     implicit (one scalar solve per block) with diagonal gamma.

@@ -1,12 +1,14 @@
 """Butcher tableaux of the IMEX additive Runge-Kutta pairs, in exact fractions.
 
-Pure data and the conversions the kernels need; the order conditions are
-checked in tests/test_ark4.py.
+Data, the conversions the kernels need, and what the registry (methods.py) asks of a scheme; the
+order conditions are checked in tests/test_ark4.py.
 """
 from fractions import Fraction
 from typing import NamedTuple
 
 import numpy as np
+
+from .steppers import ark_stepper
 
 
 class ArkPair(NamedTuple):
@@ -26,6 +28,18 @@ class ArkPair(NamedTuple):
     gamma: str
     b: tuple
     bhat: tuple
+    kind = "adaptive IMEX"
+
+    def stepper(self):
+        """The pair's stepper (steppers.ark_step with its arrays), compiled on first use."""
+        return ark_stepper(*self.kernel_arrays())
+
+    def error_weights(self):
+        """b - bhat (steppers.block_error)."""
+        return self.kernel_arrays()[4]
+
+    def refusal(self, law):
+        return None
 
     def matrices(self):
         """(c, A_E, A_I, b, bhat) as Fractions; A_E and A_I square, A_I with its diagonal."""
