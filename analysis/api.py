@@ -58,13 +58,10 @@ def summarize(catalogs, output=None, *, partial=False, force=False, region=False
     request = Request(paths, None if output is None else str(output), partial=partial, force=force, region=region,
                       region_span=region_span, region_skip=region_skip, given=checked)
     comm = comm or MPI.COMM_WORLD
-    reduce_on(comm, request, say=say or _silent, warn=lambda line: warnings.warn(line, stacklevel=3))
+    reduce_on(comm, request, say=say or (lambda *args, **kwargs: None),
+              warn=lambda line: warnings.warn(line, stacklevel=3))
     comm.Barrier()     # the summary is written (by rank 0) before any rank reads it
     return Summary(request.output or default_output(paths))
-
-
-def _silent(*args, **kwargs):
-    pass
 
 
 class Summary:

@@ -75,9 +75,22 @@ def reduce_task(chunks, written, nu, n_blocks_chain, opt, rows=None, layout=LAYO
     rows of every kind in all) into its tables (statistics.Tables: {table: (stretches, width)}; the
     attribute `rows` the rows read). Every statistic is fed each chunk once. The chunks are consumed to
     their end (the catalog checks a task's checksum there)."""
-    k = opt.blocks
-    out = layout.empty(k, bin_edges(opt, n_blocks_chain, layout))
+    out = layout.empty(opt.blocks, bin_edges(opt, n_blocks_chain, layout))
     out.rows = 0
+    for seen in task_rows(chunks, written, nu, n_blocks_chain, opt, rows, layout):
+        for statistic in layout.statistics:
+            statistic.feed(out, seen)
+    out.carry.clear()    # the statistics' carry of this task ends with it
+    for name in layout.samples:   # a stretch's sample: one array of its values in the order fed
+        out[name] = [np.concatenate(parts) if parts else np.zeros(0) for parts in out[name]]
+    return out
+
+
+def task_rows(chunks, written, nu, n_blocks_chain, opt, rows=None, layout=LAYOUT):
+    """The statistics' view of each chunk of one task's rows (statistics.Rows: the inertial events and creep
+    episodes apart, their stretches, the recurrences of each large-event criterion so far), as reduce_task feeds
+    them; arguments as there."""
+    k = opt.blocks
     scanners = {c: RecurrenceScanner(n_blocks_chain, float(getattr(opt, c.threshold)), getattr(opt, c.window))
                 for c in _criteria(layout)} if written else {}
     lo = row = 0
@@ -98,16 +111,10 @@ def reduce_task(chunks, written, nu, n_blocks_chain, opt, rows=None, layout=LAYO
                 src, T, interior = scanner.feed(ev["t"], ev["epicenter"], values, ev["boundary"])
                 scans[criterion.name] = ((src * k) // written, T * nu, interior)
             lo = hi
-        seen = Rows(part, inertial, ev, block, creep, creep_block, scans.get("mu"), t_before, nu, opt, n_blocks_chain,
-                    ev is not None and lo == written, scans)
-        for statistic in layout.statistics:
-            statistic.feed(out, seen)
+        yield Rows(part, inertial, ev, block, creep, creep_block, scans.get("mu"), t_before, nu, opt, n_blocks_chain,
+                   ev is not None and lo == written, scans)
         if ev is not None:
             t_before = ev["t"][-1]
-    out.carry.clear()    # the statistics' carry of this task ends with it
-    for name in layout.samples:   # a stretch's sample: one array of its values in the order fed
-        out[name] = [np.concatenate(parts) if parts else np.zeros(0) for parts in out[name]]
-    return out
 
 
 def _creep_stretches(inertial, creep, before, row, written, rows, k):

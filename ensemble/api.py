@@ -32,12 +32,22 @@ def load_config(source, overrides=()):
         from .config import _apply_overrides, parse_override
         raw = copy.deepcopy(source)
         return from_dict(raw, _apply_overrides(raw, [(o, parse_override(o)) for o in overrides]))
-    if isinstance(source, os.PathLike) or (isinstance(source, str) and "\n" not in source
-                                            and source.strip().endswith(".toml")):
+    if _path(source) is not None:
         return load(source, overrides)
     if isinstance(source, (str, bytes)):
         return loads(source, overrides)
     raise ConfigError(f"a config is a path, a TOML text or a dict of sections, not {type(source).__name__}")
+
+
+def _path(source):
+    """The config file `source` names (a path, or one line of text naming an existing file or ending in .toml,
+    which load() then finds or says is missing), or None for a TOML text or a dict."""
+    if isinstance(source, os.PathLike):
+        return Path(source)
+    if isinstance(source, str) and "\n" not in source and (source.strip().endswith(".toml")
+                                                         or Path(source).is_file()):
+        return Path(source)
+    return None
 
 
 def simulate(source, output=None, *, overrides=(), force=False, resume=False, log=None, comm=None):
@@ -56,9 +66,9 @@ def simulate(source, output=None, *, overrides=(), force=False, resume=False, lo
     cfg = load_config(source, overrides)
     if output is not None:
         cfg = replace(cfg, "output", path=str(output))
-    inputs = (str(source),) if isinstance(source, (str, os.PathLike)) and not str(source).count("\n") else ()
+    inputs = () if _path(source) is None else (str(source),)
     try:
-        code = run_tasks(RunContext(cfg, cfg.output.path, comm or MPI.COMM_WORLD, log=log or _silent, resume=resume,
+        code = run_tasks(RunContext(cfg, cfg.output.path, comm or MPI.COMM_WORLD, log=log or _quiet, resume=resume,
                                     force=force, command="ensemble.simulate(...)", inputs=inputs))
     except (LockError, Refused) as err:
         raise RunError(str(err)) from None
@@ -71,5 +81,5 @@ def simulate(source, output=None, *, overrides=(), force=False, resume=False, lo
     return Path(cfg.output.path)
 
 
-def _silent(*args, **kwargs):
-    pass
+def _quiet(*args, **kwargs):
+    """A log that says nothing."""

@@ -108,10 +108,9 @@ QUICK = {
     "test_quick_tier.py": ["test_every_test_named_in_the_quick_tier_exists",
                            "test_every_test_file_is_in_the_quick_tier_or_says_why_not"],
     "test_writes.py": ["test_no_module_writes_a_file_around_the_helper"],
+    "test_api.py": ["test_a_config_is_a_path_a_toml_text_or_a_dict"],
 }
 NOT_QUICK = {   # test files with no test in the quick tier, and why
-    "test_api.py": "the worked example of docs/api.md is a run and two reductions, checked against the commands' "
-                   "(25 s)",
     "test_sequences.py": "every test needs a serial catalog and a full-chain reference (10 s and more)",
     "test_hard_cases.py": "hard cases at their own sizes (N = 6400, t = 1e15): tens of seconds each",
     "test_kernel_identity.py": "compiles the kernels of a reference commit first (about 15 s, more under load)",

@@ -93,3 +93,21 @@ def test_bad_input_raises_what_the_commands_refuse_with(example, tmp_path):
     with pytest.raises(SummaryError, match="not a reduction summary"):
         analysis.Summary(d / "small.h5")
     assert not (tmp_path / "s.h5").exists()
+
+
+def test_a_config_is_a_path_a_toml_text_or_a_dict(tmp_path, monkeypatch):
+    """load_config takes the same config four ways; a one-line string is a file's name when such a file exists or
+    it ends in .toml (then a missing file is said as one), else TOML text."""
+    import ensemble
+    from ensemble.config import ConfigError
+    text = "[model]\nN = 7\n"
+    (tmp_path / "cfg.conf").write_text(text)
+    monkeypatch.chdir(tmp_path)
+    for source in ({"model": {"N": 7}}, text, tmp_path / "cfg.conf", "cfg.conf", "model.N = 7"):
+        cfg = ensemble.load_config(source)
+        assert cfg.model.N == 7
+    assert ensemble.load_config("cfg.conf", ["model.N=9"]).model.N == 9
+    with pytest.raises(ConfigError, match="missing.toml: no such config file"):
+        ensemble.load_config("missing.toml")
+    with pytest.raises(ConfigError, match="a config is a path"):
+        ensemble.load_config(7)

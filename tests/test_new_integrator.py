@@ -82,6 +82,20 @@ ENTRY = ('    Method("heun", HeunEuler(), "Heun\'s method with Euler\'s embedded
          'explicit"),\n')
 IMPORT = "from .heun import HeunEuler\n"
 
+# one event of a 12-block chain from the same onset, with Heun at two tolerances and ark4 far below both: Heun's
+# step control is that of an embedded order 1 (steps ~ rtol^(-1/2): 10x for 100x tighter; ark4's 3.1x, ark3's 4.1x)
+EVENT = """
+import numpy as np
+from ensemble.config import Integrator, Model
+from ensemble.events import advance_to_onset, check, run_event
+model = Model(N=12)
+force, psi = -np.random.default_rng(3).uniform(0, 1, 12), np.zeros(12)
+epicenter, _, force, psi = advance_to_onset(force, psi, model)
+for method, rtol in (("heun", 1e-6), ("heun", 1e-8), ("ark4", 1e-12)):
+    r = check(run_event(force, psi, epicenter, model, Integrator(method=method, rtol=rtol)))
+    print(r.steps, repr(r.slip), r.relative_energy_residual, np.count_nonzero(r.profile))
+"""
+
 CONFIG = """[model]
 N = 12
 b = 20.0
@@ -135,6 +149,12 @@ def test_an_integrator_by_its_stepper_and_one_entry_validates_and_runs_ark4s_eve
     path, meaning, stages = res.stdout.strip().splitlines()
     assert path == str(root / "ensemble/__init__.py")                 # the copy, not this tree
     assert "heun (adaptive explicit)" in meaning and stages == "2"    # derived from the entry
+    res = run_bounded([sys.executable, "-c", EVENT], 300, cwd="/", env=env)
+    assert res.returncode == 0, res.stderr
+    (loose, *_), (tight, slip, residual, slipped), (_, reference, *_) = [
+        [float(x) for x in line.split()] for line in res.stdout.splitlines()]
+    assert slipped == 12 and 7 < tight / loose < 14, (loose, tight)    # second order, and its own stepper
+    assert abs(slip / reference - 1) < 1e-7 and residual < 1e-8
     for method in ("heun", "ark4"):
         res = ensemble(root, env, "run", f"{method}.toml", "-o", f"{method}.h5")
         assert res.returncode == 0, res.stderr

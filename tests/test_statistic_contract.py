@@ -72,14 +72,15 @@ def test_every_statistic_touches_only_what_it_declares(catalog, command):
         n_blocks, nu = int(tasks["N"][k]), float(tasks["nu"][k])
         kinds |= set(np.unique(part["kind"]))
         edges = reduce.bin_edges(opt, n_blocks, layout)
-        tables = reduce.reduce_task(iter([part]), int(np.count_nonzero(part["kind"] == schema.KIND_EVENT)), nu,
-                                    n_blocks, opt, len(part["t"]), layout)
+        written = int(np.count_nonzero(part["kind"] == schema.KIND_EVENT))
+        tables = reduce.reduce_task(iter([part]), written, nu, n_blocks, opt, len(part["t"]), layout)
         for st in layout.statistics:
             own, allowed = {t.name for t in st.tables}, allowed_options(st)
             # feed: the task's rows as one chunk, into fresh tables
             seen, watch = set(), Watched(opt)
-            st.feed(WatchedTables(layout, dict(layout.empty(opt.blocks, edges)), seen),
-                    _rows(part, opt.blocks, nu, watch, n_blocks, layout, opt))
+            rows = next(reduce.task_rows(iter([part]), written, nu, n_blocks, watch, len(part["t"]), layout))
+            watch.read.clear()        # the recurrences' criteria read theirs: the statistic has not yet
+            st.feed(WatchedTables(layout, dict(layout.empty(opt.blocks, edges)), seen), rows)
             assert seen <= own, f"{st.name}'s feed touches the tables {sorted(seen - own)} of others"
             assert watch.read <= allowed, \
                 f"{st.name}'s feed reads the undeclared options {sorted(watch.read - allowed)}"
@@ -96,25 +97,6 @@ def test_every_statistic_touches_only_what_it_declares(catalog, command):
             assert watch.read <= allowed, \
                 f"{st.name}'s estimate reads the undeclared options {sorted(watch.read - allowed)}"
     assert kinds == {schema.KIND_EVENT, schema.KIND_CREEP} and len(layout.statistics) >= 3
-
-
-def _rows(part, blocks, nu, opt, n_blocks, layout, real_opt):
-    """The Rows of one chunk, as reduce_task hands them to every statistic (its recurrences included)."""
-    from analysis.recurrence import RecurrenceScanner
-    from analysis.statistics import Rows
-    inertial = part["kind"] == schema.KIND_EVENT
-    creep = part["kind"] == schema.KIND_CREEP
-    ev = {name: column[inertial] for name, column in part.items()}
-    written = int(inertial.sum())
-    block = (np.arange(written) * blocks) // max(written, 1)
-    scans = {}
-    for c in reduce._criteria(layout):
-        scanner = RecurrenceScanner(n_blocks, float(getattr(real_opt, c.threshold)), getattr(real_opt, c.window))
-        src, T, interior = scanner.feed(ev["t"], ev["epicenter"], np.asarray(ev[c.column], dtype=float),
-                                        ev["boundary"])
-        scans[c.name] = ((src * blocks) // max(written, 1), T * nu, interior)
-    creep_block = np.minimum(((np.cumsum(inertial) - inertial)[creep] * blocks) // max(written, 1), blocks - 1)
-    return Rows(part, inertial, ev, block, creep, creep_block, scans.get("mu"), np.nan, nu, opt, n_blocks, True, scans)
 
 
 @pytest.mark.parametrize("command", COMMANDS)

@@ -205,13 +205,14 @@ def holds(s, statistic):
             and all(f"points/{name}" in s for name in statistic.extra_datasets))
 
 
-def number_text(est, lo, hi):
-    """A number as the report prints it: "0.84 [0.77, 0.91]", the estimate alone without an interval, "-" if NaN."""
+def number_text(est, lo, hi, digits=".4g", missing="-"):
+    """A number as the report prints it: "0.84 [0.77, 0.91]", the estimate alone without an interval, `missing` if
+    NaN; digits: the format of each (".2f" in a figure's label)."""
     if not np.isfinite(est):
-        return "-"
-    if np.isfinite(lo):
-        return f"{est:.4g} [{lo:.4g}, {hi:.4g}]"
-    return f"{est:.4g}"
+        return missing
+    if np.isfinite(lo) and np.isfinite(hi):
+        return f"{est:{digits}} [{lo:{digits}}, {hi:{digits}}]"
+    return f"{est:{digits}}"
 
 
 def report_line(label, text):

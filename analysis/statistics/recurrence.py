@@ -110,13 +110,6 @@ def _zoom(s, i, x, peak):
     return draw_inset
 
 
-def interval_text(est, lo, hi):
-    """'0.84 [0.77, 0.91]' (or the estimate alone, or 'n/a')."""
-    if not np.isfinite(est):
-        return "n/a"
-    return f"{est:.2f} [{lo:.2f}, {hi:.2f}]" if np.isfinite(lo) and np.isfinite(hi) else f"{est:.2f}"
-
-
 def figure_size(n):
     from ..drawing import grid
     rows, cols = grid(n)
@@ -141,7 +134,7 @@ def draw(summaries, fig, keys, labels, names, title):
         band(ax, x, s["points/tnu_interior_density"][i], s["points/tnu_interior_lo"][i],
              s["points/tnu_interior_hi"][i], "interior events (the rupture reaches neither end)", "C3", style="--")
         if "points/numbers/cv_tnu" in s:       # (summaries before format 4 have no intervals statistic)
-            label += "\nCV of $T\\nu$ " + interval_text(*s["points/numbers/cv_tnu"][i])
+            label += "\nCV of $T\\nu$ " + number_text(*s["points/numbers/cv_tnu"][i], digits=".2f", missing="n/a")
         ax.set_title(label, fontsize=FONT + 1)
         ax.set_xlabel(r"$T\nu$")
         ax.set_ylabel(r"$P(T\nu)$")
