@@ -93,7 +93,7 @@ force, psi = -np.random.default_rng(3).uniform(0, 1, 12), np.zeros(12)
 epicenter, _, force, psi = advance_to_onset(force, psi, model)
 for method, rtol in (("heun", 1e-6), ("heun", 1e-8), ("ark4", 1e-12)):
     r = check(run_event(force, psi, epicenter, model, Integrator(method=method, rtol=rtol)))
-    print(r.steps, repr(r.slip), r.relative_energy_residual, np.count_nonzero(r.profile))
+    print(r.steps, repr(float(r.slip)), repr(float(r.relative_energy_residual)), np.count_nonzero(r.profile))
 """
 
 CONFIG = """[model]
