@@ -109,6 +109,9 @@ QUICK = {
                            "test_every_test_file_is_in_the_quick_tier_or_says_why_not"],
     "test_writes.py": ["test_no_module_writes_a_file_around_the_helper"],
     "test_api.py": ["test_a_config_is_a_path_a_toml_text_or_a_dict"],
+    "test_rupture_statistics.py": ["test_the_tables_are_the_events_whatever_the_chunks",
+                                   "test_the_correlation_length_recovers_the_scale_of_exponential_draws",
+                                   "test_a_hand_built_sequence_gives_its_classes"],
 }
 NOT_QUICK = {   # test files with no test in the quick tier, and why
     "test_sequences.py": "every test needs a serial catalog and a full-chain reference (10 s and more)",

@@ -48,6 +48,11 @@ BAD = {
     "seis_ring": ["nan", "inf", "-1", "1e400"],
     "seis_short": ["nan", "inf", "-1", "1e400"],
     "seis_long": ["nan", "inf", "-0.5", "1e400"],
+    "lr_bins": ["0.5:nan:20", "0:1600", "1600:0:20", "0:1600:0", "0:1e308:10000000000"],
+    "lr_min": ["nan", "inf", "0", "-3", "2.5", "10" + "0" * 30],
+    "lr_max": ["nan", "inf", "0", "10" + "0" * 30],
+    "class_min": ["nan", "inf", "0", "x"],
+    "uni_edge": ["nan", "inf", "-0.1", "0.6", "x"],
     "region_span": ["nan", "inf", "0", "-1", "1e400", "x"],
     "region_skip": ["nan", "inf", "-1", "1e400", "x"],
 }

@@ -51,6 +51,8 @@ The statistics today (the registry finds a module by its STATISTIC; this list is
     seismicity.py         seismicity around large events: foreshocks, aftershocks, quiescence, the rate map
     rupture.py            rupture lengths n (the comparison's size axis): R(log10 n), the dip, the power law
     regularity.py         how periodic the large events by rupture length recur (the comparison's)
+    rupture_length.py     P(L_r) of the rupture lengths and its exponential tail: the correlation length L_0
+    rupture_classes.py    unilateral and bilateral ruptures: their shares, R(mu), epicenters at a past rim
 """
 import importlib
 import math
