@@ -83,9 +83,10 @@ def brute_force(part, opt):
     return want
 
 
-@pytest.mark.parametrize("seed", [1, 2])
-def test_the_tables_are_the_events_whatever_the_chunks(seed):
-    part, opt = synthetic(700, seed), options()
+@pytest.mark.parametrize("seed,lr_max", [(1, 80), (2, 10 ** 9)])
+def test_the_tables_are_the_events_whatever_the_chunks(seed, lr_max):
+    """lr_max 10^9: the fit ends at N - 1, whole-chain ruptures out."""
+    part, opt = synthetic(700, seed), options(lr_max=lr_max)
     want = brute_force(part, opt)
     written = int(np.count_nonzero(part["kind"] == KIND_EVENT))
     for size in (700, 13, 1):
@@ -93,6 +94,15 @@ def test_the_tables_are_the_events_whatever_the_chunks(seed):
         for table, name in (("lr", "lr"), ("mu_uni", "mu_uni"), ("mu_bi", "mu_bi"), ("fit", "rupture_length"),
                             ("classes", "rupture_classes")):
             np.testing.assert_array_equal(out[name], want[table], err_msg=f"{name}, chunks of {size}")
+    # the numbers: of the summed tables, as the brute force's sums give them
+    n, excess, span = want["fit"].sum(axis=0)
+    u = reduce.LAYOUT.sum_of({name: table.sum(axis=0) for name, table in out.items() if name in reduce.LAYOUT.tables})
+    l0, n_fit = rupture_length.estimate(u, opt)
+    assert n_fit == n and l0 == rupture_length.correlation_length(n, excess, min(lr_max, N_BLOCKS - 1) - opt.lr_min)
+    assert np.isfinite(l0)
+    c = dict(zip(rupture_classes.COLUMNS, want["classes"].sum(axis=0)))
+    assert rupture_classes.estimate(u, opt) == [c["n_classified"], c["n_uni"] / c["n_classified"],
+                                                c["n_uni_rim"] / c["n_uni_prev"], c["n_bi_rim"] / c["n_bi_prev"]]
     # what the comparison stands on: each class, with and without a predecessor at its rim, in several stretches
     assert np.all(want["classes"].sum(axis=0) > 0) and np.all(want["fit"][:, 0] > 0)
 
