@@ -1,0 +1,19 @@
+#!/bin/bash
+# The runs and reductions behind docs/successors.md. Usage: bash examples/successors/run.sh [ranks] [out_dir]
+# (from the repository root; out_dir defaults to runs/successors). An interrupted run is resumed.
+set -euo pipefail
+ranks=${1:-2}
+out=${2:-runs/successors}
+mkdir -p "$out"
+py=.venv/bin/python
+cat="$out/ruptures.h5"
+if [ -e "$cat.partial" ]; then
+    mpirun -n "$ranks" $py -m ensemble resume "$cat"
+elif [ ! -e "$cat" ]; then
+    mpirun -n "$ranks" $py -m ensemble run examples/successors/ruptures.toml -o "$cat"
+fi
+$py -m analysis reduce "$cat" -o docs/successors/ruptures.summary.h5 --force
+$py -m analysis report docs/successors/ruptures.summary.h5 > docs/successors/ruptures.report.txt
+for figure in rupture_length rupture_classes; do
+    $py -m analysis plot docs/successors/ruptures.summary.h5 --figure $figure -o docs/successors/$figure.png
+done
