@@ -73,7 +73,8 @@ from .statistics import bin_names
 
 FORMAT = filekind.SUMMARY_FORMAT_PREFIX + "6"   # 6: checksums (a `crc32` on every dataset, `attrs_crc32` over
 # the file's attributes: seal, checked by read); a statistic added since (the rupture lengths and classes) adds its
-# datasets to it, and a summary written before lacks them (statistics.holds: not shown). 5: the seismicity around large events (/bins/seis_*,
+# datasets to it, and a summary written before lacks them (statistics.holds: not shown). 5: the seismicity around
+# large events (/bins/seis_*,
 # /per_task/seis_*, /per_task/seismicity, /points/seismicity_rate, its numbers, the seis_* attributes). 4: the
 # intervals statistic (/per_task/intervals, cv_tnu, mean_gap, cv_gap). 3: the creep episodes (bins, per-task
 # counts and sums, densities, CREEP_NUMBERS). 2: GR b and its standard error, 9 per-task sums, peaks by

@@ -46,7 +46,9 @@ LOG10_E = math.log10(math.e)
 N_CHAIN = 40
 OPT = {"mu_bins": (-1.0, 7.0, 32),     # width 0.25: magnitudes on the 0.25 grid sit on edges
        "tnu_bins": (0.0, 40.0, 40),    # width 1: grid times give T nu on the edges
-       "mu_c": 4.0, "window": 3, "b_cut": 3.0, "bootstrap": 100, "seed": 11}
+       "mu_c": 4.0, "window": 3, "b_cut": 3.0, "bootstrap": 100, "seed": 11,
+       # the rupture statistics on the synthetic chain of N_CHAIN blocks
+       "lr_bins": (0.5, 40.5, 8), "lr_min": 2, "lr_max": 30, "class_min": 3, "uni_edge": 0.2}
 
 # `python -m analysis reduce` with the rows streamed in chunks of argv[1] events (options.CHUNK has no
 # command-line option): small chunks make recurrences straddle them (reduce_here: the same in this process)
@@ -63,7 +65,8 @@ def reduce_command(chunk, paths, out, level, blocks):
             "--mu-bins={}:{}:{}".format(*o["mu_bins"]), "--tnu-bins={}:{}:{}".format(*o["tnu_bins"]),
             "--mu-c", str(o["mu_c"]), "--window", str(o["window"]), "--b-cut", str(o["b_cut"]),
             "--bootstrap", str(o["bootstrap"]), "--seed", str(o["seed"]), "--level", str(level),
-            "--blocks", str(blocks)]
+            "--blocks", str(blocks), "--lr-bins={}:{}:{}".format(*o["lr_bins"]), "--lr-min", str(o["lr_min"]),
+            "--lr-max", str(o["lr_max"]), "--class-min", str(o["class_min"]), "--uni-edge", str(o["uni_edge"])]
 
 
 def run(cmd):
@@ -99,7 +102,9 @@ def options(level, blocks):
     return {"mu_edges": np.linspace(*OPT["mu_bins"][:2], OPT["mu_bins"][2] + 1),
             "tnu_edges": np.linspace(*OPT["tnu_bins"][:2], OPT["tnu_bins"][2] + 1),
             "mu_c": OPT["mu_c"], "window": OPT["window"], "b_cut": OPT["b_cut"],
-            "bootstrap": OPT["bootstrap"], "level": level, "blocks": blocks, "seed": OPT["seed"]}
+            "bootstrap": OPT["bootstrap"], "level": level, "blocks": blocks, "seed": OPT["seed"],
+            "lr_edges": np.linspace(*OPT["lr_bins"][:2], OPT["lr_bins"][2] + 1),
+            **{name: OPT[name] for name in ("lr_min", "lr_max", "class_min", "uni_edge")}}
 
 
 # -- synthetic catalogs ---------------------------------------------------------------------
@@ -124,6 +129,10 @@ def synthetic_events(rng, task, n, gridded):
         mu[30:34] = 3.0
     half = rng.integers(0, 1 + (3 * np.clip(mu, 0, None)).astype(int))
     first, last = np.maximum(epi - half, 0), np.minimum(epi + half, N_CHAIN - 1)
+    # zones reaching no end: every third event's epicenter at its zone's right end, every third halfway (no draw,
+    # no end reached anew: the streams, and what the recurrences see, stay)
+    inside = (first > 0) & (last < N_CHAIN - 1)
+    last = np.where(inside, epi + half * (np.arange(n) % 3) // 2, last)
     return {"task": np.full(n, task, dtype=np.int64), "t": t, "epicenter": epi.astype(np.int64), "mu": mu,
             "slip": 10.0 ** mu, "first": first.astype(np.int64), "last": last.astype(np.int64),
             "n_slipped": (last - first + 1).astype(np.int64), "boundary": (first == 0) | (last == N_CHAIN - 1),
@@ -225,6 +234,10 @@ def test_catalogs_exercise_the_edges(references):
     assert np.any(np.isin(tnu, opt["tnu_edges"][1:-1])) and np.any(tnu == 0) and np.any(tnu > opt["tnu_edges"][-1])
     interior = np.concatenate([t.interior for t in raw])
     assert len(tnu) > 500 and 0.2 < interior.mean() < 0.8
+    # the rupture statistics: a finite L_0 with an interval, both classes, at and away from a predecessor's rim
+    for name in ("L0", "fraction_unilateral", "uni_at_rim", "bi_at_rim"):
+        est, lo, hi = exp[f"points/numbers/{name}"].T
+        assert np.all(np.isfinite(est)) and np.all(lo < hi) and np.all((est > 0) & ((est < 1) | (name == "L0"))), name
     # recurrences that straddle chunks of 7 and 13 rows and stretches
     start, end = np.concatenate([t.rec_start for t in raw]), np.concatenate([t.rec_end for t in raw])
     assert np.any(start // 7 != end // 7) and np.any(start // 13 != end // 13)
