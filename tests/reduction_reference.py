@@ -91,7 +91,7 @@ INTERVAL_COLUMNS = ("sum_tnu2", "n_gaps", "sum_gap", "sum_gap2")   # of /per_tas
 SEISMICITY_NUMBERS = ("background_rate", "foreshock_rate", "aftershock_rate", "quiescence_ratio", "doughnut_ratio")
 # the documented defaults of reduce --seis-time-bins -1000:1000:40, --seis-distance-bins 0:40:20, --seis-near 2,
 # --seis-ring 10, --seis-short 50, --seis-long 500
-RUPTURE = {"lr_edges": np.linspace(0.5, 1600.5, 321), "lr_min": 50, "lr_max": 10 ** 9, "class_min": 10,
+RUPTURE = {"lr_edges": np.linspace(0.5, 1600.5, 321), "lr_min": 200, "lr_max": 10 ** 9, "class_min": 10,
            "uni_edge": 0.1}
 RUPTURE_NUMBERS = ("L0", "n_L0", "n_classified", "fraction_unilateral", "uni_at_rim", "bi_at_rim")
 RUPTURE_CURVES = ("lr", "mu_uni", "mu_bi")

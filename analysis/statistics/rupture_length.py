@@ -9,7 +9,9 @@ K = top - lr_min, has a mean excess E[L_r - lr_min] rising monotonically with L_
 L_0 is the root of that mean = the events' mean excess, which is a function of sums (events, excess, K), so a
 resample's L_0 is that of its events exactly. No root (a mean excess at or above K / 2: the lengths do not fall
 off over the range) gives NaN, as fewer than two events do. The definition of L_r and the range are this
-code's choice: the paper's text was not at hand (docs/successors.md).
+code's choice: the paper's text was not at hand (docs/successors.md). lr_min's default, 200 blocks, lies past
+the hump of P(L_r) at the seed paper's b = 20 (its peak near 130 blocks): from 50 the fit would take the hump's
+rise for the tail. The tail is not quite exponential: L_0 falls as lr_min grows (docs/successors.md).
 """
 import math
 
@@ -126,7 +128,7 @@ STATISTIC = Statistic(
     curves=(Curve("lr", "lr", ("numbers", "n_events"), "L_r", "all events", "1/block"),),
     feed=feed, estimate=estimate, uses_tables=("numbers",),
     options=(Option("lr_bins", "bins", "0.5:1600.5:320", "blocks", "rupture-length bins lo:hi:n of P(L_r)"),
-             Option("lr_min", "count", 50, "blocks", "shortest rupture length of the L_0 fit", 1, 10 ** 9),
+             Option("lr_min", "count", 200, "blocks", "shortest rupture length of the L_0 fit", 1, 10 ** 9),
              Option("lr_max", "count", 10 ** 9, "blocks",
                     "longest rupture length of the L_0 fit (at most N - 1: whole-chain ruptures are out)",
                     1, 10 ** 9)),

@@ -13,7 +13,11 @@ elif [ ! -e "$cat" ]; then
     mpirun -n "$ranks" $py -m ensemble run examples/successors/ruptures.toml -o "$cat"
 fi
 $py -m analysis reduce "$cat" -o docs/successors/ruptures.summary.h5 --force
+for lo in 50 300; do      # the L_0 fit's lower end: its sensitivity (docs/successors.md)
+    $py -m analysis reduce "$cat" -o "$out/ruptures_lr$lo.summary.h5" --lr-min $lo --force
+    $py -m analysis report "$out/ruptures_lr$lo.summary.h5" | grep -E "^point|L_0" > docs/successors/lr_min_$lo.txt
+done
 $py -m analysis report docs/successors/ruptures.summary.h5 > docs/successors/ruptures.report.txt
 for figure in rupture_length rupture_classes; do
-    $py -m analysis plot docs/successors/ruptures.summary.h5 --figure $figure -o docs/successors/$figure.png
+    $py -m analysis plot docs/successors/ruptures.summary.h5 --figure $figure -o docs/successors/$figure.png --force
 done
