@@ -62,6 +62,9 @@ here the slow and obvious way, from the raw events:
   if min(e - first, last - e) <= uni_edge (last - first), else bilateral; it has a predecessor if a large event
   (mu >= mu_c) came before it in its task, and is at its rim if its epicenter lies within `window` of that
   last such event's first or last block; R(mu) of each class over its own count;
+- mean slip per block slip / n_slipped: its sum per lr bin over the events in the bin (the curve; NaN for an
+  empty bin); over the fit's events, those with 2 L >= lr_min + top (upper half) and the others (lower): the
+  mean over all of them, and the upper half's mean over the lower's;
 - a reduction is partial if a catalog's name ends in .partial or one of its tasks is not
   finished (status 1) or holds fewer than events_per_task events; the summary then states the
   events reduced of those expected and names those catalogs.
@@ -93,8 +96,9 @@ SEISMICITY_NUMBERS = ("background_rate", "foreshock_rate", "aftershock_rate", "q
 # --seis-ring 10, --seis-short 50, --seis-long 500
 RUPTURE = {"lr_edges": np.linspace(0.5, 1600.5, 321), "lr_min": 200, "lr_max": 10 ** 9, "class_min": 10,
            "uni_edge": 0.1}
-RUPTURE_NUMBERS = ("L0", "n_L0", "n_classified", "fraction_unilateral", "uni_at_rim", "bi_at_rim")
-RUPTURE_CURVES = ("lr", "mu_uni", "mu_bi")
+RUPTURE_NUMBERS = ("L0", "n_L0", "n_classified", "fraction_unilateral", "uni_at_rim", "bi_at_rim", "mean_slip_large",
+                   "slip_ratio")
+RUPTURE_CURVES = ("lr", "mu_uni", "mu_bi", "mean_slip")
 CLASS_COLUMNS = ("n_classified", "n_uni", "n_bi", "n_uni_prev", "n_uni_rim", "n_bi_prev", "n_bi_rim")
 SEIS = {"seis_time_edges": np.linspace(-1000, 1000, 41), "seis_distance_edges": np.linspace(0, 40, 21),
         "seis_near": 2.0, "seis_ring": 10.0, "seis_short": 50.0, "seis_long": 500.0}
@@ -294,7 +298,7 @@ def correlation_length(n, excess, span):
 
 
 def statistics(mu, tnu, interior, event_slip, creep_mu, creep_log_duration, creep_taken, creep_slip, gaps,
-               seis_cells, seis_exposure, block_span, lr, fit, cls, has_prev, at_rim, opt):
+               seis_cells, seis_exposure, block_span, lr, fit, cls, has_prev, at_rim, mean_slip, slip_half, opt):
     """Curves and numbers of pooled raw data: mu (all inertial events), tnu and interior
     (recurrences), event_slip (the inertial events' slips), the creep episodes' mu, log10(duration
     nu), taken over (ending 2) and slip, and the inter-event times (times nu) of the inertial events."""
@@ -352,7 +356,15 @@ def statistics(mu, tnu, interior, event_slip, creep_mu, creep_log_duration, cree
                                            int(np.count_nonzero((cls == 1) & has_prev))),
                     "bi_at_rim": quotient(int(np.count_nonzero((cls == 2) & at_rim)),
                                           int(np.count_nonzero((cls == 2) & has_prev)))})
+    lower, upper = mean_slip[slip_half == 0], mean_slip[slip_half == 1]
+    numbers["mean_slip_large"] = quotient(sum(float(x) for x in lower) + sum(float(x) for x in upper),
+                                          len(lower) + len(upper))
+    numbers["slip_ratio"] = quotient(quotient(sum(float(x) for x in upper), len(upper)),
+                                     quotient(sum(float(x) for x in lower), len(lower)))
     le = edges_of(opt, "lr_edges")
+    slip_sums = np.array([sum(float(x) for x, length in zip(mean_slip, lr) if le[j] <= length < le[j + 1])
+                          for j in range(len(le) - 1)])
+    in_bin = histogram(lr, le)
     ce, de = edges_of(opt, "creep_mu_edges"), edges_of(opt, "creep_duration_edges")
     curves = {"mu": density(histogram(mu, me), me, n),
               "tnu": density(h_t, te, len(tnu)),
@@ -361,7 +373,8 @@ def statistics(mu, tnu, interior, event_slip, creep_mu, creep_log_duration, cree
               "creep_duration": density(histogram(creep_log_duration, de), de, m),
               "lr": density(histogram(lr, le), le, n),
               "mu_uni": density(histogram(mu[cls == 1], me), me, n_uni),
-              "mu_bi": density(histogram(mu[cls == 2], me), me, n_bi)}
+              "mu_bi": density(histogram(mu[cls == 2], me), me, n_bi),
+              "mean_slip": np.array([x / c if c else math.nan for x, c in zip(slip_sums, in_bin)])}
     return curves, numbers
 
 
@@ -407,7 +420,8 @@ class Task:
                                        else np.zeros(0))
         self.creep_taken = column["ending"][creep] == 2 if creep else np.zeros(0, dtype=bool)
         self.creep_slip = column["slip"][creep].astype(float) if creep else np.zeros(0)
-        self.ruptures({name: column[name][inertial] for name in ("mu", "epicenter", "first", "last", "n_slipped")},
+        self.ruptures({name: column[name][inertial] for name in ("mu", "epicenter", "first", "last", "n_slipped",
+                                                                 "slip")},
                       n_blocks, opt, k, n)
         ev = {name: column[name][inertial] for name in ("t", "mu", "epicenter", "boundary")}
         self.n = n
@@ -431,13 +445,16 @@ class Task:
         whether a large event came before it and whether its epicenter lies at that event's rim."""
         lo, top = edges_of(opt, "lr_min"), min(edges_of(opt, "lr_max"), n_blocks - 1)
         self.lr = np.array([float(x) for x in ev["n_slipped"]])
-        fit, fit_stretch, cls, has_prev, at_rim = [], [], [], [], []
+        fit, fit_stretch, cls, has_prev, at_rim, mean_slip, slip_half = [], [], [], [], [], [], []
         previous = None
         for i in range(n):
             length, f, last, e = (int(ev[c][i]) for c in ("n_slipped", "first", "last", "epicenter"))
+            mean_slip.append(float(ev["slip"][i]) / length)
+            slip_half.append(-1)
             if lo <= length <= top:
                 fit.append((1.0, float(length - lo), float(top - lo)))
                 fit_stretch.append(i * k // n)
+                slip_half[-1] = 1 if 2 * length >= lo + top else 0
             c = 0
             if length >= edges_of(opt, "class_min") and f > 0 and last < n_blocks - 1:
                 c = 1 if min(e - f, last - e) <= edges_of(opt, "uni_edge") * (last - f) else 2
@@ -451,6 +468,8 @@ class Task:
         self.cls = np.array(cls, dtype=np.int64)
         self.has_prev = np.array(has_prev, dtype=bool)
         self.at_rim = np.array(at_rim, dtype=bool)
+        self.mean_slip = np.array(mean_slip, dtype=float)
+        self.slip_half = np.array(slip_half, dtype=np.int64)
 
     def seis(self, ev, nu, n_blocks, opt):
         """Every pair's cell and stretch (of its mainshock), every mainshock's exposure row and stretch."""
@@ -483,7 +502,7 @@ class Task:
         """(mu, tnu, interior, event slip, creep mu, creep log10(duration nu), creep taken over,
         creep slip) of the whole task or of one stretch."""
         creep = (self.creep_mu, self.creep_log_duration, self.creep_taken, self.creep_slip)
-        ruptures = (self.lr, self.fit, self.cls, self.has_prev, self.at_rim)
+        ruptures = (self.lr, self.fit, self.cls, self.has_prev, self.at_rim, self.mean_slip, self.slip_half)
         if stretch is None:
             return (self.mu, self.tnu, self.interior, self.event_slip, *creep, self.gaps, self.seis_cells,
                     self.seis_exposure, self.block_span, *ruptures)
@@ -491,7 +510,8 @@ class Task:
         return (self.mu[e], self.tnu[r], self.interior[r], self.event_slip[e], *(x[c] for x in creep),
                 self.gaps[self.gap_stretch == stretch], self.seis_cells[self.seis_cell_stretch == stretch],
                 self.seis_exposure[self.seis_main_stretch == stretch], self.block_span[self.gap_stretch == stretch],
-                self.lr[e], self.fit[self.fit_stretch == stretch], self.cls[e], self.has_prev[e], self.at_rim[e])
+                self.lr[e], self.fit[self.fit_stretch == stretch], self.cls[e], self.has_prev[e], self.at_rim[e],
+                self.mean_slip[e], self.slip_half[e])
 
     def per_stretch(self, opt):
         k, me, te = opt["blocks"], opt["mu_edges"], opt["tnu_edges"]
@@ -511,9 +531,13 @@ class Task:
         lr_h, fit_sums = np.zeros((k, len(le) - 1), dtype=np.int64), np.zeros((k, 3))
         classes = np.zeros((k, len(CLASS_COLUMNS)))
         uni_h, bi_h = np.zeros((k, len(me) - 1), dtype=np.int64), np.zeros((k, len(me) - 1), dtype=np.int64)
+        slip_h, slip_columns = np.zeros((k, len(le) - 1)), np.zeros((k, 4))
         for s in range(k):
             (mu, tnu, interior, event_slip, creep_mu, creep_log_duration, taken, creep_slip, gaps, cells,
-             exposure, block_span, lr, fit, cls, has_prev, at_rim) = self.unit(s)
+             exposure, block_span, lr, fit, cls, has_prev, at_rim, mean_slip, slip_half) = self.unit(s)
+            slip_h[s] = [mean_slip[(lr >= le[j]) & (lr < le[j + 1])].sum() for j in range(len(le) - 1)]
+            slip_columns[s] = [(slip_half == 0).sum(), mean_slip[slip_half == 0].sum(), (slip_half == 1).sum(),
+                               mean_slip[slip_half == 1].sum()]
             lr_h[s], fit_sums[s] = histogram(lr, le), fit.sum(axis=0)
             uni, bi = cls == 1, cls == 2
             classes[s] = [np.count_nonzero(cls > 0), uni.sum(), bi.sum(), (uni & has_prev).sum(), (uni & at_rim).sum(),
@@ -529,7 +553,7 @@ class Task:
             numbers[s] = [len(mu), np.count_nonzero(mu >= opt["mu_c"]), len(tnu), tnu.sum(),
                           interior.sum(), tnu[interior].sum(), len(gr), gr.sum(), (gr ** 2).sum()]
         return (mu_h, t_h, ti_h, numbers, cm_h, cd_h, creep, intervals, pairs, seis_exposure, seis_columns, lr_h,
-                fit_sums, classes, uni_h, bi_h)
+                fit_sums, classes, uni_h, bi_h, slip_h, slip_columns)
 
 
 def _pool(units, pick):
@@ -687,7 +711,7 @@ def expected_summary(catalogs, opt):
     stacks = [t.per_stretch(opt) for t in per_task]
     for j, name in enumerate(("mu", "tnu", "tnu_interior", "numbers", "creep_mu", "creep_duration", "creep",
                               "intervals", "seis_pairs", "seis_exposure", "seismicity", "lr", "rupture_length",
-                              "rupture_classes", "mu_uni", "mu_bi")):
+                              "rupture_classes", "mu_uni", "mu_bi", "slip_lr", "slip_scaling")):
         exp[f"per_task/{name}"] = np.stack([s[j] for s in stacks])
     results = []
     for params, rows in points:
@@ -752,7 +776,8 @@ def check_summary(s, expected, opt):
               "points/peaks", "attrs", "bins/lr"}
              | {f"per_task/{k}" for k in ("mu", "tnu", "tnu_interior", "numbers", "creep_mu", "creep_duration",
                                           "creep", "intervals", "seis_pairs", "seis_exposure", "seismicity", "lr",
-                                          "rupture_length", "rupture_classes", "mu_uni", "mu_bi")}
+                                          "rupture_length", "rupture_classes", "mu_uni", "mu_bi", "slip_lr",
+                                          "slip_scaling")}
              | {f"points/{p}" for p in PARAMS} | tasks_keys | numbers | curves)
     # a new output must get its brute-force check here
     assert set(s) == known, f"unchecked {set(s) - known}, missing {known - set(s)}"
@@ -804,6 +829,9 @@ def check_summary(s, expected, opt):
     for key in sorted(curves):
         np.testing.assert_allclose(s[key], expected[key], rtol=RTOL, atol=0, err_msg=key)
     np.testing.assert_array_equal(s["per_task/rupture_length"][..., 0], expected["per_task/rupture_length"][..., 0])
+    np.testing.assert_array_equal(s["per_task/slip_scaling"][..., ::2], expected["per_task/slip_scaling"][..., ::2])
+    for key in ("per_task/slip_lr", "per_task/slip_scaling"):
+        np.testing.assert_allclose(s[key], expected[key], rtol=RTOL, atol=0, err_msg=key)
     np.testing.assert_allclose(s["per_task/rupture_length"], expected["per_task/rupture_length"], rtol=RTOL, atol=0)
     for key in sorted(numbers):
         # L_0: a root found two ways (bisection there, brentq on a closed form here) agrees to 1e-9 relative

@@ -9,7 +9,7 @@ import pytest
 
 from analysis import options as reduce_options
 from analysis import reduce
-from analysis.statistics import rupture_classes, rupture_length
+from analysis.statistics import rupture_classes, rupture_length, slip_scaling
 from ensemble.model.workspace import KIND_CREEP, KIND_EVENT
 from ensemble.store import schema
 
@@ -54,7 +54,8 @@ def brute_force(part, opt):
     edges_lr, edges_mu = opt.lr_edges, opt.mu_edges
     want = {"lr": np.zeros((k, len(edges_lr) - 1), np.int64), "mu_uni": np.zeros((k, len(edges_mu) - 1), np.int64),
             "mu_bi": np.zeros((k, len(edges_mu) - 1), np.int64), "fit": np.zeros((k, 3)),
-            "classes": np.zeros((k, len(rupture_classes.COLUMNS)))}
+            "classes": np.zeros((k, len(rupture_classes.COLUMNS))),
+            "slip_lr": np.zeros((k, len(edges_lr) - 1)), "slip": np.zeros((k, 4))}
     col = {c: j for j, c in enumerate(rupture_classes.COLUMNS)}
     previous = None
     top = min(opt.lr_max, N_BLOCKS - 1)
@@ -62,11 +63,15 @@ def brute_force(part, opt):
         s = m * k // n
         length, f, last, e = (int(ev[c][m]) for c in ("n_slipped", "first", "last", "epicenter"))
         mu = ev["mu"][m]
+        mean_slip = ev["slip"][m] / length
         for j in range(len(edges_lr) - 1):
             if edges_lr[j] <= length < edges_lr[j + 1]:
                 want["lr"][s, j] += 1
+                want["slip_lr"][s, j] += mean_slip
         if opt.lr_min <= length <= top:
             want["fit"][s] += (1, length - opt.lr_min, top - opt.lr_min)
+            half = 2 if length >= (opt.lr_min + top) / 2 else 0
+            want["slip"][s, half:half + 2] += (1, mean_slip)
         if length >= opt.class_min and f > 0 and last < N_BLOCKS - 1:
             kind = "uni" if min(e - f, last - e) <= opt.uni_edge * (last - f) else "bi"
             want["classes"][s, col["n_classified"]] += 1
@@ -94,12 +99,18 @@ def test_the_tables_are_the_events_whatever_the_chunks(seed, lr_max):
         for table, name in (("lr", "lr"), ("mu_uni", "mu_uni"), ("mu_bi", "mu_bi"), ("fit", "rupture_length"),
                             ("classes", "rupture_classes")):
             np.testing.assert_array_equal(out[name], want[table], err_msg=f"{name}, chunks of {size}")
+        for table, name in (("slip_lr", "slip_lr"), ("slip", "slip_scaling")):     # sums in another order
+            np.testing.assert_allclose(out[name], want[table], rtol=1e-12, atol=0, err_msg=f"{name}, chunks of {size}")
     # the numbers: of the summed tables, as the brute force's sums give them
     n, excess, span = want["fit"].sum(axis=0)
     u = reduce.LAYOUT.sum_of({name: table.sum(axis=0) for name, table in out.items() if name in reduce.LAYOUT.tables})
     l0, n_fit = rupture_length.estimate(u, opt)
     assert n_fit == n and l0 == rupture_length.correlation_length(n, excess, min(lr_max, N_BLOCKS - 1) - opt.lr_min)
     assert np.isfinite(l0)
+    n_lo, s_lo, n_hi, s_hi = want["slip"].sum(axis=0)
+    np.testing.assert_allclose(slip_scaling.estimate(u, opt),
+                               [(s_lo + s_hi) / (n_lo + n_hi), (s_hi / n_hi) / (s_lo / n_lo)], rtol=1e-12)
+    assert n_lo > 0 and n_hi > 0
     c = dict(zip(rupture_classes.COLUMNS, want["classes"].sum(axis=0)))
     assert rupture_classes.estimate(u, opt) == [c["n_classified"], c["n_uni"] / c["n_classified"],
                                                 c["n_uni_rim"] / c["n_uni_prev"], c["n_bi_rim"] / c["n_bi_prev"]]
@@ -178,4 +189,5 @@ def test_report_plot_and_export_show_them(reduced, tmp_path):
     assert res.returncode == 0, res.stderr
     numbers = (tmp_path / "tables" / "numbers.csv").read_text()
     assert "L0_lo" in numbers and "fraction_unilateral" in numbers
-    assert "mu_uni" in (tmp_path / "tables" / "curves.csv").read_text()
+    curves = (tmp_path / "tables" / "curves.csv").read_text()
+    assert "mu_uni" in curves and "mean_slip" in curves and "slip_ratio" in numbers

@@ -53,6 +53,7 @@ The statistics today (the registry finds a module by its STATISTIC; this list is
     regularity.py         how periodic the large events by rupture length recur (the comparison's)
     rupture_length.py     P(L_r) of the rupture lengths and its exponential tail: the correlation length L_0
     rupture_classes.py    unilateral and bilateral ruptures: their shares, R(mu), epicenters at a past rim
+    slip_scaling.py       the mean slip per block against the rupture length
 """
 import importlib
 import math
@@ -394,15 +395,16 @@ class Tables(dict):
         values = np.ascontiguousarray(np.broadcast_to(np.asarray(values, dtype=out.dtype), block.shape))
         _add_at(out, self.layout.column(table, name), block, values)
 
-    def count(self, table, block, values, edges):
-        """Histogram `values` into `table` (bins `edges`) at stretches `block`; out of range: not counted."""
+    def count(self, table, block, values, edges, weights=None):
+        """Histogram `values` into `table` (bins `edges`) at stretches `block`; out of range: not counted. A table
+        of sums (Table.weights) adds `weights` (one per value; default 1), one after the other in their order."""
         idx = np.searchsorted(edges, values, side="right") - 1
         ok = (idx >= 0) & (idx < len(edges) - 1)
         out = self[table]
         if out.dtype.kind == "i":   # counts: a sum in any order is exact
             out += np.bincount(block[ok] * out.shape[1] + idx[ok], minlength=out.size).reshape(out.shape)
         else:
-            np.add.at(out, (block[ok], idx[ok]), 1)
+            np.add.at(out, (block[ok], idx[ok]), 1.0 if weights is None else np.asarray(weights, float)[ok])
 
     def append(self, table, block, values):
         """Append `values` to sample `table`, each to the list of its stretch (`block`), in order."""
