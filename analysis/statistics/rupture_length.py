@@ -124,7 +124,7 @@ STATISTIC = Statistic(
                   columns=("n_fit", "sum_excess", "sum_span"))),
     numbers=(Number("L0", "blocks", "seismic correlation length: P(L_r) ~ exp(-L_r / L_0) fitted by maximum "
                                     "likelihood on lr_min <= L_r <= min(lr_max, N - 1)", "L_0"),
-             Number("n_L0", "count", "events in the range of the L_0 fit", "events in L_0 fit")),
+             Number("n_L0", "count", "events in the range of the L_0 fit", "L_0 fit events")),
     curves=(Curve("lr", "lr", ("numbers", "n_events"), "L_r", "all events", "1/block"),),
     feed=feed, estimate=estimate, uses_tables=("numbers",),
     options=(Option("lr_bins", "bins", "0.5:1600.5:320", "blocks", "rupture-length bins lo:hi:n of P(L_r)"),
