@@ -368,7 +368,7 @@ MUTATIONS = (
              ("tests/test_export.py::test_without_pandas_a_dataframe_is_a_clear_error",),
              "frame=True without pandas fails with a bare import error"),
     Mutation("rupture-length-fits-whole-chain", "analysis/statistics/rupture_length.py",
-             "top = min(opt.lr_max, rows.n_blocks - 1)", "top = min(opt.lr_max, rows.n_blocks)",
+             "return lr_min, min(lr_max, n_blocks - 1)", "return lr_min, min(lr_max, n_blocks)",
              ("tests/test_rupture_statistics.py::test_the_tables_are_the_events_whatever_the_chunks",),
              "ruptures of the whole chain (the chain's size, not the fault's) inside the L_0 fit"),
     Mutation("rupture-length-span-summed", "analysis/statistics/rupture_length.py",

@@ -49,12 +49,17 @@ def correlation_length(n, excess, span):
     return 1.0 / math.sqrt(lo * hi)
 
 
+def fit_range(lr_min, lr_max, n_blocks):
+    """(lr_min, top): the L_0 fit's range of a chain of n_blocks, whole-chain ruptures out."""
+    return lr_min, min(lr_max, n_blocks - 1)
+
+
 def feed(acc, rows):
     if rows.ev is None:
         return
     opt, length = rows.opt, rows.ev["n_slipped"]
     acc.count("lr", rows.block, length, opt.lr_edges)
-    top = min(opt.lr_max, rows.n_blocks - 1)
+    _, top = fit_range(opt.lr_min, opt.lr_max, rows.n_blocks)
     fit = (length >= opt.lr_min) & (length <= top)
     block = rows.block[fit]
     acc.add(NAME, "n_fit", block, 1)
@@ -71,7 +76,7 @@ def fitted_density(s, i, lengths):
     """The fitted law of point i of summary `s` as a density over all its inertial events, at integer `lengths`
     (NaN outside the fit's range and without an L_0)."""
     l0, n_fit = s["points/numbers/L0"][i, 0], s["points/numbers/n_L0"][i, 0]
-    lo, top = int(s["attrs"]["lr_min"]), min(int(s["attrs"]["lr_max"]), int(s["points/N"][i]) - 1)
+    lo, top = fit_range(int(s["attrs"]["lr_min"]), int(s["attrs"]["lr_max"]), int(s["points/N"][i]))
     out = np.full(len(lengths), np.nan)
     inside = (lengths >= lo) & (lengths <= top)
     if np.isfinite(l0) and n_fit > 0 and inside.any():

@@ -11,6 +11,7 @@ does not hold yet: issue 45.)
 import numpy as np
 
 from . import Curve, Number, Statistic, Table
+from .rupture_length import fit_range
 
 NAME = "slip_scaling"
 COLUMNS = ("n_lower", "slip_lower", "n_upper", "slip_upper")
@@ -22,7 +23,7 @@ def feed(acc, rows):
     opt, length = rows.opt, rows.ev["n_slipped"]
     mean = rows.ev["slip"] / np.maximum(length, 1)
     acc.count("slip_lr", rows.block, length, opt.lr_edges, weights=mean)
-    top = min(opt.lr_max, rows.n_blocks - 1)
+    _, top = fit_range(opt.lr_min, opt.lr_max, rows.n_blocks)
     fit = (length >= opt.lr_min) & (length <= top)
     upper = fit & (2 * length >= opt.lr_min + top)
     lower = fit & ~upper
