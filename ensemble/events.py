@@ -10,8 +10,8 @@ from .model import laws
 from .model.event import integrate_event
 from .model.schedule import build_schedule, tree_min
 from .model.workspace import (D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D_ENERGY_SCALE, D_LOAD_WORK,
-                              D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK, NTRACE, OK, STATUS_TEXT,
-                              Workspace)
+                              D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_STRESS_DROP, D_VMAX, D_WORK, NTRACE, OK,
+                              STATUS_TEXT, Workspace)
 
 
 @dataclass
@@ -33,6 +33,7 @@ class EventResult:
     force: np.ndarray       # state after the event (c-free frame)
     psi: np.ndarray
     seconds: float          # wall time of the event kernel alone (no set-up: what a run pays)
+    stress_drop: float      # mean force drop of the slipped blocks by the slip (workspace.D_STRESS_DROP)
 
     @property
     def relative_energy_residual(self):
@@ -96,7 +97,7 @@ def run_event(force, psi, epicenter, model, integrator, v_start=0.0, trace=None)
     return EventResult(status, d[D_SLIP], d[D_DURATION], int(d[D_STEPS]), int(d[D_BLOCK_STEPS]),
                        int(d[D_REJECTED]), int(d[D_CUTS]), d[D_VMAX], d[D_WORK],
                        d[D_RESIDUAL], d[D_ENERGY_SCALE], d[D_ELASTIC], d[D_LOAD_WORK], profile, force,
-                       psi, seconds)
+                       psi, seconds, d[D_STRESS_DROP])
 
 
 def check(result, what="event"):

@@ -35,6 +35,7 @@ from ensemble.store import reader, schema  # noqa: E402
 from ensemble.store.errors import CatalogError  # noqa: E402
 from ensemble.store.files import partial_path  # noqa: E402
 from tests.processes import child_env, run_bounded, wait_for  # noqa: E402
+from tests.same_catalogs import common_fields  # noqa: E402
 
 DEADLINE = 120        # seconds for any command: what they take is a few (a hang fails the attack)
 QUICK = 30            # ... for a run that must end at once (a full disk, a failed collective step)
@@ -360,12 +361,12 @@ def an_older_format(w):
     with h5py.File(old, "r") as h5:
         assert "kind" not in h5["events"] and "creep" not in h5["checkpoint"]
     assert len(events["t"]) == len(tasks["point"]) * int(attrs["events_per_task"])
-    assert np.all(events["kind"] == 0) and np.all(events["ending"] == 0)
+    assert np.all(events["kind"] == 0) and np.all(events["ending"] == 0) and np.all(np.isnan(events["stress_drop"]))
     now = w.root / "format4-now.h5"
     res = _python("ensemble", "run", w.format_4_config(), "-o", now)
     assert res.returncode == 0, res.stderr
-    now, _, _ = reader.read(now)          # (the aging law at b = 20 is unchanged by the creep phase)
-    for column in schema.EVENT_FIELDS:
+    now, _, now_attrs = reader.read(now)          # (the aging law at b = 20 is unchanged by the creep phase)
+    for column in common_fields(attrs, now_attrs):
         np.testing.assert_array_equal(events[column], now[column], err_msg=column)
     res = _python("analysis", "reduce", old, "-o", w.root / "format4.summary.h5")
     assert res.returncode == 0, res.stderr
@@ -399,8 +400,8 @@ def format_5_with_creep(w):
     now = w.root / "format5-now.h5"
     res = _python("ensemble", "run", w.creep_config(), "-o", now)
     assert res.returncode == 0, res.stderr
-    events_now, _, _ = reader.read(now)
-    for column in schema.EVENT_FIELDS:
+    events_now, _, now_attrs = reader.read(now)
+    for column in common_fields(attrs, now_attrs):
         np.testing.assert_array_equal(events[column], events_now[column], err_msg=column)
     with reader.Reader(old) as cat:
         creeps = cat.layout.creep

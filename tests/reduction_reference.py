@@ -65,6 +65,9 @@ here the slow and obvious way, from the raw events:
 - mean slip per block slip / n_slipped: its sum per lr bin over the events in the bin (the curve; NaN for an
   empty bin); over the fit's events, those with 2 L >= lr_min + top (upper half) and the others (lower): the
   mean over all of them, and the upper half's mean over the lower's;
+- stress drop (/events/stress_drop, NaN in catalogs before bk-catalog-7): the same over the events that have one
+  (not NaN): its sum and their count per lr bin (the curve their quotient), the mean over the fit's events and
+  the upper half's mean over the lower's;
 - a reduction is partial if a catalog's name ends in .partial or one of its tasks is not
   finished (status 1) or holds fewer than events_per_task events; the summary then states the
   events reduced of those expected and names those catalogs.
@@ -97,8 +100,8 @@ SEISMICITY_NUMBERS = ("background_rate", "foreshock_rate", "aftershock_rate", "q
 RUPTURE = {"lr_edges": np.linspace(0.5, 1600.5, 321), "lr_min": 200, "lr_max": 10 ** 9, "class_min": 10,
            "uni_edge": 0.1}
 RUPTURE_NUMBERS = ("L0", "n_L0", "n_classified", "fraction_unilateral", "uni_at_rim", "bi_at_rim", "mean_slip_large",
-                   "slip_ratio")
-RUPTURE_CURVES = ("lr", "mu_uni", "mu_bi", "mean_slip")
+                   "slip_ratio", "mean_drop_large", "drop_ratio")
+RUPTURE_CURVES = ("lr", "mu_uni", "mu_bi", "mean_slip", "mean_drop")
 CLASS_COLUMNS = ("n_classified", "n_uni", "n_bi", "n_uni_prev", "n_uni_rim", "n_bi_prev", "n_bi_rim")
 SEIS = {"seis_time_edges": np.linspace(-1000, 1000, 41), "seis_distance_edges": np.linspace(0, 40, 21),
         "seis_near": 2.0, "seis_ring": 10.0, "seis_short": 50.0, "seis_long": 500.0}
@@ -298,7 +301,8 @@ def correlation_length(n, excess, span):
 
 
 def statistics(mu, tnu, interior, event_slip, creep_mu, creep_log_duration, creep_taken, creep_slip, gaps,
-               seis_cells, seis_exposure, block_span, lr, fit, cls, has_prev, at_rim, mean_slip, slip_half, opt):
+               seis_cells, seis_exposure, block_span, lr, fit, cls, has_prev, at_rim, mean_slip, slip_half, drop,
+               opt):
     """Curves and numbers of pooled raw data: mu (all inertial events), tnu and interior
     (recurrences), event_slip (the inertial events' slips), the creep episodes' mu, log10(duration
     nu), taken over (ending 2) and slip, and the inter-event times (times nu) of the inertial events."""
@@ -361,7 +365,16 @@ def statistics(mu, tnu, interior, event_slip, creep_mu, creep_log_duration, cree
                                           len(lower) + len(upper))
     numbers["slip_ratio"] = quotient(quotient(sum(float(x) for x in upper), len(upper)),
                                      quotient(sum(float(x) for x in lower), len(lower)))
+    known = ~np.isnan(drop)
+    lower, upper = drop[(slip_half == 0) & known], drop[(slip_half == 1) & known]
+    numbers["mean_drop_large"] = quotient(sum(float(x) for x in lower) + sum(float(x) for x in upper),
+                                          len(lower) + len(upper))
+    numbers["drop_ratio"] = quotient(quotient(sum(float(x) for x in upper), len(upper)),
+                                     quotient(sum(float(x) for x in lower), len(lower)))
     le = edges_of(opt, "lr_edges")
+    drop_sums = np.array([sum(float(x) for x, length in zip(drop[known], lr[known]) if le[j] <= length < le[j + 1])
+                          for j in range(len(le) - 1)])
+    drop_in_bin = histogram(lr[known], le)
     slip_sums = np.array([sum(float(x) for x, length in zip(mean_slip, lr) if le[j] <= length < le[j + 1])
                           for j in range(len(le) - 1)])
     in_bin = histogram(lr, le)
@@ -374,7 +387,8 @@ def statistics(mu, tnu, interior, event_slip, creep_mu, creep_log_duration, cree
               "lr": density(histogram(lr, le), le, n),
               "mu_uni": density(histogram(mu[cls == 1], me), me, n_uni),
               "mu_bi": density(histogram(mu[cls == 2], me), me, n_bi),
-              "mean_slip": np.array([x / c if c else math.nan for x, c in zip(slip_sums, in_bin)])}
+              "mean_slip": np.array([x / c if c else math.nan for x, c in zip(slip_sums, in_bin)]),
+              "mean_drop": np.array([x / c if c else math.nan for x, c in zip(drop_sums, drop_in_bin)])}
     return curves, numbers
 
 
@@ -421,7 +435,7 @@ class Task:
         self.creep_taken = column["ending"][creep] == 2 if creep else np.zeros(0, dtype=bool)
         self.creep_slip = column["slip"][creep].astype(float) if creep else np.zeros(0)
         self.ruptures({name: column[name][inertial] for name in ("mu", "epicenter", "first", "last", "n_slipped",
-                                                                 "slip")},
+                                                                 "slip", "stress_drop")},
                       n_blocks, opt, k, n)
         ev = {name: column[name][inertial] for name in ("t", "mu", "epicenter", "boundary")}
         self.n = n
@@ -470,6 +484,7 @@ class Task:
         self.at_rim = np.array(at_rim, dtype=bool)
         self.mean_slip = np.array(mean_slip, dtype=float)
         self.slip_half = np.array(slip_half, dtype=np.int64)
+        self.drop = np.array([float(x) for x in ev["stress_drop"]], dtype=float)
 
     def seis(self, ev, nu, n_blocks, opt):
         """Every pair's cell and stretch (of its mainshock), every mainshock's exposure row and stretch."""
@@ -502,7 +517,8 @@ class Task:
         """(mu, tnu, interior, event slip, creep mu, creep log10(duration nu), creep taken over,
         creep slip) of the whole task or of one stretch."""
         creep = (self.creep_mu, self.creep_log_duration, self.creep_taken, self.creep_slip)
-        ruptures = (self.lr, self.fit, self.cls, self.has_prev, self.at_rim, self.mean_slip, self.slip_half)
+        ruptures = (self.lr, self.fit, self.cls, self.has_prev, self.at_rim, self.mean_slip, self.slip_half,
+                    self.drop)
         if stretch is None:
             return (self.mu, self.tnu, self.interior, self.event_slip, *creep, self.gaps, self.seis_cells,
                     self.seis_exposure, self.block_span, *ruptures)
@@ -511,7 +527,7 @@ class Task:
                 self.gaps[self.gap_stretch == stretch], self.seis_cells[self.seis_cell_stretch == stretch],
                 self.seis_exposure[self.seis_main_stretch == stretch], self.block_span[self.gap_stretch == stretch],
                 self.lr[e], self.fit[self.fit_stretch == stretch], self.cls[e], self.has_prev[e], self.at_rim[e],
-                self.mean_slip[e], self.slip_half[e])
+                self.mean_slip[e], self.slip_half[e], self.drop[e])
 
     def per_stretch(self, opt):
         k, me, te = opt["blocks"], opt["mu_edges"], opt["tnu_edges"]
@@ -532,9 +548,16 @@ class Task:
         classes = np.zeros((k, len(CLASS_COLUMNS)))
         uni_h, bi_h = np.zeros((k, len(me) - 1), dtype=np.int64), np.zeros((k, len(me) - 1), dtype=np.int64)
         slip_h, slip_columns = np.zeros((k, len(le) - 1)), np.zeros((k, 4))
+        drop_n, drop_h = np.zeros((k, len(le) - 1), dtype=np.int64), np.zeros((k, len(le) - 1))
+        drop_columns = np.zeros((k, 4))
         for s in range(k):
             (mu, tnu, interior, event_slip, creep_mu, creep_log_duration, taken, creep_slip, gaps, cells,
-             exposure, block_span, lr, fit, cls, has_prev, at_rim, mean_slip, slip_half) = self.unit(s)
+             exposure, block_span, lr, fit, cls, has_prev, at_rim, mean_slip, slip_half, drop) = self.unit(s)
+            known = ~np.isnan(drop)
+            drop_n[s] = histogram(lr[known], le)
+            drop_h[s] = [drop[known & (lr >= le[j]) & (lr < le[j + 1])].sum() for j in range(len(le) - 1)]
+            lo, hi = known & (slip_half == 0), known & (slip_half == 1)
+            drop_columns[s] = [lo.sum(), drop[lo].sum(), hi.sum(), drop[hi].sum()]
             slip_h[s] = [mean_slip[(lr >= le[j]) & (lr < le[j + 1])].sum() for j in range(len(le) - 1)]
             slip_columns[s] = [(slip_half == 0).sum(), mean_slip[slip_half == 0].sum(), (slip_half == 1).sum(),
                                mean_slip[slip_half == 1].sum()]
@@ -553,7 +576,7 @@ class Task:
             numbers[s] = [len(mu), np.count_nonzero(mu >= opt["mu_c"]), len(tnu), tnu.sum(),
                           interior.sum(), tnu[interior].sum(), len(gr), gr.sum(), (gr ** 2).sum()]
         return (mu_h, t_h, ti_h, numbers, cm_h, cd_h, creep, intervals, pairs, seis_exposure, seis_columns, lr_h,
-                fit_sums, classes, uni_h, bi_h, slip_h, slip_columns)
+                fit_sums, classes, uni_h, bi_h, slip_h, slip_columns, drop_n, drop_h, drop_columns)
 
 
 def _pool(units, pick):
@@ -711,7 +734,8 @@ def expected_summary(catalogs, opt):
     stacks = [t.per_stretch(opt) for t in per_task]
     for j, name in enumerate(("mu", "tnu", "tnu_interior", "numbers", "creep_mu", "creep_duration", "creep",
                               "intervals", "seis_pairs", "seis_exposure", "seismicity", "lr", "rupture_length",
-                              "rupture_classes", "mu_uni", "mu_bi", "slip_lr", "slip_scaling")):
+                              "rupture_classes", "mu_uni", "mu_bi", "slip_lr", "slip_scaling", "drop_n", "drop_lr",
+                              "stress_drop")):
         exp[f"per_task/{name}"] = np.stack([s[j] for s in stacks])
     results = []
     for params, rows in points:
@@ -777,7 +801,7 @@ def check_summary(s, expected, opt):
              | {f"per_task/{k}" for k in ("mu", "tnu", "tnu_interior", "numbers", "creep_mu", "creep_duration",
                                           "creep", "intervals", "seis_pairs", "seis_exposure", "seismicity", "lr",
                                           "rupture_length", "rupture_classes", "mu_uni", "mu_bi", "slip_lr",
-                                          "slip_scaling")}
+                                          "slip_scaling", "drop_n", "drop_lr", "stress_drop")}
              | {f"points/{p}" for p in PARAMS} | tasks_keys | numbers | curves)
     # a new output must get its brute-force check here
     assert set(s) == known, f"unchecked {set(s) - known}, missing {known - set(s)}"
@@ -830,7 +854,9 @@ def check_summary(s, expected, opt):
         np.testing.assert_allclose(s[key], expected[key], rtol=RTOL, atol=0, err_msg=key)
     np.testing.assert_array_equal(s["per_task/rupture_length"][..., 0], expected["per_task/rupture_length"][..., 0])
     np.testing.assert_array_equal(s["per_task/slip_scaling"][..., ::2], expected["per_task/slip_scaling"][..., ::2])
-    for key in ("per_task/slip_lr", "per_task/slip_scaling"):
+    np.testing.assert_array_equal(s["per_task/drop_n"], expected["per_task/drop_n"])
+    np.testing.assert_array_equal(s["per_task/stress_drop"][..., ::2], expected["per_task/stress_drop"][..., ::2])
+    for key in ("per_task/slip_lr", "per_task/slip_scaling", "per_task/drop_lr", "per_task/stress_drop"):
         np.testing.assert_allclose(s[key], expected[key], rtol=RTOL, atol=0, err_msg=key)
     np.testing.assert_allclose(s["per_task/rupture_length"], expected["per_task/rupture_length"], rtol=RTOL, atol=0)
     for key in sorted(numbers):

@@ -1,4 +1,4 @@
-"""The catalog of a chain that creeps (bk-catalog-6): inertial events and creep episodes as rows of
+"""The catalog of a chain that creeps (bk-catalog-7): inertial events and creep episodes as rows of
 /events (`kind`, `ending`), each record's creep state in its checkpoint slots where its chain can creep
 (/checkpoint/creep), statistics of the inertial events alone, and a run interrupted with creep in flight,
 or run on two ranks, that writes the uninterrupted serial catalog.
@@ -10,6 +10,7 @@ no creep state, so one catalog holds slots of both sizes.
 import shutil
 import signal
 import sys
+from pathlib import Path
 
 import h5py
 import numpy as np
@@ -66,7 +67,7 @@ def tasks_of(tasks, b):
 def test_a_creeping_chain_writes_both_kinds_and_keeps_its_creep_state(creeping):
     d, _ = creeping
     events, tasks, attrs = reader.read(d / "full.h5")
-    assert attrs["format"] == schema.FORMAT == "bk-catalog-6"
+    assert attrs["format"] == schema.FORMAT == "bk-catalog-7"
     kind, ending = events["kind"], events["ending"]
     assert kind.dtype == ending.dtype == np.int8
     for k in tasks_of(tasks, CREEPING):
@@ -76,6 +77,8 @@ def test_a_creeping_chain_writes_both_kinds_and_keeps_its_creep_state(creeping):
         assert np.all(ending[inertial] == 0) and np.all(np.isin(ending[creep], (1, 2)))
         assert np.all(np.diff(events["t"][inertial]) >= 0)       # events in time order among themselves
         assert np.all(events["duration"][creep] > 0) and np.all(events["slip"][creep] > 0)
+        # a stress drop for each inertial event (tests/test_physics.py checks its value), none for an episode
+        assert np.all(events["stress_drop"][inertial] > 0) and np.all(np.isnan(events["stress_drop"][creep]))
     stiff = np.isin(events["task"], tasks_of(tasks, STIFF))
     assert stiff.any() and np.all(kind[stiff] == 0) and np.all(ending[stiff] == 0)
     # the checkpoint slots: a creep state where the chain can creep, none where it cannot
@@ -99,6 +102,31 @@ def test_a_creeping_chain_writes_both_kinds_and_keeps_its_creep_state(creeping):
     np.testing.assert_array_equal(table["kind"], kind)
     np.testing.assert_array_equal(table["ending"], ending)
     assert export.columns(d / "full.h5", "events")["ending"] == schema.DATASETS["events/ending"][::2]
+
+
+def test_a_catalog_of_the_format_before_reads_without_stress_drops(tmp_path):
+    """A bk-catalog-6 catalog (the committed one of tests/test_summary_identity.py, with creep episodes) reads:
+    every column it stores as stored (its events checksum covers those), the stress drop NaN; the export writes
+    the column; a run of it is not continued: one line naming its format, the file unchanged."""
+    import gzip
+    old = tmp_path / "format6.h5"
+    with gzip.open(f"{ROOT}/tests/data/summary_reference_catalog.h5.gz") as src, open(old, "wb") as dst:
+        shutil.copyfileobj(src, dst)
+    events, _, attrs = reader.read(old)
+    assert attrs["format"] == "bk-catalog-6"
+    assert np.count_nonzero(events["kind"] == 1) > 0 and np.all(np.isnan(events["stress_drop"]))
+    with h5py.File(old, "r") as h5:
+        assert "stress_drop" not in h5["events"]
+        for name in schema.STORED_EVENT_FIELDS["bk-catalog-6"]:
+            np.testing.assert_array_equal(events[name], h5["events"][name][...][:len(events[name])], err_msg=name)
+    assert np.all(np.isnan(export.events(old)["stress_drop"]))
+    part = Path(partial_path(tmp_path / "format6-resume.h5"))
+    shutil.copy(old, part)
+    before = part.read_bytes()
+    res = run_cli("resume", tmp_path / "format6-resume.h5")
+    assert res.returncode == 1 and "bk-catalog-6" in res.stderr and len(res.stderr.strip().splitlines()) == 1, \
+        res.stderr
+    assert part.read_bytes() == before
 
 
 def test_reduce_counts_the_inertial_events_alone(creeping):

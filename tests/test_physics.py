@@ -74,6 +74,33 @@ def test_energy_balance_per_event():
     assert relative.max() < 1e-10
 
 
+def force_drop(profile, l):
+    """Each block's force drop by a slip profile, the driver held: y_i - l^2 (lap y)_i, free ends (an end block
+    has one spring)."""
+    y = np.asarray(profile, dtype=float)
+    lap = np.zeros_like(y)
+    lap[:-1] += y[1:] - y[:-1]
+    lap[1:] += y[:-1] - y[1:]
+    return y - l ** 2 * lap
+
+
+def test_stress_drop_is_the_slipped_blocks_mean_force_drop():
+    """/events/stress_drop (workspace.D_STRESS_DROP) is the mean over the blocks that slipped of their force
+    drop by the event's slip, recomputed here from the whole profile's Laplacian (the kernel counts each slipped
+    block's springs to blocks that did not slip): 40 events of a developed chain, some reaching an end."""
+    model = Model(N=60, b=20.0, a=2.0)
+    force, psi = developed_state(model, 300)
+    ends = 0
+    for _ in range(40):
+        _, ev = next_event(force, psi, model, 1e-3)
+        slipped = ev.profile > 0
+        ends += bool(slipped[0] or slipped[-1])
+        expected = force_drop(ev.profile, model.l)[slipped].mean()
+        assert ev.stress_drop == pytest.approx(expected, rel=1e-12), (ev.stress_drop, expected)
+        force, psi = ev.force, ev.psi
+    assert 0 < ends < 40
+
+
 def test_c_invariance_from_equivalent_physical_states():
     """c = 1e2 and c = 1e4 give the same events from states that differ by the uniform shift of u.
 
@@ -129,6 +156,8 @@ def test_kernel_agrees_with_independent_full_chain_reference():
     # is off by up to one step (measured 1.9e-5).
     np.testing.assert_allclose(ours.profile, ref["profile"], rtol=1e-8, atol=1e-9 * ours.slip)
     assert ours.duration == pytest.approx(ref["duration"], abs=3e-5)
+    # the stress drop from the reference's profile (it keeps c and u: its forces are its own)
+    assert ours.stress_drop == pytest.approx(force_drop(ref["profile"], model.l)[slipped].mean(), rel=1e-8)
 
 
 def test_a_single_block_runs_its_stick_slip_cycle(tmp_path):

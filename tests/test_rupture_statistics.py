@@ -40,6 +40,9 @@ def synthetic(n, seed):
     part["slip"] = length * rng.uniform(0.5, 2.0, n)
     part["mu"] = np.log10(part["slip"])
     part["kind"] = np.where(rng.random(n) < 0.1, KIND_CREEP, KIND_EVENT).astype(np.int8)
+    # stress drops: NaN for a creep episode and for a few events (as an older catalog's, which the sums leave out)
+    part["stress_drop"] = np.where((part["kind"] == KIND_CREEP) | (rng.random(n) < 0.1), np.nan,
+                                   rng.uniform(1.0, 30.0, n))
     return part
 
 
@@ -55,7 +58,9 @@ def brute_force(part, opt):
     want = {"lr": np.zeros((k, len(edges_lr) - 1), np.int64), "mu_uni": np.zeros((k, len(edges_mu) - 1), np.int64),
             "mu_bi": np.zeros((k, len(edges_mu) - 1), np.int64), "fit": np.zeros((k, 3)),
             "classes": np.zeros((k, len(rupture_classes.COLUMNS))),
-            "slip_lr": np.zeros((k, len(edges_lr) - 1)), "slip": np.zeros((k, 4))}
+            "slip_lr": np.zeros((k, len(edges_lr) - 1)), "slip": np.zeros((k, 4)),
+            "drop_n": np.zeros((k, len(edges_lr) - 1), np.int64), "drop_lr": np.zeros((k, len(edges_lr) - 1)),
+            "drop": np.zeros((k, 4))}
     col = {c: j for j, c in enumerate(rupture_classes.COLUMNS)}
     previous = None
     top = min(opt.lr_max, N_BLOCKS - 1)
@@ -63,15 +68,20 @@ def brute_force(part, opt):
         s = m * k // n
         length, f, last, e = (int(ev[c][m]) for c in ("n_slipped", "first", "last", "epicenter"))
         mu = ev["mu"][m]
-        mean_slip = ev["slip"][m] / length
+        mean_slip, drop = ev["slip"][m] / length, ev["stress_drop"][m]
         for j in range(len(edges_lr) - 1):
             if edges_lr[j] <= length < edges_lr[j + 1]:
                 want["lr"][s, j] += 1
                 want["slip_lr"][s, j] += mean_slip
+                if not math.isnan(drop):
+                    want["drop_n"][s, j] += 1
+                    want["drop_lr"][s, j] += drop
         if opt.lr_min <= length <= top:
             want["fit"][s] += (1, length - opt.lr_min, top - opt.lr_min)
             half = 2 if length >= (opt.lr_min + top) / 2 else 0
             want["slip"][s, half:half + 2] += (1, mean_slip)
+            if not math.isnan(drop):
+                want["drop"][s, half:half + 2] += (1, drop)
         if length >= opt.class_min and f > 0 and last < N_BLOCKS - 1:
             kind = "uni" if min(e - f, last - e) <= opt.uni_edge * (last - f) else "bi"
             want["classes"][s, col["n_classified"]] += 1
@@ -97,9 +107,10 @@ def test_the_tables_are_the_events_whatever_the_chunks(seed, lr_max):
     for size in (700, 13, 1):
         out = reduce.reduce_task(chunks(part, size), written, 1.0, N_BLOCKS, opt, len(part["t"]))
         for table, name in (("lr", "lr"), ("mu_uni", "mu_uni"), ("mu_bi", "mu_bi"), ("fit", "rupture_length"),
-                            ("classes", "rupture_classes")):
+                            ("classes", "rupture_classes"), ("drop_n", "drop_n")):
             np.testing.assert_array_equal(out[name], want[table], err_msg=f"{name}, chunks of {size}")
-        for table, name in (("slip_lr", "slip_lr"), ("slip", "slip_scaling")):     # sums in another order
+        for table, name in (("slip_lr", "slip_lr"), ("slip", "slip_scaling"), ("drop_lr", "drop_lr"),
+                            ("drop", "stress_drop")):     # sums in another order
             np.testing.assert_allclose(out[name], want[table], rtol=1e-12, atol=0, err_msg=f"{name}, chunks of {size}")
     # the numbers: of the summed tables, as the brute force's sums give them
     n, excess, span = want["fit"].sum(axis=0)
@@ -108,9 +119,11 @@ def test_the_tables_are_the_events_whatever_the_chunks(seed, lr_max):
     assert n_fit == n and l0 == rupture_length.correlation_length(n, excess, min(lr_max, N_BLOCKS - 1) - opt.lr_min)
     assert np.isfinite(l0)
     n_lo, s_lo, n_hi, s_hi = want["slip"].sum(axis=0)
+    d_lo, t_lo, d_hi, t_hi = want["drop"].sum(axis=0)
     np.testing.assert_allclose(slip_scaling.estimate(u, opt),
-                               [(s_lo + s_hi) / (n_lo + n_hi), (s_hi / n_hi) / (s_lo / n_lo)], rtol=1e-12)
-    assert n_lo > 0 and n_hi > 0
+                               [(s_lo + s_hi) / (n_lo + n_hi), (s_hi / n_hi) / (s_lo / n_lo),
+                                (t_lo + t_hi) / (d_lo + d_hi), (t_hi / d_hi) / (t_lo / d_lo)], rtol=1e-12)
+    assert n_lo > 0 and n_hi > 0 and 0 < d_lo < n_lo and 0 < d_hi < n_hi
     c = dict(zip(rupture_classes.COLUMNS, want["classes"].sum(axis=0)))
     assert rupture_classes.estimate(u, opt) == [c["n_classified"], c["n_uni"] / c["n_classified"],
                                                 c["n_uni_rim"] / c["n_uni_prev"], c["n_bi_rim"] / c["n_bi_prev"]]

@@ -47,9 +47,10 @@ from .transitions import (NO_CUT, ONSET_LOADING, ONSET_NEIGHBOUR, STICK, above_t
                           loading_cut, locate, pressed, rest_psi, velocity_slopes)
 from .undo import clear_log, log_block
 from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D_ENERGY_SCALE, D_FIRST, D_LAST,
-                        D_LOAD_WORK, D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_VMAX, D_WORK, EV_BLOCK_STEPS,
-                        EV_CUTS, EV_EPICENTER, EV_ERR_PREV, EV_FAR, EV_H_NEXT, EV_NA, EV_NT, EV_PHASE, EV_REJECTED,
-                        EV_SLIP_TIME, EV_STEPS, EV_STILL, EV_T_FAR, EV_TAU, EV_TRACED, EV_VMAX, EV_WORK, EV_YREST, F0,
+                        D_LOAD_WORK, D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_STRESS_DROP, D_VMAX, D_WORK,
+                        EV_BLOCK_STEPS, EV_CUTS, EV_EPICENTER, EV_ERR_PREV, EV_FAR, EV_H_NEXT, EV_NA, EV_NT, EV_PHASE,
+                        EV_REJECTED, EV_SLIP_TIME, EV_STEPS, EV_STILL, EV_T_FAR, EV_TAU, EV_TRACED, EV_VMAX, EV_WORK,
+                        EV_YREST, F0,
                         HD0, CR_HB, CR_V, CR_VN, HD1, IN_EVENT, NONFINITE, OK, P, P0, PAUSED, SLIDING, STALLED,
                         STOPPED, TOO_LONG, TR, TS, UNLIMITED, UNSTABLE, UNTOUCHED, V, V0, Y, Y0, YS, PausedEvent)
 
@@ -447,6 +448,7 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, p, work, slip_t
     first = n
     last = -1
     nslip = 0
+    drop = 0.0       # sum of the slipped blocks' force drops by the slip (workspace.py: D_STRESS_DROP)
     # Energy balance in the c-free frame (derivation in docs of workspace.py):
     # dE - W_load = -sum(y F0) + sum(y^2)/2 + l2 sum(dy^2)/2 - nu tau sum(y) + nu int(sum y)
     e_change = 0.0
@@ -459,6 +461,8 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, p, work, slip_t
             nslip += 1
             first = min(first, i)
             last = max(last, i)
+            outside = (1 if i > 0 and not W[i - 1, Y] > 0.0 else 0) + (1 if i < n - 1 and not W[i + 1, Y] > 0.0 else 0)
+            drop += y * (1.0 + p.l2 * outside)
         # the non-negative terms (own and spring energies) count alike in both sums
         stored = 0.5 * y * y
         if i + 1 < n:
@@ -481,6 +485,7 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, p, work, slip_t
     diag[D_ENERGY_SCALE] = gross
     diag[D_ELASTIC] = elastic
     diag[D_LOAD_WORK] = nu * tau * slip - nu * slip_time
+    diag[D_STRESS_DROP] = drop / max(nslip, 1)
     # The touched blocks move to the end time (loading, state grown since they
     # stopped); their untouched neighbours stay at t0, which is just as valid.
     # Then the slip changes the forces (free ends: an end block has one spring).

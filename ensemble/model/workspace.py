@@ -91,10 +91,16 @@ NCOLS = X_THETA + 1
 
 # entries of the per-event diagnostics vector
 (D_DURATION, D_SLIP, D_FIRST, D_LAST, D_NSLIP, D_WORK, D_RESIDUAL, D_STEPS, D_VMAX,
- D_BLOCK_STEPS, D_REJECTED, D_CUTS, D_ENERGY_SCALE, D_ELASTIC, D_LOAD_WORK, D_KIND, D_ENDING) = range(17)
-NDIAG = 17
+ D_BLOCK_STEPS, D_REJECTED, D_CUTS, D_ENERGY_SCALE, D_ELASTIC, D_LOAD_WORK, D_KIND, D_ENDING,
+ D_STRESS_DROP) = range(18)
+NDIAG = 18
 # D_KIND: what a row of the kernels' output is; D_ENDING: how a creep episode ended (1 its blocks
 # stopped, 2 an inertial event took them; 0 for an event)
+# D_STRESS_DROP: an event's stress drop, the mean over the blocks that slipped (the set S) of the drop of
+# their force (F0 + nu t - y + l^2 lap y) by the slip alone, the driver held where it was at the onset:
+# (1 / |S|) sum_{i in S} y_i (1 + l^2 n_i), n_i the neighbours of i outside S (the springs within S cancel
+# in the sum). The driver's advance adds nu * duration to every force (at most ~1e-5 at the paper's nu).
+# NaN for a creep episode, whose blocks' slips are not kept one by one.
 KIND_EVENT, KIND_CREEP = 0, 1
 
 # columns of the optional step trace of an event (one row per step tried, rejected ones included)

@@ -13,8 +13,8 @@ from ..config import ConfigError, parse_section, section_lines
 from ..integrators import INTEGRATORS, kernel_params
 from ..model.chain import simulate
 from ..model.workspace import (CS_H, CS_NCREEP, CS_T_HI, CS_T_LO, D_DURATION, D_ENDING, D_FIRST, D_KIND, D_LAST,
-                               D_NSLIP, D_SLIP, EV_NA, EV_PHASE, EV_STEPS, EV_TAU, EV_VMAX, IN_EVENT, NDIAG, OK,
-                               PAUSED, STATUS_TEXT, UNLIMITED, Workspace)
+                               D_NSLIP, D_SLIP, D_STRESS_DROP, EV_NA, EV_PHASE, EV_STEPS, EV_TAU, EV_VMAX, IN_EVENT,
+                               NDIAG, OK, PAUSED, STATUS_TEXT, UNLIMITED, Workspace)
 from ..store.checkpoint import Checkpoint, carries_creep
 from ..store.errors import CatalogError
 from .tasks import initial_state
@@ -104,6 +104,7 @@ def event_rows(task, t, epicenter, diag):
         "n_slipped": diag[:, D_NSLIP].astype(np.int64),
         "boundary": (first == 0) | (last == task.model.N - 1), "duration": diag[:, D_DURATION],
         "kind": diag[:, D_KIND].astype(np.int8), "ending": diag[:, D_ENDING].astype(np.int8),
+        "stress_drop": diag[:, D_STRESS_DROP],
     }
 
 

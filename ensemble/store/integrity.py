@@ -70,6 +70,8 @@ def event_problems(ev, n_blocks, first_row=0, t_before=-np.inf):
         (inertial & (t < previous),
          lambda i: f"time {float(t[i])!r} before the event ahead of it ({float(previous[i])!r})"),
         (~(inertial | (kind == 1)), lambda i: f"kind {int(kind[i])}"),
+        (~(ev["stress_drop"] > 0) & ~np.isnan(ev["stress_drop"]),
+         lambda i: f"stress drop {float(ev['stress_drop'][i])}"),
         (np.where(inertial, ending != 0, (ending != 1) & (ending != 2)),
          lambda i: f"ending {int(ending[i])} of a row of kind {int(kind[i])}"),
     )

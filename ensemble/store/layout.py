@@ -25,7 +25,7 @@ from .checkpoint import Checkpoint, Head, TaskRecord, carries_creep, state_size
 from .errors import CatalogError, writing
 from .integrity import EventCrc, commit_crc, crc, event_problems
 from .schema import (C_DONE, C_EVENTS_CRC, C_ROW_CRC, C_SEQ, C_STATE_CRC, C_WRITTEN, CHECKSUMMED, EPISODE_COLUMNS,
-                     EVENT_FIELDS, FAILED, FINISHED, NCOMMIT, OLDER_EVENT_FIELDS, OPEN, READ_CHUNK, SUPPLIED,
+                     EVENT_FIELDS, FAILED, FINISHED, NCOMMIT, OPEN, READ_CHUNK, STORED_EVENT_FIELDS, SUPPLIED,
                      WITH_CREEP, fixed_text)
 
 
@@ -42,7 +42,7 @@ class Layout:
         self.barrier = barrier
         self.format = h5.attrs.get("format")
         # the event columns this catalog stores (those of its format), in the order of its events CRC
-        self.event_fields = tuple(EVENT_FIELDS) if self.format in WITH_CREEP else OLDER_EVENT_FIELDS
+        self.event_fields = STORED_EVENT_FIELDS.get(self.format, tuple(EVENT_FIELDS))
         try:
             self.events = {name: h5["events"][name] for name in self.event_fields}
             self.tasks = {name: h5["tasks"][name] for name in h5["tasks"]}

@@ -30,22 +30,25 @@ from ..config import LAW_KEYS
 from ..model import laws
 from ..model.workspace import KIND_CREEP, KIND_EVENT, NEPISODE
 
-FORMAT = "bk-catalog-6"
-# older formats this version reads (not resumes), and what they lack: bk-catalog-5 keeps a creep state of
+FORMAT = "bk-catalog-7"
+# older formats this version reads (not resumes), and what they lack: bk-catalog-6 has no /events/stress_drop (the
+# reader supplies NaN); bk-catalog-5 keeps a creep state of
 # another layout in its checkpoints (its episode table without the episodes' energy, EPISODE_COLUMNS);
 # bk-catalog-4 has no /events/kind and /events/ending (every row an inertial event; the reader supplies kind 0,
 # ending 0) and no creep state in its checkpoints; bk-catalog-3 lacks also tables_crc and /tasks/record_crc (its
 # tables are checked against its config only). Only FORMAT is written and resumed.
 OLDER = {
+    "bk-catalog-6": "written before events kept their stress drop (no /events/stress_drop)",
     "bk-catalog-5": "written before creep episodes kept their energy (another creep state in its checkpoints)",
     "bk-catalog-4": "written before the creep phase (no /events/kind, no creep state in its checkpoints)",
     "bk-catalog-3": "written before its tables were checksummed",
 }
 READABLE = {*OLDER, FORMAT}
-CHECKSUMMED = {"bk-catalog-4", "bk-catalog-5", FORMAT}      # formats with tables_crc and /tasks/record_crc
-WITH_CREEP = {"bk-catalog-5", FORMAT}       # formats with /events/kind, /events/ending and /checkpoint/creep
+# formats with tables_crc and /tasks/record_crc; with /events/kind, /events/ending and /checkpoint/creep
+CHECKSUMMED = {"bk-catalog-4", "bk-catalog-5", "bk-catalog-6", FORMAT}
+WITH_CREEP = {"bk-catalog-5", "bk-catalog-6", FORMAT}
 # columns of the episode table in a checkpoint's creep state (Workspace.creep_state), by format
-EPISODE_COLUMNS = {"bk-catalog-5": 14, FORMAT: NEPISODE}
+EPISODE_COLUMNS = {"bk-catalog-5": 14, "bk-catalog-6": NEPISODE, FORMAT: NEPISODE}
 
 # /events/kind: what a row is, KIND_EVENT (0) or KIND_CREEP (1) (ensemble/model/workspace.py, imported above)
 # /events/ending: 0 an inertial event; a creep episode 1 whose blocks all stopped, 2 taken over by an event
@@ -53,12 +56,15 @@ ENDING_EVENT, ENDING_STOPPED, ENDING_TAKEN_OVER = 0, 1, 2
 EVENT_FIELDS = {
     "task": np.int64, "t": np.float64, "epicenter": np.int64, "mu": np.float64,
     "slip": np.float64, "first": np.int64, "last": np.int64, "n_slipped": np.int64,
-    "boundary": np.bool_, "duration": np.float64, "kind": np.int8, "ending": np.int8,
+    "boundary": np.bool_, "duration": np.float64, "kind": np.int8, "ending": np.int8, "stress_drop": np.float64,
 }
-# the columns of the formats before bk-catalog-5 (their events CRC covers these, in this order); the reader
-# supplies the others as SUPPLIED says
-OLDER_EVENT_FIELDS = tuple(EVENT_FIELDS)[:10]
-SUPPLIED = {"kind": KIND_EVENT, "ending": ENDING_EVENT}
+# the columns each format stores (its events CRC covers these, in this order); the reader supplies the others
+# as SUPPLIED says
+STORED_EVENT_FIELDS = {
+    "bk-catalog-3": tuple(EVENT_FIELDS)[:10], "bk-catalog-4": tuple(EVENT_FIELDS)[:10],
+    "bk-catalog-5": tuple(EVENT_FIELDS)[:12], "bk-catalog-6": tuple(EVENT_FIELDS)[:12], FORMAT: tuple(EVENT_FIELDS),
+}
+SUPPLIED = {"kind": KIND_EVENT, "ending": ENDING_EVENT, "stress_drop": np.nan}
 TASK_FIELDS = {
     "point": np.int64, "seed_index": np.int64, "N": np.int64, "l": np.float64, "nu": np.float64,
     # every friction law's keys (model/laws/); NaN for a key of another law than the task's
@@ -95,6 +101,9 @@ DATASETS = {
     "events/ending": ("code", _EVENT_ROWS, f"{ENDING_EVENT} an inertial event; a creep episode {ENDING_STOPPED} "
                                            f"whose blocks all stopped, {ENDING_TAKEN_OVER} taken over by an "
                                            "inertial event; absent in catalogs before bk-catalog-5: 0"),
+    "events/stress_drop": ("model force", _EVENT_ROWS, "mean over the blocks that slipped of the drop of their force "
+                                                       "by the slip (the driver held at its onset position); NaN for "
+                                                       "a creep episode, and in catalogs before bk-catalog-7"),
     "tasks/point": ("index", _TASK_ROWS, "parameter point (position in the product of the [sweep] lists)"),
     "tasks/seed_index": ("index", _TASK_ROWS, "realisation of its point; task = point * run.seeds + seed_index"),
     "tasks/N": ("count", _TASK_ROWS, "number of blocks of the chain"),
