@@ -1,4 +1,4 @@
-"""python -m analysis reduce|plot|report|paper|export|compare ...
+"""python -m analysis reduce|plot|report|paper|export|compare|history ...
 
 reduce streams one or more catalogs into per-task histograms (ranks split the tasks of all
 catalogs under mpirun and rank 0 merges them), pools the tasks of equal parameters (N, l, nu and
@@ -9,7 +9,7 @@ stream and parameters) in two catalogs is refused; so is an unfinished run (a *.
 catalog, unfinished tasks) unless --partial is given. plot overlays the points of one or more
 summaries; report prints a summary's numbers; paper sets the paper's claims beside them; export
 writes a catalog's or a summary's tables; compare sets the points of catalogs of several friction
-laws side by side (analysis/compare.py).
+laws side by side (analysis/compare.py); history draws an event history a run kept (analysis/history.py).
 
 Every numeric option is checked before any file is read (NUMERIC below: finite, in its range,
 sizes this machine can hold), and every output path before any work (ensemble/checks.py: not
@@ -95,6 +95,13 @@ def _parser():
     ex.add_argument("--force", action="store_true", help="overwrite tables already in the directory")
     ex.add_argument("--partial", action="store_true",
                     help="export an unfinished run as far as written (every table's header says so)")
+    hi = sub.add_parser("history", help="an event history of a catalog (output.history) -> figure of its velocity "
+                                         "in space and time (analysis/history.py)")
+    hi.add_argument("catalog")
+    hi.add_argument("-o", "--output", required=True, help="FILE.png or FILE.pdf")
+    hi.add_argument("--task", type=int, default=None, help="the task (default: the first with a history)")
+    hi.add_argument("--index", type=int, default=0, help="its history number (default 0: its first)")
+    hi.add_argument("--force", action="store_true", help="overwrite an existing figure")
     cp = sub.add_parser("compare", help="catalogs of several friction laws -> table and figures on a "
                                          "law-independent size axis (docs/laws.md)")
     cp.add_argument("catalogs", nargs="+", metavar="catalog")
@@ -153,6 +160,13 @@ def _paper(args):
     return 0
 
 
+def _history(args):
+    from .history import draw
+    checks.output(args.output, inputs=[args.catalog], force=args.force, what="figure")   # before the work
+    print(f"wrote {args.output}: {draw(args.catalog, args.output, args.task, args.index)}")
+    return 0
+
+
 def _export(args):
     from .export import write
     for path in write(args.source, args.output, args.format, force=args.force, partial=args.partial):
@@ -164,7 +178,7 @@ def main(argv=None):
     args = _parser().parse_args(argv)
     try:
         return {"reduce": _reduce, "plot": _plot, "report": _report, "export": _export,
-                "compare": _compare, "paper": _paper}[args.command](args)
+                "compare": _compare, "paper": _paper, "history": _history}[args.command](args)
     except BrokenPipeError:
         raise   # the reader of stdout went away: not a file error; __main__ ends quietly
     except (CatalogError, summary.SummaryError, ValueError, OSError) as err:

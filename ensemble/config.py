@@ -111,6 +111,11 @@ class Output:
     flush_seconds: float = 60.0  # ... or after this long, whichever comes first
     progress_seconds: float = 30.0  # rank 0 prints a progress line this often
     writer: str = "auto"         # "parallel" (mpio), "rank0" (messages to rank 0), "auto"
+    history: int = 0             # events per task whose history (velocity and slip profiles in time) is kept
+    history_mu: float = 4.0      # ... the first recorded events of magnitude at least this
+    history_snapshots: int = 1000  # ... at most this many snapshots each (the last is the event's end)
+    history_dt: float = 1.0      # ... a snapshot at least this often in the event's time (model time)
+    history_dlogv: float = 0.1   # ... and whenever its largest velocity has changed by this in log10
 
 
 # (the names in sections.py, where filekind.py reads them too)

@@ -29,6 +29,9 @@ def _nonneg(x):
 MAX_BLOCKS = 10 ** 6
 MAX_COUNT = 10 ** 12
 MAX_BATCH = 10 ** 7
+# event histories: each takes up to history_snapshots x 16 N bytes of the catalog (ensemble/model/history.py)
+MAX_HISTORIES = 1000
+MAX_SNAPSHOTS = 100_000
 MAX_NU = 10.0
 
 RULES = {   # (section, key) -> (value -> bool, what it requires)
@@ -56,6 +59,11 @@ RULES = {   # (section, key) -> (value -> bool, what it requires)
     ("output", "writer"): (lambda x: x in ("auto", "parallel", "rank0"), "one of auto, parallel, rank0"),
     ("run", "poll_seconds"): (_positive, "> 0"),
     ("output", "path"): (lambda x: len(x) > 0, "a non-empty string"),
+    ("output", "history"): (lambda x: 0 <= x <= MAX_HISTORIES, f"an integer in [0, {MAX_HISTORIES}] (events per "
+                                                               "task whose history is kept; 0: none)"),
+    ("output", "history_snapshots"): (lambda x: 2 <= x <= MAX_SNAPSHOTS, f"an integer in [2, {MAX_SNAPSHOTS}]"),
+    ("output", "history_dt"): (_positive, "> 0"),
+    ("output", "history_dlogv"): (_positive, "> 0"),
 }
 
 

@@ -26,7 +26,8 @@ from .laws import loader_moves, onset_delay, rest_state, threshold
 from .schedule import advance_clock, build_schedule, finite_state, materialize, tree_min
 from .undo import log_block
 from .workspace import (BETWEEN, CS_ENDED, CS_NCREEP, D_DURATION, D_ENDING, D_KIND, D_SLIP, EV_CLOCK_HI,
-                        EV_CLOCK_LO, EV_EPICENTER, EV_PHASE, F0, KIND_EVENT, NONFINITE, NTRACE, OK, P, PAUSED)
+                        EV_CLOCK_LO, EV_EPICENTER, EV_PHASE, F0, HC_ON, HC_READY, HC_SLIP_MIN, KIND_EVENT, NONFINITE,
+                        NTRACE, OK, P, PAUSED)
 
 # Work units charged for each event besides its block-steps: a fixed stand-in for the onset
 # search (tree descent, onset delay), setting the event up and finishing it (O(log N) and
@@ -40,7 +41,8 @@ def simulate(arrays, clock, p, n_events, budget, out_t, out_epicenter, out_diag)
     arrays `arrays` (workspace.WorkArrays) with the parameters `p` (params.KernelParams).
 
     Returns (status, k), k the number of events completed in this call:
-    OK and k = n_events, or OK and k < n_events when the budget ran out between two events;
+    OK and k = n_events, or OK and k < n_events when the budget ran out between two events or an event's
+    history is ready (history.py: arrays.hctl[HC_READY] = 1, the event is row k - 1);
     PAUSED when it ran out in the middle of an event, which stays in the workspace (`event`,
     `undo`, and `clock` at its onset) and the next call continues (its row is then that
     call's first). Work: the block-steps of the events (event.py) plus EVENT_WORK per event
@@ -151,6 +153,10 @@ def simulate(arrays, clock, p, n_events, budget, out_t, out_epicenter, out_diag)
         out_diag[k, D_KIND] = KIND_EVENT
         out_diag[k, D_ENDING] = 0.0
         k += 1
+        hctl = arrays.hctl
+        if hctl[HC_ON] != 0.0 and diag[D_SLIP] >= hctl[HC_SLIP_MIN]:
+            hctl[HC_READY] = 1.0     # its snapshots are in `history`: the caller copies them (history.py)
+            return OK, k
     return (OK if event[EV_PHASE] == BETWEEN else PAUSED), k
 
 

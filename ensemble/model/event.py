@@ -45,6 +45,7 @@ from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
 from .steppers import FIRST_KEPT, FIRST_LAST, FIRST_NEW
 from .transitions import (NO_CUT, ONSET_LOADING, ONSET_NEIGHBOUR, STICK, above_threshold, event_nu, force_now,
                           loading_cut, locate, pressed, rest_psi, velocity_slopes)
+from .history import begin as begin_history, snapshot
 from .undo import clear_log, log_block
 from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D_ENERGY_SCALE, D_FIRST, D_LAST,
                         D_LOAD_WORK, D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_STRESS_DROP, D_VMAX, D_WORK,
@@ -166,6 +167,8 @@ def begin_event(arrays, t0, n, epicenter, v_start, p):
     W[epicenter, V] = v_start
     event[EV_PHASE] = IN_EVENT
     event[EV_EPICENTER] = epicenter
+    begin_history(arrays)
+    snapshot(arrays, n, na, nt, 0.0, False)
     _keep(event, _at_onset(na=na, nt=nt, yrest=yrest, t_far=t_far, far=far, vmax=v_start, h_next=p.dt))
 
 
@@ -190,6 +193,8 @@ def begin_handover(arrays, t0, n, epicenter, p):
     t_far, far = _far_onset(W, arrays.flag, n, arrays.since, arrays.tree, t0, 0.0, p)
     event[EV_PHASE] = IN_EVENT
     event[EV_EPICENTER] = epicenter
+    begin_history(arrays)
+    snapshot(arrays, n, na, nt, 0.0, False)
     _keep(event, _at_onset(na=na, nt=nt, yrest=yrest, t_far=t_far, far=far, vmax=vmax, h_next=p.dt))
 
 
@@ -396,6 +401,7 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
         unchanged = kind == NO_CUT and nstuck == 0 and na == m
         if not unchanged:
             t_far, far = _reschedule(W, flag, stuck, since, tree, nstuck, n, t0, tau, p)
+        snapshot(arrays, n, na, nt, tau, na == 0)
     if profile.shape[0] == n:
         profile[:] = 0.0
         for k in range(nt):

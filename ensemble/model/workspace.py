@@ -196,6 +196,20 @@ CS_FRESH = 6    # 1: blocks joined since the last step, the velocities are made 
 CS_DIRTY = 7    # 1: blocks joined or left since the list `crept` was made (Workspace.load sets it)
 NCSTATE = 8
 
+# Event histories (history.py): the control vector `hctl`, and the columns of a snapshot row of `history`
+HC_ON = 0          # 1: continue_event takes snapshots of the event in progress
+HC_SLIP_MIN = 1    # chain.simulate ends its call after an inertial event of at least this slip (HC_READY)
+HC_DT = 2          # a snapshot at least this often in the event's local time
+HC_RATIO = 3       # ... and whenever the largest velocity has changed by this factor
+HC_COUNT = 4       # snapshots taken of the event in progress
+HC_TAU = 5         # local time of the last snapshot
+HC_V = 6           # largest velocity at the last snapshot
+HC_DROPPED = 7     # snapshots dropped for want of rows (the buffer's last row keeps the end)
+HC_READY = 8       # 1: the last row chain.simulate wrote is an event whose snapshots are in `history`
+NHCTL = 9
+H_TAU, H_LO, H_HI = 0, 1, 2    # a snapshot: local time since the onset, the touched blocks' span lo..hi,
+H_VALUES = 3                   # then the velocities of blocks 0..n-1 (valid on lo..hi), then their slips
+
 # values of EV_PHASE
 BETWEEN, IN_EVENT = 0, 1
 
@@ -242,6 +256,8 @@ WorkArrays = namedtuple("WorkArrays", [
     "episodes", # (2 n, NEPISODE) float64: creep episodes running or waiting to be reported (E_*)
     "cstate",   # (NCSTATE,) float64: the creep phase's scalars (CS_*)
     "crept",    # (n,) int: the creeping blocks in increasing order, crept[:cstate[CS_NCREEP]] (creep.py)
+    "history",  # (snapshots, H_VALUES + 2 n) float64: the event's snapshots (history.py); 0 rows: none taken
+    "hctl",     # (NHCTL,) float64: the histories' control (HC_*)
 ])
 
 
@@ -260,7 +276,8 @@ class Workspace:
     and W[i, P] at the two-float time since[i]; `state` brings all of it to one time.
     """
 
-    def __init__(self, n):
+    def __init__(self, n, snapshots=0):
+        """snapshots: rows of the event-history buffer (history.py; 0: no histories)."""
         self.W = np.zeros((n, NCOLS))
         self.act = np.zeros(n, dtype=np.int64)
         self.flag = np.zeros(n, dtype=np.int8)
@@ -275,13 +292,16 @@ class Workspace:
         self.episodes = np.zeros((2 * n, NEPISODE))
         self.cstate = np.zeros(NCSTATE)
         self.crept = np.zeros(n, dtype=np.int64)
+        self.history = np.zeros((snapshots, H_VALUES + 2 * n))
+        self.hctl = np.zeros(NHCTL)
 
     @property
     def arrays(self):
         """The work arrays as the kernels take them (WorkArrays)."""
         return WorkArrays(W=self.W, act=self.act, flag=self.flag, touched=self.touched, stuck=self.stuck,
                           since=self.since, tree=self.tree, diag=self.diag, event=self.event, undo=self.undo,
-                          creep=self.creep, episodes=self.episodes, cstate=self.cstate, crept=self.crept)
+                          creep=self.creep, episodes=self.episodes, cstate=self.cstate, crept=self.crept,
+                          history=self.history, hctl=self.hctl)
 
     def load(self, force, psi, since=None, creep=None):
         """Set the between-events state: force and psi of every block (at time since, default 0),
@@ -296,6 +316,7 @@ class Workspace:
         self.since[:] = 0.0 if since is None else since
         self.tree[:] = np.nan    # the kernels rebuild the schedule
         self.event[:] = 0.0      # BETWEEN, undo log empty
+        self.hctl[HC_READY] = 0.0   # (no event of this state has snapshots)
         self.creep[:] = 0.0
         self.episodes[:] = 0.0
         self.cstate[:] = 0.0

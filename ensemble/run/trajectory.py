@@ -13,8 +13,9 @@ from ..config import ConfigError, parse_section, section_lines
 from ..integrators import INTEGRATORS, kernel_params
 from ..model.chain import simulate
 from ..model.workspace import (CS_H, CS_NCREEP, CS_T_HI, CS_T_LO, D_DURATION, D_ENDING, D_FIRST, D_KIND, D_LAST,
-                               D_NSLIP, D_SLIP, D_STRESS_DROP, EV_NA, EV_PHASE, EV_STEPS, EV_TAU, EV_VMAX, IN_EVENT,
-                               NDIAG, OK, PAUSED, STATUS_TEXT, UNLIMITED, Workspace)
+                               H_HI, H_LO, H_TAU, H_VALUES, HC_COUNT, HC_DROPPED, HC_DT, HC_ON, HC_RATIO, HC_READY,
+                               HC_SLIP_MIN, D_NSLIP, D_SLIP, D_STRESS_DROP, EV_NA, EV_PHASE, EV_STEPS, EV_TAU, EV_VMAX,
+                               IN_EVENT, NDIAG, OK, PAUSED, STATUS_TEXT, UNLIMITED, Workspace)
 from ..store.checkpoint import Checkpoint, carries_creep
 from ..store.errors import CatalogError
 from .tasks import initial_state
@@ -27,13 +28,22 @@ class SimulationError(RuntimeError):
 class Trajectory:
     """One task's chain between events: its workspace, clock and event counter."""
 
-    def __init__(self, cfg, task, checkpoint=None, integrator=None, label=None, discarded=None):
+    def __init__(self, cfg, task, checkpoint=None, integrator=None, label=None, discarded=None, histories=None):
+        """histories: the event histories the task has kept so far (output.history; None: it keeps none, as a
+        spin-up)."""
         self.cfg = cfg
         self.task = task
         self.label = f"task {task.index}" if label is None else label     # in error messages
         self.discarded = cfg.run.discarded if discarded is None else discarded
         self.integrator = cfg.integrator if integrator is None else integrator
-        self.ws = Workspace(task.model.N)
+        out = cfg.output
+        self.history_quota = out.history if histories is not None else 0
+        self.histories_kept = histories or 0
+        self.new_histories = []       # (slot, history) taken since the caller last collected them
+        self.ws = Workspace(task.model.N, out.history_snapshots if self.history_quota else 0)
+        hctl = self.ws.hctl
+        hctl[HC_SLIP_MIN], hctl[HC_DT] = 10.0 ** out.history_mu, out.history_dt
+        hctl[HC_RATIO] = 10.0 ** out.history_dlogv
         # a chain that can creep keeps its creep phase's state in its checkpoints (store/checkpoint.py)
         self.creeps = carries_creep(task.model)
         if checkpoint is None:
@@ -82,6 +92,8 @@ class Trajectory:
         epicenter = np.empty(n, dtype=np.int64)
         diag = np.empty((n, NDIAG))
         ws = self.ws
+        # snapshots while recording and short of the quota (switched between events only: history.py)
+        ws.hctl[HC_ON] = float(self.done >= self.discarded and self.histories_kept < self.history_quota)
         status, k = simulate(ws.arrays, self.clock, self.params, n, budget, t, epicenter, diag)
         if status not in (OK, PAUSED):
             where = self.done + k
@@ -90,8 +102,24 @@ class Trajectory:
             raise SimulationError(f"{self.label} {phase}event {where}: {STATUS_TEXT[status]} "
                                   f"(method={self.integrator.method}, dt={self.integrator.dt}, "
                                   f"rtol={self.integrator.rtol}{creep})")
+        if ws.hctl[HC_READY]:
+            ws.hctl[HC_READY] = 0.0
+            self.new_histories.append((self.histories_kept, self._history(self.done + k - 1 - self.discarded)))
+            self.histories_kept += 1
         self.done += k
         return t[:k], epicenter[:k], diag[:k]
+
+    def _history(self, row):
+        """The snapshots in the workspace as a history of recorded row `row` (ensemble/store/histories.py)."""
+        hctl, n = self.ws.hctl, self.task.model.N
+        H = self.ws.history[:int(hctl[HC_COUNT])]
+        velocity, slip = np.zeros((len(H), n)), np.zeros((len(H), n))
+        for r, snap in enumerate(H):
+            lo, hi = int(snap[H_LO]), int(snap[H_HI]) + 1      # (valid there; the others at rest, no slip)
+            velocity[r, lo:hi] = snap[H_VALUES + lo:H_VALUES + hi]
+            slip[r, lo:hi] = snap[H_VALUES + n + lo:H_VALUES + n + hi]
+        return {"row": row, "time": H[:, H_TAU].copy(), "velocity": velocity, "slip": slip,
+                "dropped": int(hctl[HC_DROPPED])}
 
 
 def event_rows(task, t, epicenter, diag):

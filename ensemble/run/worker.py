@@ -72,14 +72,14 @@ class TaskRunner:
             print(f"note: rank {self.coord.rank}: task {task.index}: {rec.damaged}; it is rerun from its start",
                   file=sys.stderr, flush=True)
             self.writer.start(task.index, integrator_text(cfg.integrator))
-            return Trajectory(cfg, task, self._start(task)), 0
+            return Trajectory(cfg, task, self._start(task), histories=0), 0
         if rec.status == FAILED:
             if self.rerun is None or (cfg.run.branch and task.point not in self.spun):
                 self.failed.append((task.index, rec.error))
                 return None
             rec = self.writer.record(task.index, restart=True)
             self.writer.start(task.index, integrator_text(self.rerun))
-            return Trajectory(cfg, task, self._start(task), self.rerun), 0
+            return Trajectory(cfg, task, self._start(task), self.rerun, histories=0), 0
         if rec.checkpoint is not None:
             self.coord.count_events(rec.checkpoint.done, resumed=True)
         if rec.written >= cfg.run.events:
@@ -87,7 +87,8 @@ class TaskRunner:
                 self.writer.finish(task.index, {})
             return None
         checkpoint = rec.checkpoint if rec.checkpoint is not None else self._start(task)
-        return Trajectory(cfg, task, checkpoint, parse_integrator(rec.integrator, where)), rec.written
+        return (Trajectory(cfg, task, checkpoint, parse_integrator(rec.integrator, where), histories=rec.histories),
+                rec.written)
 
     def _start(self, task):
         """The state a task starts from: None (its own initial state), or after branching its point's
@@ -152,6 +153,7 @@ class TaskRunner:
         total = traj.discarded + events
         buffer = []
         buffered = 0
+        histories = []      # (slot, history) of buffered rows (Trajectory.new_histories)
         chunk = 4
         budget = FIRST_BUDGET
         last_flush = time.perf_counter()
@@ -160,13 +162,13 @@ class TaskRunner:
         quiet_since, quiet_note = time.perf_counter(), QUIET_SECONDS
 
         def flush():
-            nonlocal buffer, buffered, written, last_flush
+            nonlocal buffer, buffered, written, last_flush, histories
             start = time.perf_counter()
             batch = ({name: np.concatenate([b[name] for b in buffer]) for name in buffer[0]}
                      if buffer else None)
-            self.writer.commit(record, written, batch, traj.checkpoint())
+            self.writer.commit(record, written, batch, traj.checkpoint(), histories)
             written += buffered
-            buffer, buffered = [], 0
+            buffer, buffered, histories = [], 0, []
             last_flush = time.perf_counter()
             self.io_time += last_flush - start
 
@@ -195,6 +197,8 @@ class TaskRunner:
                 recorded_here += k
                 buffer.append(event_rows(traj.task, *out))
                 buffered += k
+                histories += traj.new_histories
+                traj.new_histories = []
             now = time.perf_counter()
             if k:
                 quiet_since, quiet_note = now, QUIET_SECONDS

@@ -64,4 +64,5 @@ class TaskRecord:
     integrator: str = ""            # its [integrator] as TOML text
     error: str = ""
     damaged: str = ""               # what is wrong with its record (tables.py): rerun it from its start
+    histories: int = 0              # event histories of its committed rows kept (histories.py)
 

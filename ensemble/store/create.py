@@ -10,7 +10,7 @@ import numpy as np
 from ..version import __version__
 from ..model import laws
 from ..sweep import spinups as spinup_points
-from . import tables
+from . import histories, tables
 from .checkpoint import carries_creep, state_size
 from .layout import fixed_digest
 from .schema import (DATASETS, EVENT_FIELDS, FORMAT, LAW_BYTES, NCOMMIT, OPEN, PROVENANCE_FIELDS, TASK_FIELDS,
@@ -77,10 +77,31 @@ def create_layout(h5, cfg, tasks, integrator_text, software=""):
     tg.create_dataset("record_crc", data=np.array(
         [tables.record_crc(k, {name: col[k] for name, col in columns.items()}) for k in range(len(tasks))],
         dtype=np.int64))
+    _create_histories(h5, cfg, tasks)
     for name, entry in DATASETS.items():
         if name in h5:    # /spinup only with run.branch
             h5[name].attrs["description"] = description(entry)
     h5.attrs["tables_crc"] = fixed_digest(h5)
+
+
+def _create_histories(h5, cfg, tasks):
+    """/histories (histories.py), only where the run keeps event histories."""
+    per_task, snapshots = cfg.output.history, cfg.output.history_snapshots
+    if per_task == 0:
+        return
+    slots = len(tasks) * per_task
+    blocks = max(t.model.N for t in tasks)
+    g = h5.create_group(histories.GROUP)
+    g.attrs["per_task"] = per_task
+    g.attrs["snapshots"] = snapshots
+    g.attrs["blocks"] = blocks
+    for name in histories.SCALARS:
+        g.create_dataset(name, data=np.full(slots, -1, dtype=np.int64))
+    for name, shape in (("time", (slots, snapshots)), ("velocity", (slots, snapshots, blocks)),
+                        ("slip", (slots, snapshots, blocks))):
+        # never filled, like /events: only the snapshots written take space
+        g.create_dataset(name, shape=shape, dtype=np.float64, fillvalue=np.nan, fill_time="never",
+                         dcpl=early_allocation())
 
 
 def early_allocation():
@@ -98,6 +119,7 @@ def estimate_bytes(cfg, tasks):
             + 8 * sum(2 * state_size(t.model.N, carries_creep(t.model)) for t in records)   # checkpoint slots
             + len(records) * (8 * (2 * NCOMMIT + 1) + 1)                      # commit rows, offsets, creep
             + len(tasks) * (8 * (len(TASK_FIELDS) + len(PROVENANCE_FIELDS) + 5) + 2 * TEXT_BYTES + LAW_BYTES))
+    data += histories.size_bound(cfg, tasks)
     metadata = 4096 * (len(DATASETS) + 4) + 2 * len(cfg.to_toml()) + 64 * 1024
     return int(data * 1.01) + metadata
 

@@ -23,6 +23,7 @@ from ..sweep import spinups as spinup_points, task_list
 from . import tables
 from .checkpoint import Checkpoint, Head, TaskRecord, carries_creep, state_size
 from .errors import CatalogError, writing
+from .histories import GROUP, Histories
 from .integrity import EventCrc, commit_crc, crc, event_problems
 from .schema import (C_DONE, C_EVENTS_CRC, C_ROW_CRC, C_SEQ, C_STATE_CRC, C_WRITTEN, CHECKSUMMED, EPISODE_COLUMNS,
                      EVENT_FIELDS, FAILED, FINISHED, NCOMMIT, OPEN, READ_CHUNK, STORED_EVENT_FIELDS, SUPPLIED,
@@ -57,6 +58,8 @@ class Layout:
             self.spinup = {name: ds[...] for name, ds in h5["spinup"].items()} if "spinup" in h5 else {}
             # which records keep a creep state in their slots (none before bk-catalog-5)
             self.creep = (h5["checkpoint"]["creep"][...].astype(np.int64) if self.format in WITH_CREEP else None)
+            # event histories (histories.py), where the run keeps them
+            self.histories = Histories(h5, self.path) if GROUP in h5 else None
         except (KeyError, OSError, ValueError) as err:
             raise CatalogError(f"{self.path}: damaged catalog ({err})") from None
         n_tasks = len(self.n_blocks)
@@ -227,6 +230,8 @@ class Layout:
         self._crc[task] = self.verify_events(task, head.written)
         rec.checkpoint = self.read_state(task, head)
         rec.written = head.written
+        if self.histories is not None and task < self.n_tasks:
+            rec.histories = self.histories.kept(task, head.written)
         return rec
 
     def _check_creep_layout(self, task):
@@ -261,6 +266,12 @@ class Layout:
                 self.events[name][lo:lo + n] = batch[name]
         self._write(task, "events", write)
         running.update(batch)
+
+    def write_history(self, task, slot, history):
+        """One event history (histories.py), before the commit whose rows include its event."""
+        if self.histories is None:
+            raise CatalogError(f"{self.path}: task {task}: an event history for a catalog laid out without them")
+        self.histories.write(task, slot, history)
 
     def write_checkpoint(self, task, checkpoint, written):
         running = self._crc[task]

@@ -75,6 +75,14 @@ class Reader:
             return parts
         return rows_where(parts, lambda part: part["kind"] == kind)
 
+    def histories(self, task):
+        """The task's event histories (list of dicts: row, time (s,), velocity and slip (s, N), dropped), of
+        its committed rows, verified; [] where the run kept none (ensemble/store/histories.py)."""
+        if self.layout.histories is None:
+            return []
+        written = int(self.tasks["events_written"][task])
+        return self.layout.histories.read(task, written, int(self.layout.n_blocks[task]))
+
     def count(self, task, kind):
         """The task's committed rows of that kind (/events/kind alone, not verified: task_events verifies)."""
         written = int(self.tasks["events_written"][task])

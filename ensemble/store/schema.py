@@ -152,6 +152,16 @@ DATASETS = {
                           "per task and slot: [sequence, events done incl. transient, events written, CRC of "
                           "the state slot, CRC of the written events, CRC of the row]; the valid row with the "
                           "highest sequence is the task's truth"),
+    # only where output.history > 0 (ensemble/store/histories.py); H = tasks * output.history slots, task k's
+    # from k * output.history, S = output.history_snapshots, N the largest chain's
+    "histories/row": ("index", "(H,)", "the event's row among its task's rows (-1: slot unused; its /events row is "
+                                       "task * events_per_task + row)"),
+    "histories/snapshots": ("count", "(H,)", "snapshots kept, from the onset to the event's end"),
+    "histories/dropped": ("count", "(H,)", "snapshots dropped for want of rows (output.history_snapshots)"),
+    "histories/crc": ("CRC-32", "(H,)", "CRC of the history (row, counts, its snapshots' data)"),
+    "histories/time": ("model time", "(H, S)", "local time of each snapshot since the event's onset"),
+    "histories/velocity": ("model length / model time", "(H, S, N)", "each block's velocity at the snapshot"),
+    "histories/slip": ("model length", "(H, S, N)", "each block's slip since the onset at the snapshot"),
 }
 # columns of Reader.tasks that are not /tasks datasets or are read from elsewhere
 READER_TASKS = {

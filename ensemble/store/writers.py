@@ -85,7 +85,9 @@ class ParallelWriter(_Writer):
                 files.discard(path)
             raise CatalogError(error, collective=True)
 
-    def commit(self, task, start, batch, checkpoint):
+    def commit(self, task, start, batch, checkpoint, histories=()):
+        for slot, history in histories:
+            self.layout.write_history(task, slot, history)
         if batch is not None:
             self.layout.write_events(task, start, batch)
         self.layout.write_checkpoint(task, checkpoint, start + (0 if batch is None else len(batch["t"])))
@@ -166,8 +168,8 @@ class Rank0Writer(_Writer):
     def record(self, task, restart=False):
         return self._call("record", task, restart)
 
-    def commit(self, task, start, batch, checkpoint):
-        self._call("commit", task, start, batch, checkpoint)
+    def commit(self, task, start, batch, checkpoint, histories=()):
+        self._call("commit", task, start, batch, checkpoint, histories)
 
     def finish(self, task, provenance):
         self._call("finish", task, provenance)
@@ -187,7 +189,9 @@ class Rank0Writer(_Writer):
         if kind == "record":
             return layout.record(*args)
         if kind == "commit":
-            task, start, batch, checkpoint = args
+            task, start, batch, checkpoint, histories = args
+            for slot, history in histories:
+                layout.write_history(task, slot, history)
             if batch is not None:
                 layout.write_events(task, start, batch)
                 self._flush()   # events reach the file before the commit row points past them

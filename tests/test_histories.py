@@ -1,0 +1,146 @@
+"""Event histories (output.history; ensemble/model/history.py, ensemble/store/histories.py): recording them changes
+no event of the catalog, bit for bit; each is the event it names (its end is the event's slip profile, summing to
+its slip, at its duration), sampled from the onset by velocity and by time; they are the first recorded events of
+their magnitude; two ranks under mpiexec and a run killed between a history and its commit give the same.
+"""
+import shutil
+import sys
+
+import numpy as np
+import pytest
+
+from ensemble.store import reader
+
+from .conftest import run_cli, write_config
+from .processes import ROOT, analysis_here, child_env, run_bounded
+from .same_catalogs import assert_same_events
+
+TIMEOUT = 300
+MU = 2.0          # output.history_mu: at N = 100, b = 20 about one event in ten
+PER_TASK = 3
+HISTORY = {"history": PER_TASK, "history_mu": MU, "history_snapshots": 2000, "history_dt": 0.1,
+           "history_dlogv": 0.2}
+
+
+def config(d, **output):
+    return write_config(d / f"cfg{len(output)}.toml", model={"N": 100, "b": 20.0},
+                        run={"seeds": 2, "events": 150, "transient": 50}, output={"batch": 40, **output})
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    """The same config without and with histories, serial."""
+    d = tmp_path_factory.mktemp("histories")
+    out = {}
+    for name, extra in (("plain", {}), ("recorded", HISTORY)):
+        res = run_cli("run", config(d, **extra), "-o", d / f"{name}.h5", timeout=TIMEOUT)
+        assert res.returncode == 0, res.stdout + res.stderr
+        out[name] = d / f"{name}.h5"
+    return d, out
+
+
+def histories_of(path):
+    with reader.Reader(path) as cat:
+        return [cat.histories(k) for k in range(len(cat.tasks["point"]))], cat.per_task
+
+
+def test_recording_changes_no_event(runs):
+    _, out = runs
+    assert_same_events(out["plain"], out["recorded"])
+    plain, _ = histories_of(out["plain"])
+    assert all(h == [] for h in plain)
+
+
+def test_a_history_is_its_event_from_onset_to_end(runs):
+    _, out = runs
+    events, _, _ = reader.read(out["recorded"])
+    histories, per_task = histories_of(out["recorded"])
+    for task, kept in enumerate(histories):
+        mine = {name: col[events["task"] == task] for name, col in events.items()}
+        # the first PER_TASK recorded inertial events of mu >= MU, in order
+        first = np.flatnonzero((mine["mu"] >= MU) & (mine["kind"] == 0))[:PER_TASK]
+        assert [h["row"] for h in kept] == list(first) and len(first) == PER_TASK
+        for h in kept:
+            row, time, v, y = h["row"], h["time"], h["velocity"], h["slip"]
+            # the end is the event's: its slip profile, summing to its slip, at its duration, all at rest
+            assert y[-1].sum() == pytest.approx(mine["slip"][row], rel=1e-12)
+            assert time[-1] == mine["duration"][row] and not v[-1].any()
+            slipped = np.flatnonzero(y[-1] > 0)
+            assert (slipped[0], slipped[-1], len(slipped)) == (mine["first"][row], mine["last"][row],
+                                                              mine["n_slipped"][row])
+            # from the onset (the epicenter alone, nothing slipped yet), in time, blocks never moving back
+            assert time[0] == 0 and np.all(np.diff(time) > 0) and not y[0].any()
+            assert np.all(np.diff(y, axis=0) >= 0) and np.all(v >= 0)
+            assert np.argmax(v[1]) == mine["epicenter"][row]
+            # sampled by time (history_dt) and by velocity (history_dlogv): no gap longer than the step after
+            # history_dt, the largest velocity rising through several decades before the rupture
+            vmax = v.max(axis=1)
+            assert h["dropped"] == 0 and len(time) > 20
+            assert vmax.max() / vmax[1] > 100
+            # the slip of each snapshot is the time integral of the velocity: trapezoids between snapshots, to
+            # the sampling's accuracy (history_dt 0.1: measured up to 4.6e-3 of the largest slip)
+            integral = np.concatenate([np.zeros((1, v.shape[1])),
+                                       np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(time)[:, None], axis=0)])
+            off = np.abs(integral - y).max() / y[-1].max()
+            print(f"row {row}: {len(time)} snapshots; trapezoids of v against the slip: {off:.1e} of the largest")
+            assert off < 1e-2
+
+
+def test_two_ranks_write_the_same_histories(runs):
+    d, out = runs
+    mpi = d / "mpi.h5"
+    res = run_bounded([shutil.which("mpiexec"), "-n", "2", sys.executable, "-m", "ensemble", "run",
+                       str(config(d, **HISTORY)), "-o", str(mpi)], TIMEOUT, env=child_env())
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert_same_events(out["recorded"], mpi)
+    same_histories(out["recorded"], mpi)
+
+
+def same_histories(a, b):
+    ha, _ = histories_of(a)
+    hb, _ = histories_of(b)
+    assert len(ha) == len(hb)
+    for x, y in zip(ha, hb):
+        assert len(x) == len(y) == PER_TASK
+        for p, q in zip(x, y):
+            assert p["row"] == q["row"] and p["dropped"] == q["dropped"]
+            for name in ("time", "velocity", "slip"):
+                np.testing.assert_array_equal(p[name], q[name], err_msg=name)
+
+
+def test_a_run_killed_between_a_history_and_its_commit_resumes_to_the_same(runs):
+    """Killed (as by kill -9) right after its first history's last write, before the commit of its event's row:
+    the resumed run writes that history again, and the catalog is the uninterrupted one's."""
+    d, out = runs
+    cfg = config(d, **HISTORY)
+    log = d / "writes.log"
+    code = (f"import sys; sys.path.insert(0, {str(ROOT)!r}); from tests import inject; inject.log_writes({str(log)!r}); "
+            f"inject.main(['run', {str(cfg)!r}, '-o', {str(d / 'logged.h5')!r}])")
+    res = run_bounded([sys.executable, "-c", code], TIMEOUT, env=child_env())
+    assert res.returncode == 0, res.stderr
+    writes = log.read_text().splitlines()
+    at = next(int(line.split()[0]) for line in writes if line.split()[2:] == ["/histories/row"])
+    code = (f"import sys; sys.path.insert(0, {str(ROOT)!r}); from tests import inject; inject.crash_at_write({at + 1}); "
+            f"inject.main(['run', {str(cfg)!r}, '-o', {str(d / 'killed.h5')!r}])")
+    res = run_bounded([sys.executable, "-c", code], TIMEOUT, env=child_env())
+    assert res.returncode == 99, res.stderr
+    res = run_cli("resume", d / "killed.h5", timeout=TIMEOUT)
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert_same_events(out["recorded"], d / "killed.h5")
+    same_histories(out["recorded"], d / "killed.h5")
+
+
+def test_analysis_history_draws_one_and_says_which(runs, tmp_path):
+    _, out = runs
+    res = analysis_here("history", out["recorded"], "--task", "1", "--index", "2", "-o", tmp_path / "h.png")
+    assert res.returncode == 0, res.stderr
+    events, _, _ = reader.read(out["recorded"])
+    histories, _ = histories_of(out["recorded"])
+    row = histories[1][2]["row"]
+    mu = events["mu"][events["task"] == 1][row]
+    assert f"task 1, row {row}: mu = {mu:.2f}" in res.stdout and (tmp_path / "h.png").stat().st_size > 10_000
+    # none there: one line naming the file, exit 1, no figure
+    for path, args in ((out["plain"], ()), (out["recorded"], ("--index", str(PER_TASK)))):
+        res = analysis_here("history", path, *args, "-o", tmp_path / "none.png")
+        assert res.returncode == 1 and len(res.stderr.strip().splitlines()) == 1 and str(path) in res.stderr
+        assert not (tmp_path / "none.png").exists()
