@@ -69,7 +69,7 @@ def draw(path, output, task=None, index=0):
     right.set_ylabel("velocity", fontsize=FONT + 1)
     right.tick_params(labelsize=FONT)
     count = right.twinx()
-    count.plot(time, np.count_nonzero(h["velocity"] > 0, axis=1), color="C2", lw=1.0, label="blocks sliding")
+    count.plot(time, h["sliding"], color="C2", lw=1.0, label="blocks sliding")
     count.set_ylabel("blocks sliding", fontsize=FONT + 1, color="C2")
     count.tick_params(labelsize=FONT)
     lines = right.get_lines() + count.get_lines()

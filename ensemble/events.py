@@ -9,9 +9,9 @@ from .integrators import kernel_params
 from .model import laws
 from .model.event import integrate_event
 from .model.schedule import build_schedule, tree_min
-from .model.workspace import (D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D_ENERGY_SCALE, D_LOAD_WORK,
-                              D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_STRESS_DROP, D_VMAX, D_WORK, NTRACE, OK,
-                              STATUS_TEXT, Workspace)
+from .model.workspace import (D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D_ENERGY_SCALE, D_LOAD_WORK, D_REJECTED,
+                              D_RESIDUAL, D_SLIP, D_STEPS, D_STRESS_DROP, D_N_ONSET, D_T_SPREAD, D_T_WIDEST,
+                              D_N_WIDEST, D_VMAX, D_WORK, NTRACE, OK, STATUS_TEXT, Workspace)
 
 
 @dataclass
@@ -34,6 +34,7 @@ class EventResult:
     psi: np.ndarray
     seconds: float          # wall time of the event kernel alone (no set-up: what a run pays)
     stress_drop: float      # mean force drop of the slipped blocks by the slip (workspace.D_STRESS_DROP)
+    nucleation: tuple       # (n_onset, t_spread, t_widest, n_widest): workspace.D_N_ONSET ...
 
     @property
     def relative_energy_residual(self):
@@ -97,7 +98,8 @@ def run_event(force, psi, epicenter, model, integrator, v_start=0.0, trace=None)
     return EventResult(status, d[D_SLIP], d[D_DURATION], int(d[D_STEPS]), int(d[D_BLOCK_STEPS]),
                        int(d[D_REJECTED]), int(d[D_CUTS]), d[D_VMAX], d[D_WORK],
                        d[D_RESIDUAL], d[D_ENERGY_SCALE], d[D_ELASTIC], d[D_LOAD_WORK], profile, force,
-                       psi, seconds, d[D_STRESS_DROP])
+                       psi, seconds, d[D_STRESS_DROP],
+                       (int(d[D_N_ONSET]), d[D_T_SPREAD], d[D_T_WIDEST], int(d[D_N_WIDEST])))
 
 
 def check(result, what="event"):

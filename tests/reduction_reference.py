@@ -68,6 +68,10 @@ here the slow and obvious way, from the raw events:
 - stress drop (/events/stress_drop, NaN in catalogs before bk-catalog-7): the same over the events that have one
   (not NaN): its sum and their count per lr bin (the curve their quotient), the mean over the fit's events and
   the upper half's mean over the lower's;
+- nucleation: of the large inertial events (mu >= mu_c) with n_onset > 0 (catalogs from bk-catalog-7): their count
+  and the means of n_onset (L_sc), n_widest (L_c) and t_widest; of those with a t_spread (not NaN) its mean and
+  their share of the count; per mu bin, of all inertial events with n_onset > 0, the mean n_widest (the curve;
+  NaN for an empty bin);
 - a reduction is partial if a catalog's name ends in .partial or one of its tasks is not
   finished (status 1) or holds fewer than events_per_task events; the summary then states the
   events reduced of those expected and names those catalogs.
@@ -100,8 +104,9 @@ SEISMICITY_NUMBERS = ("background_rate", "foreshock_rate", "aftershock_rate", "q
 RUPTURE = {"lr_edges": np.linspace(0.5, 1600.5, 321), "lr_min": 200, "lr_max": 10 ** 9, "class_min": 10,
            "uni_edge": 0.1}
 RUPTURE_NUMBERS = ("L0", "n_L0", "n_classified", "fraction_unilateral", "uni_at_rim", "bi_at_rim", "mean_slip_large",
-                   "slip_ratio", "mean_drop_large", "drop_ratio")
-RUPTURE_CURVES = ("lr", "mu_uni", "mu_bi", "mean_slip", "mean_drop")
+                   "slip_ratio", "mean_drop_large", "drop_ratio", "L_sc", "t_initial", "spread_share", "L_c",
+                   "t_nucleation")
+RUPTURE_CURVES = ("lr", "mu_uni", "mu_bi", "mean_slip", "mean_drop", "nucleation_length")
 CLASS_COLUMNS = ("n_classified", "n_uni", "n_bi", "n_uni_prev", "n_uni_rim", "n_bi_prev", "n_bi_rim")
 SEIS = {"seis_time_edges": np.linspace(-1000, 1000, 41), "seis_distance_edges": np.linspace(0, 40, 21),
         "seis_near": 2.0, "seis_ring": 10.0, "seis_short": 50.0, "seis_long": 500.0}
@@ -302,7 +307,7 @@ def correlation_length(n, excess, span):
 
 def statistics(mu, tnu, interior, event_slip, creep_mu, creep_log_duration, creep_taken, creep_slip, gaps,
                seis_cells, seis_exposure, block_span, lr, fit, cls, has_prev, at_rim, mean_slip, slip_half, drop,
-               opt):
+               nuc, opt):
     """Curves and numbers of pooled raw data: mu (all inertial events), tnu and interior
     (recurrences), event_slip (the inertial events' slips), the creep episodes' mu, log10(duration
     nu), taken over (ending 2) and slip, and the inter-event times (times nu) of the inertial events."""
@@ -371,6 +376,17 @@ def statistics(mu, tnu, interior, event_slip, creep_mu, creep_log_duration, cree
                                           len(lower) + len(upper))
     numbers["drop_ratio"] = quotient(quotient(sum(float(x) for x in upper), len(upper)),
                                      quotient(sum(float(x) for x in lower), len(lower)))
+    nuc = np.asarray(nuc, dtype=float).reshape(-1, 5)      # mu, n_onset, t_spread, t_widest, n_widest
+    large = nuc[(nuc[:, 0] >= opt["mu_c"]) & (nuc[:, 1] > 0)]
+    spread = large[~np.isnan(large[:, 2])]
+    numbers.update({"L_sc": quotient(sum(float(x) for x in large[:, 1]), len(large)),
+                    "t_initial": quotient(sum(float(x) for x in spread[:, 2]), len(spread)),
+                    "spread_share": quotient(len(spread), len(large)),
+                    "L_c": quotient(sum(float(x) for x in large[:, 4]), len(large)),
+                    "t_nucleation": quotient(sum(float(x) for x in large[:, 3]), len(large))})
+    with_columns = nuc[nuc[:, 1] > 0]
+    nuc_sums = [sum(float(r[4]) for r in with_columns if me[j] <= r[0] < me[j + 1]) for j in range(len(me) - 1)]
+    nuc_in_bin = histogram(with_columns[:, 0], me)
     le = edges_of(opt, "lr_edges")
     drop_sums = np.array([sum(float(x) for x, length in zip(drop[known], lr[known]) if le[j] <= length < le[j + 1])
                           for j in range(len(le) - 1)])
@@ -388,7 +404,8 @@ def statistics(mu, tnu, interior, event_slip, creep_mu, creep_log_duration, cree
               "mu_uni": density(histogram(mu[cls == 1], me), me, n_uni),
               "mu_bi": density(histogram(mu[cls == 2], me), me, n_bi),
               "mean_slip": np.array([x / c if c else math.nan for x, c in zip(slip_sums, in_bin)]),
-              "mean_drop": np.array([x / c if c else math.nan for x, c in zip(drop_sums, drop_in_bin)])}
+              "mean_drop": np.array([x / c if c else math.nan for x, c in zip(drop_sums, drop_in_bin)]),
+              "nucleation_length": np.array([x / c if c else math.nan for x, c in zip(nuc_sums, nuc_in_bin)])}
     return curves, numbers
 
 
@@ -435,7 +452,8 @@ class Task:
         self.creep_taken = column["ending"][creep] == 2 if creep else np.zeros(0, dtype=bool)
         self.creep_slip = column["slip"][creep].astype(float) if creep else np.zeros(0)
         self.ruptures({name: column[name][inertial] for name in ("mu", "epicenter", "first", "last", "n_slipped",
-                                                                 "slip", "stress_drop")},
+                                                                 "slip", "stress_drop", "n_onset", "t_spread",
+                                                                 "t_widest", "n_widest")},
                       n_blocks, opt, k, n)
         ev = {name: column[name][inertial] for name in ("t", "mu", "epicenter", "boundary")}
         self.n = n
@@ -485,6 +503,8 @@ class Task:
         self.mean_slip = np.array(mean_slip, dtype=float)
         self.slip_half = np.array(slip_half, dtype=np.int64)
         self.drop = np.array([float(x) for x in ev["stress_drop"]], dtype=float)
+        self.nuc = np.array([[float(ev[c][i]) for c in ("mu", "n_onset", "t_spread", "t_widest", "n_widest")]
+                             for i in range(n)], dtype=float).reshape(-1, 5)
 
     def seis(self, ev, nu, n_blocks, opt):
         """Every pair's cell and stretch (of its mainshock), every mainshock's exposure row and stretch."""
@@ -518,7 +538,7 @@ class Task:
         creep slip) of the whole task or of one stretch."""
         creep = (self.creep_mu, self.creep_log_duration, self.creep_taken, self.creep_slip)
         ruptures = (self.lr, self.fit, self.cls, self.has_prev, self.at_rim, self.mean_slip, self.slip_half,
-                    self.drop)
+                    self.drop, self.nuc)
         if stretch is None:
             return (self.mu, self.tnu, self.interior, self.event_slip, *creep, self.gaps, self.seis_cells,
                     self.seis_exposure, self.block_span, *ruptures)
@@ -527,7 +547,7 @@ class Task:
                 self.gaps[self.gap_stretch == stretch], self.seis_cells[self.seis_cell_stretch == stretch],
                 self.seis_exposure[self.seis_main_stretch == stretch], self.block_span[self.gap_stretch == stretch],
                 self.lr[e], self.fit[self.fit_stretch == stretch], self.cls[e], self.has_prev[e], self.at_rim[e],
-                self.mean_slip[e], self.slip_half[e], self.drop[e])
+                self.mean_slip[e], self.slip_half[e], self.drop[e], self.nuc[e])
 
     def per_stretch(self, opt):
         k, me, te = opt["blocks"], opt["mu_edges"], opt["tnu_edges"]
@@ -550,9 +570,19 @@ class Task:
         slip_h, slip_columns = np.zeros((k, len(le) - 1)), np.zeros((k, 4))
         drop_n, drop_h = np.zeros((k, len(le) - 1), dtype=np.int64), np.zeros((k, len(le) - 1))
         drop_columns = np.zeros((k, 4))
+        nuc_columns, nuc_len = np.zeros((k, 6)), np.zeros((k, len(me) - 1))
+        nuc_n = np.zeros((k, len(me) - 1), dtype=np.int64)
         for s in range(k):
             (mu, tnu, interior, event_slip, creep_mu, creep_log_duration, taken, creep_slip, gaps, cells,
-             exposure, block_span, lr, fit, cls, has_prev, at_rim, mean_slip, slip_half, drop) = self.unit(s)
+             exposure, block_span, lr, fit, cls, has_prev, at_rim, mean_slip, slip_half, drop, nuc) = self.unit(s)
+            large = nuc[(nuc[:, 0] >= opt["mu_c"]) & (nuc[:, 1] > 0)]
+            spread = large[~np.isnan(large[:, 2])]
+            nuc_columns[s] = [len(large), large[:, 1].sum(), len(spread), spread[:, 2].sum(), large[:, 4].sum(),
+                              large[:, 3].sum()]
+            with_columns = nuc[nuc[:, 1] > 0]
+            nuc_n[s] = histogram(with_columns[:, 0], me)
+            nuc_len[s] = [with_columns[(with_columns[:, 0] >= me[j]) & (with_columns[:, 0] < me[j + 1]), 4].sum()
+                          for j in range(len(me) - 1)]
             known = ~np.isnan(drop)
             drop_n[s] = histogram(lr[known], le)
             drop_h[s] = [drop[known & (lr >= le[j]) & (lr < le[j + 1])].sum() for j in range(len(le) - 1)]
@@ -576,7 +606,8 @@ class Task:
             numbers[s] = [len(mu), np.count_nonzero(mu >= opt["mu_c"]), len(tnu), tnu.sum(),
                           interior.sum(), tnu[interior].sum(), len(gr), gr.sum(), (gr ** 2).sum()]
         return (mu_h, t_h, ti_h, numbers, cm_h, cd_h, creep, intervals, pairs, seis_exposure, seis_columns, lr_h,
-                fit_sums, classes, uni_h, bi_h, slip_h, slip_columns, drop_n, drop_h, drop_columns)
+                fit_sums, classes, uni_h, bi_h, slip_h, slip_columns, drop_n, drop_h, drop_columns,
+                nuc_columns, nuc_n, nuc_len)
 
 
 def _pool(units, pick):
@@ -735,7 +766,7 @@ def expected_summary(catalogs, opt):
     for j, name in enumerate(("mu", "tnu", "tnu_interior", "numbers", "creep_mu", "creep_duration", "creep",
                               "intervals", "seis_pairs", "seis_exposure", "seismicity", "lr", "rupture_length",
                               "rupture_classes", "mu_uni", "mu_bi", "slip_lr", "slip_scaling", "drop_n", "drop_lr",
-                              "stress_drop")):
+                              "stress_drop", "nucleation", "nuc_n", "nuc_len")):
         exp[f"per_task/{name}"] = np.stack([s[j] for s in stacks])
     results = []
     for params, rows in points:
@@ -801,7 +832,8 @@ def check_summary(s, expected, opt):
              | {f"per_task/{k}" for k in ("mu", "tnu", "tnu_interior", "numbers", "creep_mu", "creep_duration",
                                           "creep", "intervals", "seis_pairs", "seis_exposure", "seismicity", "lr",
                                           "rupture_length", "rupture_classes", "mu_uni", "mu_bi", "slip_lr",
-                                          "slip_scaling", "drop_n", "drop_lr", "stress_drop")}
+                                          "slip_scaling", "drop_n", "drop_lr", "stress_drop", "nucleation", "nuc_n",
+                                          "nuc_len")}
              | {f"points/{p}" for p in PARAMS} | tasks_keys | numbers | curves)
     # a new output must get its brute-force check here
     assert set(s) == known, f"unchecked {set(s) - known}, missing {known - set(s)}"
@@ -856,7 +888,11 @@ def check_summary(s, expected, opt):
     np.testing.assert_array_equal(s["per_task/slip_scaling"][..., ::2], expected["per_task/slip_scaling"][..., ::2])
     np.testing.assert_array_equal(s["per_task/drop_n"], expected["per_task/drop_n"])
     np.testing.assert_array_equal(s["per_task/stress_drop"][..., ::2], expected["per_task/stress_drop"][..., ::2])
-    for key in ("per_task/slip_lr", "per_task/slip_scaling", "per_task/drop_lr", "per_task/stress_drop"):
+    np.testing.assert_array_equal(s["per_task/nuc_n"], expected["per_task/nuc_n"])
+    counts = [0, 2]
+    np.testing.assert_array_equal(s["per_task/nucleation"][..., counts], expected["per_task/nucleation"][..., counts])
+    for key in ("per_task/slip_lr", "per_task/slip_scaling", "per_task/drop_lr", "per_task/stress_drop",
+                "per_task/nucleation", "per_task/nuc_len"):
         np.testing.assert_allclose(s[key], expected[key], rtol=RTOL, atol=0, err_msg=key)
     np.testing.assert_allclose(s["per_task/rupture_length"], expected["per_task/rupture_length"], rtol=RTOL, atol=0)
     for key in sorted(numbers):

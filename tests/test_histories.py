@@ -29,10 +29,10 @@ def config(d, **output):
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
-    """The same config without and with histories, serial."""
+    """The same config without histories, with them, and with them in buffers of 8 snapshots; serial."""
     d = tmp_path_factory.mktemp("histories")
     out = {}
-    for name, extra in (("plain", {}), ("recorded", HISTORY)):
+    for name, extra in (("plain", {}), ("recorded", HISTORY), ("cramped", {**HISTORY, "history_snapshots": 8})):
         res = run_cli("run", config(d, **extra), "-o", d / f"{name}.h5", timeout=TIMEOUT)
         assert res.returncode == 0, res.stdout + res.stderr
         out[name] = d / f"{name}.h5"
@@ -86,6 +86,20 @@ def test_a_history_is_its_event_from_onset_to_end(runs):
             assert off < 1e-2
 
 
+def test_a_full_buffer_keeps_the_end(runs):
+    """Eight snapshots a history: the first seven as the full recording's, the eighth its end, the rest counted as
+    dropped."""
+    _, out = runs
+    full, _ = histories_of(out["recorded"])
+    cramped, _ = histories_of(out["cramped"])
+    for whole, short in zip(full, cramped):
+        for a, b in zip(whole, short):
+            assert a["row"] == b["row"] and len(b["time"]) == 8 and b["dropped"] == len(a["time"]) - 8
+            for name in ("time", "sliding", "velocity", "slip"):
+                np.testing.assert_array_equal(b[name][:7], a[name][:7], err_msg=name)
+                np.testing.assert_array_equal(b[name][7], a[name][-1], err_msg=name)
+
+
 def test_two_ranks_write_the_same_histories(runs):
     d, out = runs
     mpi = d / "mpi.h5"
@@ -104,7 +118,7 @@ def same_histories(a, b):
         assert len(x) == len(y) == PER_TASK
         for p, q in zip(x, y):
             assert p["row"] == q["row"] and p["dropped"] == q["dropped"]
-            for name in ("time", "velocity", "slip"):
+            for name in ("time", "sliding", "velocity", "slip"):
                 np.testing.assert_array_equal(p[name], q[name], err_msg=name)
 
 
@@ -114,14 +128,14 @@ def test_a_run_killed_between_a_history_and_its_commit_resumes_to_the_same(runs)
     d, out = runs
     cfg = config(d, **HISTORY)
     log = d / "writes.log"
-    code = (f"import sys; sys.path.insert(0, {str(ROOT)!r}); from tests import inject; inject.log_writes({str(log)!r}); "
-            f"inject.main(['run', {str(cfg)!r}, '-o', {str(d / 'logged.h5')!r}])")
+    code = (f"import sys; sys.path.insert(0, {str(ROOT)!r}); from tests import inject; "
+            f"inject.log_writes({str(log)!r}); inject.main(['run', {str(cfg)!r}, '-o', {str(d / 'logged.h5')!r}])")
     res = run_bounded([sys.executable, "-c", code], TIMEOUT, env=child_env())
     assert res.returncode == 0, res.stderr
     writes = log.read_text().splitlines()
     at = next(int(line.split()[0]) for line in writes if line.split()[2:] == ["/histories/row"])
-    code = (f"import sys; sys.path.insert(0, {str(ROOT)!r}); from tests import inject; inject.crash_at_write({at + 1}); "
-            f"inject.main(['run', {str(cfg)!r}, '-o', {str(d / 'killed.h5')!r}])")
+    code = (f"import sys; sys.path.insert(0, {str(ROOT)!r}); from tests import inject; "
+            f"inject.crash_at_write({at + 1}); inject.main(['run', {str(cfg)!r}, '-o', {str(d / 'killed.h5')!r}])")
     res = run_bounded([sys.executable, "-c", code], TIMEOUT, env=child_env())
     assert res.returncode == 99, res.stderr
     res = run_cli("resume", d / "killed.h5", timeout=TIMEOUT)
@@ -144,3 +158,32 @@ def test_analysis_history_draws_one_and_says_which(runs, tmp_path):
         res = analysis_here("history", path, *args, "-o", tmp_path / "none.png")
         assert res.returncode == 1 and len(res.stderr.strip().splitlines()) == 1 and str(path) in res.stderr
         assert not (tmp_path / "none.png").exists()
+
+
+def test_the_nucleation_columns_are_where_the_history_says():
+    """A history of every step (history_dt tiny) against the kernel's nucleation columns of the same events
+    (in-process, a Trajectory): t_spread is the step before the first snapshot in which more blocks than the
+    onset's have moved (a block starts at rest, at the end of the step that starts it), n_widest the most blocks
+    sliding in a snapshot and t_widest the first snapshot with that many; 1 block at each onset (b = 20: no
+    creep)."""
+    from ensemble.config import loads
+    from ensemble.run.trajectory import Trajectory, event_rows
+    from ensemble.sweep import task_list
+    cfg = loads("[model]\nN = 100\nb = 20.0\n[run]\nevents = 100\ntransient = 50\n[output]\nhistory = 4\n"
+                "history_mu = 2.0\nhistory_snapshots = 20000\nhistory_dt = 1e-12\n")
+    traj = Trajectory(cfg, task_list(cfg)[0], histories=0)
+    rows = []
+    while traj.done < 150:
+        rows.append(traj.advance(10))
+    ev = event_rows(traj.task, *(np.concatenate([r[j] for r in rows]) for j in range(3)))
+    assert len(traj.new_histories) == 4
+    for _, h in traj.new_histories:
+        row = 50 + h["row"]
+        time, moved = h["time"], np.count_nonzero((h["velocity"] > 0) | (h["slip"] > 0), axis=1)
+        assert h["dropped"] == 0 and ev["n_onset"][row] == 1 and h["sliding"][0] == 1
+        grown = int(np.argmax(moved > 1))
+        widest = int(np.argmax(h["sliding"]))
+        assert ev["t_spread"][row] == time[grown - 1]
+        assert ev["n_widest"][row] == h["sliding"][widest] > 1 and ev["t_widest"][row] == time[widest]
+        print(f"row {row}: t_spread {ev['t_spread'][row]:.4g}, widest {ev['n_widest'][row]} blocks at "
+              f"{ev['t_widest'][row]:.4g}, {len(time)} snapshots")

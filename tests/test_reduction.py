@@ -136,11 +136,17 @@ def synthetic_events(rng, task, n, gridded):
     # stress drops without a draw (the streams stay): rising with the length, a tenth of them unknown (NaN, as an
     # older catalog's)
     drop = np.where(epi % 10 == 3, np.nan, 5.0 + (mu % 1.0) + 0.02 * (last - first + 1))
+    # nucleation columns, likewise: some unknown (n_onset 0, as an older catalog's), some without a spread (NaN)
+    n_onset = np.where(epi % 7 == 2, 0, 1 + (epi % 3 == 0) * (epi % 5))
+    t_spread = np.where(epi % 4 == 1, np.nan, 1.0 + 10.0 * (mu % 1.0))
+    t_widest = 2.0 + 10.0 * (mu % 1.0) + 0.1 * (epi % 9)
+    n_widest = 1 + (last - first) // 4
     return {"task": np.full(n, task, dtype=np.int64), "t": t, "epicenter": epi.astype(np.int64), "mu": mu,
             "slip": 10.0 ** mu, "first": first.astype(np.int64), "last": last.astype(np.int64),
             "n_slipped": (last - first + 1).astype(np.int64), "boundary": (first == 0) | (last == N_CHAIN - 1),
             "duration": rng.random(n) + 0.1, "kind": np.zeros(n, np.int8), "ending": np.zeros(n, np.int8),
-            "stress_drop": drop}
+            "stress_drop": drop, "n_onset": n_onset.astype(np.int64), "t_spread": t_spread, "t_widest": t_widest,
+            "n_widest": n_widest.astype(np.int64)}
 
 
 def write_catalog(path, config_text, written, seed):
@@ -240,9 +246,9 @@ def test_catalogs_exercise_the_edges(references):
     assert len(tnu) > 500 and 0.2 < interior.mean() < 0.8
     # the rupture statistics: a finite L_0 with an interval, both classes, at and away from a predecessor's rim
     for name in ("L0", "fraction_unilateral", "uni_at_rim", "bi_at_rim", "mean_slip_large", "slip_ratio",
-                 "mean_drop_large", "drop_ratio"):
+                 "mean_drop_large", "drop_ratio", "L_sc", "t_initial", "spread_share", "L_c", "t_nucleation"):
         est, lo, hi = exp[f"points/numbers/{name}"].T
-        share = name in ("fraction_unilateral", "uni_at_rim", "bi_at_rim")
+        share = name in ("fraction_unilateral", "uni_at_rim", "bi_at_rim", "spread_share")
         assert np.all(np.isfinite(est)) and np.all(lo < hi) and np.all((est > 0) & ((est < 1) | (not share))), name
     # recurrences that straddle chunks of 7 and 13 rows and stretches
     start, end = np.concatenate([t.rec_start for t in raw]), np.concatenate([t.rec_end for t in raw])

@@ -41,8 +41,8 @@ from .workspace import (CR_DIAG, CR_DPSI, CR_DU, CR_EP, CR_H, CR_HB, CR_LEFT, CR
                         E_ACTIVE, E_BLOCK_STEPS, E_END_HI, E_END_LO, E_EPICENTER, E_FIRST, E_LAST, E_LOAD_WORK,
                         E_NBLOCKS, E_RUNNING, E_RUPTURED, E_SERIAL, E_SLIP, E_START_HI, E_START_LO, E_STATE, E_STOPPED,
                         E_VMAX, E_WORK, F0, P, D_BLOCK_STEPS, D_DURATION, D_ELASTIC, D_ENDING, D_ENERGY_SCALE, D_FIRST,
-                        D_KIND, D_LAST, D_LOAD_WORK, D_NSLIP, D_RESIDUAL, D_SLIP, D_STRESS_DROP, D_VMAX, D_WORK, EV_NT,
-                        KIND_CREEP, PAUSED, SLIDING, V)
+                        D_KIND, D_LAST, D_LOAD_WORK, D_NSLIP, D_RESIDUAL, D_SLIP, D_STRESS_DROP, D_T_WIDEST,
+                        D_T_SPREAD, D_VMAX, D_WORK, EV_NT, KIND_CREEP, PAUSED, SLIDING, V)
 
 # what continue_creep returns besides PAUSED
 REACHED = 10      # creep is integrated up to the onset of the schedule's next block (or nothing creeps)
@@ -757,6 +757,7 @@ def report(arrays, n, out_t, out_epicenter, out_diag, k):
             # not an episode's own: the balance closes over a run (workspace.py)
             out_diag[k, D_ELASTIC] = out_diag[k, D_RESIDUAL] = out_diag[k, D_ENERGY_SCALE] = np.nan
             out_diag[k, D_STRESS_DROP] = np.nan     # (its blocks' slips are not kept one by one)
+            out_diag[k, D_T_SPREAD] = out_diag[k, D_T_WIDEST] = np.nan     # (an event's nucleation: none here)
             out_diag[k, D_KIND] = KIND_CREEP
             out_diag[k, D_ENDING] = 1.0 if state == E_STOPPED else 2.0
             return 1

@@ -49,11 +49,12 @@ from .history import begin as begin_history, snapshot
 from .undo import clear_log, log_block
 from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D_ENERGY_SCALE, D_FIRST, D_LAST,
                         D_LOAD_WORK, D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_STRESS_DROP, D_VMAX, D_WORK,
-                        EV_BLOCK_STEPS, EV_CUTS, EV_EPICENTER, EV_ERR_PREV, EV_FAR, EV_H_NEXT, EV_NA, EV_NT, EV_PHASE,
-                        EV_REJECTED, EV_SLIP_TIME, EV_STEPS, EV_STILL, EV_T_FAR, EV_TAU, EV_TRACED, EV_VMAX, EV_WORK,
-                        EV_YREST, F0,
-                        HD0, CR_HB, CR_V, CR_VN, HD1, IN_EVENT, NONFINITE, OK, P, P0, PAUSED, SLIDING, STALLED,
-                        STOPPED, TOO_LONG, TR, TS, UNLIMITED, UNSTABLE, UNTOUCHED, V, V0, Y, Y0, YS, PausedEvent)
+                        D_N_ONSET, D_T_SPREAD, D_T_WIDEST, D_N_WIDEST, EV_N_ONSET, EV_T_SPREAD, EV_T_WIDEST,
+                        EV_N_WIDEST, EV_BLOCK_STEPS, EV_CUTS, EV_EPICENTER, EV_ERR_PREV, EV_FAR, EV_H_NEXT, EV_NA,
+                        EV_NT, EV_PHASE, EV_REJECTED, EV_SLIP_TIME, EV_STEPS, EV_STILL, EV_T_FAR, EV_TAU, EV_TRACED,
+                        EV_VMAX, EV_WORK, EV_YREST, F0, HD0, CR_HB, CR_V, CR_VN, HD1, IN_EVENT, NONFINITE, OK, P, P0,
+                        PAUSED, SLIDING, STALLED, STOPPED, TOO_LONG, TR, TS, UNLIMITED, UNSTABLE, UNTOUCHED, V, V0, Y,
+                        Y0, YS, PausedEvent)
 
 # Steps in a row that leave the event's time where it was (a transition located at the step's start, cut to a step
 # of no length, again and again) before the event ends with STALLED: a guard, not a regime. It was met once, with
@@ -167,6 +168,7 @@ def begin_event(arrays, t0, n, epicenter, v_start, p):
     W[epicenter, V] = v_start
     event[EV_PHASE] = IN_EVENT
     event[EV_EPICENTER] = epicenter
+    _nucleation_begins(event, nt)
     begin_history(arrays)
     snapshot(arrays, n, na, nt, 0.0, False)
     _keep(event, _at_onset(na=na, nt=nt, yrest=yrest, t_far=t_far, far=far, vmax=v_start, h_next=p.dt))
@@ -193,9 +195,30 @@ def begin_handover(arrays, t0, n, epicenter, p):
     t_far, far = _far_onset(W, arrays.flag, n, arrays.since, arrays.tree, t0, 0.0, p)
     event[EV_PHASE] = IN_EVENT
     event[EV_EPICENTER] = epicenter
+    _nucleation_begins(event, nt)
     begin_history(arrays)
     snapshot(arrays, n, na, nt, 0.0, False)
     _keep(event, _at_onset(na=na, nt=nt, yrest=yrest, t_far=t_far, far=far, vmax=vmax, h_next=p.dt))
+
+
+@nb.njit(cache=True, inline="always")
+def _nucleation_begins(event, nt):
+    """The event's nucleation markers at its onset, nt blocks sliding (workspace: D_N_ONSET ...)."""
+    event[EV_N_ONSET] = nt
+    event[EV_T_SPREAD] = -1.0
+    event[EV_T_WIDEST] = 0.0
+    event[EV_N_WIDEST] = nt
+
+
+@nb.njit(cache=True, inline="always")
+def _nucleation_step(event, na, nt, tau):
+    """After an accepted step ending at local time tau: the sliding zone's first growth beyond the onset's
+    blocks, and the widest the zone of sliding blocks (na of them) has been, first reached when."""
+    if event[EV_T_SPREAD] < 0.0 and nt > event[EV_N_ONSET]:
+        event[EV_T_SPREAD] = tau
+    if na > event[EV_N_WIDEST]:
+        event[EV_N_WIDEST] = na
+        event[EV_T_WIDEST] = tau
 
 
 @nb.njit(cache=True, inline="always")
@@ -401,6 +424,7 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
         unchanged = kind == NO_CUT and nstuck == 0 and na == m
         if not unchanged:
             t_far, far = _reschedule(W, flag, stuck, since, tree, nstuck, n, t0, tau, p)
+        _nucleation_step(event, na, nt, tau)
         snapshot(arrays, n, na, nt, tau, na == 0)
     if profile.shape[0] == n:
         profile[:] = 0.0
@@ -413,6 +437,10 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
     diag[D_BLOCK_STEPS] = block_steps
     diag[D_REJECTED] = rejected
     diag[D_CUTS] = cuts
+    diag[D_N_ONSET] = event[EV_N_ONSET]
+    diag[D_T_SPREAD] = event[EV_T_SPREAD] if event[EV_T_SPREAD] >= 0.0 else np.nan
+    diag[D_T_WIDEST] = event[EV_T_WIDEST]
+    diag[D_N_WIDEST] = event[EV_N_WIDEST]
     # the final values too, so that the vector does not depend on where the event was paused
     _keep(event, PausedEvent(na=na, nt=nt, yrest=yrest, t_far=t_far, far=far, tau=tau, work=work,
                              slip_time=slip_time, steps=steps, block_steps=block_steps, rejected=rejected, cuts=cuts,

@@ -6,9 +6,11 @@ of an accepted step (never a step of its own: the event's arithmetic is the same
 when the event's local time has advanced by hctl[HC_DT] since the last snapshot, or its largest velocity has
 changed by a factor hctl[HC_RATIO] either way, and always at its first step and at its end (the final slip
 profile, whose sum is the event's slip). So the slow initial phase is sampled by velocity, decade by decade,
-and the rupture by time. A row is [local time since the onset, lo, hi, velocities (n), slips (n)], valid on
+and the rupture by time. A row is [local time since the onset, lo, hi, blocks sliding, velocities (n), slips (n)],
+valid on
 the blocks lo..hi (the blocks the event has touched lie there; the others are at rest with no slip). When the
-buffer is full the later snapshots but the last are dropped and counted (HC_DROPPED).
+buffer is full the later snapshots are dropped and counted (HC_DROPPED), the end taking the last row (the
+snapshot there counted as dropped instead).
 
 chain.simulate ends its call after an inertial event whose slip reaches hctl[HC_SLIP_MIN] (HC_READY = 1): the
 caller copies the buffer out (ensemble/run/trajectory.py). Ending a call early changes no event (any budget
@@ -16,8 +18,8 @@ gives the same events).
 """
 import numba as nb
 
-from .workspace import (HC_COUNT, HC_DROPPED, HC_DT, HC_ON, HC_RATIO, HC_TAU, HC_V, H_HI, H_LO, H_TAU, H_VALUES,
-                        V, Y)
+from .workspace import (HC_COUNT, HC_DROPPED, HC_DT, HC_ON, HC_RATIO, HC_TAU, HC_V, H_HI, H_LO, H_NA, H_TAU,
+                        H_VALUES, V, Y)
 
 
 @nb.njit(cache=True)
@@ -48,10 +50,12 @@ def snapshot(arrays, n, na, nt, tau, final):
         return
     row = count
     if row >= H.shape[0]:
+        hc[HC_DROPPED] += 1.0     # (as if taken: the rule goes on as without a limit)
+        hc[HC_TAU] = tau
+        hc[HC_V] = vmax
         if not final:
-            hc[HC_DROPPED] += 1.0
             return
-        row = H.shape[0] - 1      # the end overwrites the last row: the final profile is always there
+        row = H.shape[0] - 1      # the end overwrites the last row (dropped instead): the end is always there
     lo, hi = n, -1
     touched = arrays.touched
     for k in range(nt):
@@ -60,6 +64,7 @@ def snapshot(arrays, n, na, nt, tau, final):
     H[row, H_TAU] = tau
     H[row, H_LO] = lo
     H[row, H_HI] = hi
+    H[row, H_NA] = na
     for i in range(lo, hi + 1):
         H[row, H_VALUES + i] = W[i, V]
         H[row, H_VALUES + n + i] = W[i, Y]

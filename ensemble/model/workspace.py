@@ -92,8 +92,8 @@ NCOLS = X_THETA + 1
 # entries of the per-event diagnostics vector
 (D_DURATION, D_SLIP, D_FIRST, D_LAST, D_NSLIP, D_WORK, D_RESIDUAL, D_STEPS, D_VMAX,
  D_BLOCK_STEPS, D_REJECTED, D_CUTS, D_ENERGY_SCALE, D_ELASTIC, D_LOAD_WORK, D_KIND, D_ENDING,
- D_STRESS_DROP) = range(18)
-NDIAG = 18
+ D_STRESS_DROP, D_N_ONSET, D_T_SPREAD, D_T_WIDEST, D_N_WIDEST) = range(22)
+NDIAG = 22
 # D_KIND: what a row of the kernels' output is; D_ENDING: how a creep episode ended (1 its blocks
 # stopped, 2 an inertial event took them; 0 for an event)
 # D_STRESS_DROP: an event's stress drop, the mean over the blocks that slipped (the set S) of the drop of
@@ -101,6 +101,11 @@ NDIAG = 18
 # (1 / |S|) sum_{i in S} y_i (1 + l^2 n_i), n_i the neighbours of i outside S (the springs within S cancel
 # in the sum). The driver's advance adds nu * duration to every force (at most ~1e-5 at the paper's nu).
 # NaN for a creep episode, whose blocks' slips are not kept one by one.
+# The nucleation of an event (event.py; analysis/statistics/nucleation.py): D_N_ONSET the blocks sliding at its
+# onset (1, or a creeping cluster handed over), D_T_SPREAD the local time at which a block beyond them started
+# to slide (NaN: none did), D_N_WIDEST the most blocks sliding at once (the zone's widest: in a large event at
+# b = 20 the crack-like growth of its nucleation, before the rupture splits into pulses of a few blocks) and
+# D_T_WIDEST the local time it was first that wide; each at the end of a step. 0, NaN, 0, NaN for a creep episode.
 KIND_EVENT, KIND_CREEP = 0, 1
 
 # columns of the optional step trace of an event (one row per step tried, rejected ones included)
@@ -144,7 +149,11 @@ EV_ERR_PREV = 18    # error norm of the last accepted step (PI control)
 EV_TRACED = 19      # rows of the step trace filled
 EV_NUNDO = 20       # entries of the undo log
 EV_STILL = 21       # steps in a row that left the event's time where it was (event.STALL_STEPS)
-NEVENT = 22
+EV_N_ONSET = 22     # blocks sliding at the onset (D_N_ONSET)
+EV_T_SPREAD = 23    # local time at which a block beyond them started (D_T_SPREAD; -1 until then)
+EV_T_WIDEST = 24    # local time at which the most blocks were sliding at once (D_T_WIDEST)
+EV_N_WIDEST = 25    # that many (D_N_WIDEST)
+NEVENT = 26
 # The loop variables of the event in progress (event.continue_event) as one record, saved into `event`
 # when a kernel call pauses and restored from it at the next, field by field and by name: field `x` in
 # slot EV_X (event._keep, event._resume). Built by keyword only, so the order of the fields below
@@ -208,7 +217,8 @@ HC_DROPPED = 7     # snapshots dropped for want of rows (the buffer's last row k
 HC_READY = 8       # 1: the last row chain.simulate wrote is an event whose snapshots are in `history`
 NHCTL = 9
 H_TAU, H_LO, H_HI = 0, 1, 2    # a snapshot: local time since the onset, the touched blocks' span lo..hi,
-H_VALUES = 3                   # then the velocities of blocks 0..n-1 (valid on lo..hi), then their slips
+H_NA = 3                       # the blocks sliding (a block started in the step is at rest at its end),
+H_VALUES = 4                   # then the velocities of blocks 0..n-1 (valid on lo..hi), then their slips
 
 # values of EV_PHASE
 BETWEEN, IN_EVENT = 0, 1

@@ -12,10 +12,11 @@ import numpy as np
 from ..config import ConfigError, parse_section, section_lines
 from ..integrators import INTEGRATORS, kernel_params
 from ..model.chain import simulate
-from ..model.workspace import (CS_H, CS_NCREEP, CS_T_HI, CS_T_LO, D_DURATION, D_ENDING, D_FIRST, D_KIND, D_LAST,
-                               H_HI, H_LO, H_TAU, H_VALUES, HC_COUNT, HC_DROPPED, HC_DT, HC_ON, HC_RATIO, HC_READY,
-                               HC_SLIP_MIN, D_NSLIP, D_SLIP, D_STRESS_DROP, EV_NA, EV_PHASE, EV_STEPS, EV_TAU, EV_VMAX,
-                               IN_EVENT, NDIAG, OK, PAUSED, STATUS_TEXT, UNLIMITED, Workspace)
+from ..model.workspace import (CS_H, CS_NCREEP, CS_T_HI, CS_T_LO, D_DURATION, D_ENDING, D_FIRST, D_KIND, D_LAST, H_HI,
+                               H_NA, H_LO, H_TAU, H_VALUES, HC_COUNT, HC_DROPPED, HC_DT, HC_ON, HC_RATIO, HC_READY,
+                               HC_SLIP_MIN, D_NSLIP, D_SLIP, D_STRESS_DROP, D_N_ONSET, D_T_SPREAD, D_T_WIDEST,
+                               D_N_WIDEST, EV_NA, EV_PHASE, EV_STEPS, EV_TAU, EV_VMAX, IN_EVENT, NDIAG, OK, PAUSED,
+                               STATUS_TEXT, UNLIMITED, Workspace)
 from ..store.checkpoint import Checkpoint, carries_creep
 from ..store.errors import CatalogError
 from .tasks import initial_state
@@ -118,7 +119,8 @@ class Trajectory:
             lo, hi = int(snap[H_LO]), int(snap[H_HI]) + 1      # (valid there; the others at rest, no slip)
             velocity[r, lo:hi] = snap[H_VALUES + lo:H_VALUES + hi]
             slip[r, lo:hi] = snap[H_VALUES + n + lo:H_VALUES + n + hi]
-        return {"row": row, "time": H[:, H_TAU].copy(), "velocity": velocity, "slip": slip,
+        return {"row": row, "time": H[:, H_TAU].copy(), "sliding": H[:, H_NA].astype(np.int64), "velocity": velocity,
+                "slip": slip,
                 "dropped": int(hctl[HC_DROPPED])}
 
 
@@ -132,7 +134,9 @@ def event_rows(task, t, epicenter, diag):
         "n_slipped": diag[:, D_NSLIP].astype(np.int64),
         "boundary": (first == 0) | (last == task.model.N - 1), "duration": diag[:, D_DURATION],
         "kind": diag[:, D_KIND].astype(np.int8), "ending": diag[:, D_ENDING].astype(np.int8),
-        "stress_drop": diag[:, D_STRESS_DROP],
+        "stress_drop": diag[:, D_STRESS_DROP], "n_onset": diag[:, D_N_ONSET].astype(np.int64),
+        "t_spread": diag[:, D_T_SPREAD], "t_widest": diag[:, D_T_WIDEST],
+        "n_widest": diag[:, D_N_WIDEST].astype(np.int64),
     }
 
 

@@ -97,10 +97,11 @@ def _create_histories(h5, cfg, tasks):
     g.attrs["blocks"] = blocks
     for name in histories.SCALARS:
         g.create_dataset(name, data=np.full(slots, -1, dtype=np.int64))
-    for name, shape in (("time", (slots, snapshots)), ("velocity", (slots, snapshots, blocks)),
-                        ("slip", (slots, snapshots, blocks))):
+    for name, shape, dtype in (("time", (slots, snapshots), np.float64), ("sliding", (slots, snapshots), np.int64),
+                               ("velocity", (slots, snapshots, blocks), np.float64),
+                               ("slip", (slots, snapshots, blocks), np.float64)):
         # never filled, like /events: only the snapshots written take space
-        g.create_dataset(name, shape=shape, dtype=np.float64, fillvalue=np.nan, fill_time="never",
+        g.create_dataset(name, shape=shape, dtype=dtype, fillvalue=_FILL[dtype], fill_time="never",
                          dcpl=early_allocation())
 
 

@@ -72,6 +72,10 @@ def event_problems(ev, n_blocks, first_row=0, t_before=-np.inf):
         (~(inertial | (kind == 1)), lambda i: f"kind {int(kind[i])}"),
         (~(ev["stress_drop"] > 0) & ~np.isnan(ev["stress_drop"]),
          lambda i: f"stress drop {float(ev['stress_drop'][i])}"),
+        ((ev["n_onset"] < 0) | (ev["n_onset"] > n_blocks) | (ev["n_widest"] < 0) | (ev["n_widest"] > n_blocks),
+         lambda i: f"nucleation's blocks {int(ev['n_onset'][i])}, {int(ev['n_widest'][i])}"),
+        ((ev["t_spread"] < 0) | (ev["t_widest"] < 0) | np.isinf(ev["t_spread"]) | np.isinf(ev["t_widest"]),
+         lambda i: f"nucleation's times {float(ev['t_spread'][i])}, {float(ev['t_widest'][i])}"),
         (np.where(inertial, ending != 0, (ending != 1) & (ending != 2)),
          lambda i: f"ending {int(ending[i])} of a row of kind {int(kind[i])}"),
     )

@@ -31,14 +31,14 @@ from ..model import laws
 from ..model.workspace import KIND_CREEP, KIND_EVENT, NEPISODE
 
 FORMAT = "bk-catalog-7"
-# older formats this version reads (not resumes), and what they lack: bk-catalog-6 has no /events/stress_drop (the
-# reader supplies NaN); bk-catalog-5 keeps a creep state of
+# older formats this version reads (not resumes), and what they lack: bk-catalog-6 has no /events/stress_drop and
+# no nucleation columns (the reader supplies NaN, and 0 for the counts); bk-catalog-5 keeps a creep state of
 # another layout in its checkpoints (its episode table without the episodes' energy, EPISODE_COLUMNS);
 # bk-catalog-4 has no /events/kind and /events/ending (every row an inertial event; the reader supplies kind 0,
 # ending 0) and no creep state in its checkpoints; bk-catalog-3 lacks also tables_crc and /tasks/record_crc (its
 # tables are checked against its config only). Only FORMAT is written and resumed.
 OLDER = {
-    "bk-catalog-6": "written before events kept their stress drop (no /events/stress_drop)",
+    "bk-catalog-6": "written before events kept their stress drop and nucleation (no /events/stress_drop)",
     "bk-catalog-5": "written before creep episodes kept their energy (another creep state in its checkpoints)",
     "bk-catalog-4": "written before the creep phase (no /events/kind, no creep state in its checkpoints)",
     "bk-catalog-3": "written before its tables were checksummed",
@@ -57,6 +57,7 @@ EVENT_FIELDS = {
     "task": np.int64, "t": np.float64, "epicenter": np.int64, "mu": np.float64,
     "slip": np.float64, "first": np.int64, "last": np.int64, "n_slipped": np.int64,
     "boundary": np.bool_, "duration": np.float64, "kind": np.int8, "ending": np.int8, "stress_drop": np.float64,
+    "n_onset": np.int64, "t_spread": np.float64, "t_widest": np.float64, "n_widest": np.int64,
 }
 # the columns each format stores (its events CRC covers these, in this order); the reader supplies the others
 # as SUPPLIED says
@@ -64,7 +65,8 @@ STORED_EVENT_FIELDS = {
     "bk-catalog-3": tuple(EVENT_FIELDS)[:10], "bk-catalog-4": tuple(EVENT_FIELDS)[:10],
     "bk-catalog-5": tuple(EVENT_FIELDS)[:12], "bk-catalog-6": tuple(EVENT_FIELDS)[:12], FORMAT: tuple(EVENT_FIELDS),
 }
-SUPPLIED = {"kind": KIND_EVENT, "ending": ENDING_EVENT, "stress_drop": np.nan}
+SUPPLIED = {"kind": KIND_EVENT, "ending": ENDING_EVENT, "stress_drop": np.nan, "n_onset": 0, "t_spread": np.nan,
+            "t_widest": np.nan, "n_widest": 0}
 TASK_FIELDS = {
     "point": np.int64, "seed_index": np.int64, "N": np.int64, "l": np.float64, "nu": np.float64,
     # every friction law's keys (model/laws/); NaN for a key of another law than the task's
@@ -104,6 +106,15 @@ DATASETS = {
     "events/stress_drop": ("model force", _EVENT_ROWS, "mean over the blocks that slipped of the drop of their force "
                                                        "by the slip (the driver held at its onset position); NaN for "
                                                        "a creep episode, and in catalogs before bk-catalog-7"),
+    # an event's nucleation (ensemble/model/workspace.py: D_N_ONSET ...; analysis/statistics/nucleation.py)
+    "events/n_onset": ("count", _EVENT_ROWS, "blocks sliding at the onset (1, or a creeping cluster handed over to "
+                                             "inertia); 0 for a creep episode and in catalogs before bk-catalog-7"),
+    "events/t_spread": ("model time", _EVENT_ROWS, "time from the onset until a block beyond those started to slide "
+                                                   "(NaN: none did; a creep episode; before bk-catalog-7)"),
+    "events/t_widest": ("model time", _EVENT_ROWS, "time from the onset until the most blocks were sliding at once "
+                                                   "(NaN: a creep episode; before bk-catalog-7)"),
+    "events/n_widest": ("count", _EVENT_ROWS, "the most blocks sliding at once (the nucleation's widest zone in a "
+                                              "large event; 0: a creep episode, before bk-catalog-7)"),
     "tasks/point": ("index", _TASK_ROWS, "parameter point (position in the product of the [sweep] lists)"),
     "tasks/seed_index": ("index", _TASK_ROWS, "realisation of its point; task = point * run.seeds + seed_index"),
     "tasks/N": ("count", _TASK_ROWS, "number of blocks of the chain"),
@@ -160,6 +171,7 @@ DATASETS = {
     "histories/dropped": ("count", "(H,)", "snapshots dropped for want of rows (output.history_snapshots)"),
     "histories/crc": ("CRC-32", "(H,)", "CRC of the history (row, counts, its snapshots' data)"),
     "histories/time": ("model time", "(H, S)", "local time of each snapshot since the event's onset"),
+    "histories/sliding": ("count", "(H, S)", "blocks sliding at the snapshot (one started in its step still at rest)"),
     "histories/velocity": ("model length / model time", "(H, S, N)", "each block's velocity at the snapshot"),
     "histories/slip": ("model length", "(H, S, N)", "each block's slip since the onset at the snapshot"),
 }
