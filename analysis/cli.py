@@ -39,6 +39,8 @@ NUMERIC = {
     **{name: (lambda v, o=o: options.check(o, v)) for name, o in options.every_option().items()},
     "region_span": lambda v: checks.number("--region-span", v, 0.0, 1e300, exclusive=True),
     "region_skip": lambda v: checks.number("--region-skip", v, 0.0, 1e300),
+    "task": lambda v: checks.count("--task", v, 0),
+    "index": lambda v: checks.count("--index", v, 0),
 }
 
 
@@ -99,8 +101,8 @@ def _parser():
                                          "in space and time (analysis/history.py)")
     hi.add_argument("catalog")
     hi.add_argument("-o", "--output", required=True, help="FILE.png or FILE.pdf")
-    hi.add_argument("--task", type=int, default=None, help="the task (default: the first with a history)")
-    hi.add_argument("--index", type=int, default=0, help="its history number (default 0: its first)")
+    hi.add_argument("--task", help="the task (default: the first with a history)")
+    hi.add_argument("--index", default="0", help="its history number (default 0: its first)")
     hi.add_argument("--force", action="store_true", help="overwrite an existing figure")
     cp = sub.add_parser("compare", help="catalogs of several friction laws -> table and figures on a "
                                          "law-independent size axis (docs/laws.md)")
@@ -162,6 +164,7 @@ def _paper(args):
 
 def _history(args):
     from .history import draw
+    check_numbers(args)
     checks.output(args.output, inputs=[args.catalog], force=args.force, what="figure")   # before the work
     print(f"wrote {args.output}: {draw(args.catalog, args.output, args.task, args.index)}")
     return 0

@@ -34,6 +34,7 @@ from ensemble.model.workspace import Workspace  # noqa: E402
 from ensemble.store import reader, schema  # noqa: E402
 from ensemble.store.errors import CatalogError  # noqa: E402
 from ensemble.store.files import partial_path  # noqa: E402
+from tests import inject  # noqa: E402
 from tests.processes import child_env, run_bounded, wait_for  # noqa: E402
 from tests.same_catalogs import common_fields  # noqa: E402
 
@@ -160,10 +161,14 @@ class Workshop:
         self.cfg.write_text(CONFIG)
         self.full = self.root / "full.h5"
         # (the first run of a session may compile the kernels: about a minute alone, more beside other tests)
-        res = _python("ensemble", "run", self.cfg, "-o", self.full, timeout=COMPILE)
+        log = self.root / "writes.log"
+        res = _python("ensemble", "run", self.cfg, "-o", self.full, setup=f"inject.log_writes({str(log)!r})",
+                      timeout=COMPILE)
         assert res.returncode == 0, res.stderr
+        # crashed just before its last write before the first finish: task 0 committed, not finished
         self.crashed = self.root / "crashed.h5"
-        res = _python("ensemble", "run", self.cfg, "-o", self.crashed, setup="inject.crash_at_write(60)")
+        res = _python("ensemble", "run", self.cfg, "-o", self.crashed,
+                      setup=f"inject.crash_at_write({inject.before_finish(log)})")
         assert res.returncode == 99, res.stderr
 
     def older(self, version=4):

@@ -50,6 +50,13 @@ def log_writes(path):
     _count_writes(on_write)
 
 
+def before_finish(log):
+    """The number of the last write or flush before the first finish record (a task's provenance, /tasks/rank)
+    in a log of log_writes: a crash there leaves that task with every row committed and no finish recorded."""
+    with open(log) as fh:
+        return next(int(line.split()[0]) for line in fh if line.split()[1:] == ["write", "/tasks/rank"]) - 1
+
+
 def fail_on_rank(rank, after_calls=1):
     """Raise a RuntimeError (a bug, not a numerical failure) on one MPI rank once it has run a while."""
     from mpi4py import MPI

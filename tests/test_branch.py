@@ -94,7 +94,7 @@ def test_branches_differ_and_the_catalog_records_their_branch_point(branched):
         np.testing.assert_array_equal(h5["spinup/spawn_key"][...], [0, SEEDS])   # each point's seed 0
         assert "run.branch" in h5["tasks/branch_of"].attrs["description"]
     assert_described(d / "full.h5", schema.DATASETS)
-    assert set(descriptions(d / "full.h5")) == set(schema.DATASETS)
+    assert set(descriptions(d / "full.h5")) == {name for name in schema.DATASETS if not name.startswith("histories/")}
     with reader.Reader(d / "full.h5") as cat:
         for point in (0, 1):
             head = cat.layout.head(2 * SEEDS + point)

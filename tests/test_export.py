@@ -387,7 +387,8 @@ def test_pandas_reads_the_csv_as_the_api_returns_it(files):
 
 # -- descriptions ------------------------------------------------------------------------------------
 
-UNBRANCHED = [name for name in schema.DATASETS if not name.startswith("spinup/")]   # run.branch = false
+# run.branch = false, output.history = 0 (tests/test_histories.py checks /histories)
+UNBRANCHED = [name for name in schema.DATASETS if not name.startswith(("spinup/", "histories/"))]
 
 
 def descriptions(path):

@@ -24,6 +24,7 @@ from ensemble.store.files import partial_path
 from ensemble.store.integrity import commit_crc
 
 from .conftest import committed, write_config
+from . import inject
 from .inject import CRASH_CODE
 from .processes import ROOT, Started, child_env, ensemble_here as here, run_bounded, wait_for
 
@@ -108,11 +109,12 @@ def _flip_byte(path, dataset, index):
 
 @pytest.fixture(scope="module")
 def crashed(small):
-    """A catalog crashed (kill -9) just before the run's 60th write: task 0 has committed its 60 events,
-    its finish is not recorded; a .partial to resume, and the lock the dead run left."""
+    """A catalog crashed (kill -9) just before the last write before its first finish record (inject.before_finish):
+    task 0 has committed its 60 events, its finish is not recorded; a .partial to resume, and the lock the dead
+    run left."""
     d, cfg = small
     out = d / "crashed.h5"
-    res = injected("inject.crash_at_write(60)", "run", cfg, "-o", out)
+    res = injected(f"inject.crash_at_write({inject.before_finish(d / 'writes.log')})", "run", cfg, "-o", out)
     assert res.returncode == CRASH_CODE, res.stderr
     _, tasks, _ = reader.read(partial_path(out))
     assert list(tasks["events_written"]) == [60, 0] and tasks["status"][0] == schema.OPEN

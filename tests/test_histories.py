@@ -6,10 +6,11 @@ their magnitude; two ranks under mpiexec and a run killed between a history and 
 import shutil
 import sys
 
+import h5py
 import numpy as np
 import pytest
 
-from ensemble.store import reader
+from ensemble.store import reader, schema
 
 from .conftest import run_cli, write_config
 from .processes import ROOT, analysis_here, child_env, run_bounded
@@ -49,6 +50,13 @@ def test_recording_changes_no_event(runs):
     assert_same_events(out["plain"], out["recorded"])
     plain, _ = histories_of(out["plain"])
     assert all(h == [] for h in plain)
+    # the group only where asked for, every dataset of it described (schema.DATASETS)
+    with h5py.File(out["plain"], "r") as a, h5py.File(out["recorded"], "r") as b:
+        assert "histories" not in a
+        names = [f"histories/{name}" for name in b["histories"]]
+        assert sorted(names) == sorted(n for n in schema.DATASETS if n.startswith("histories/"))
+        for name in names:
+            assert b[name].attrs["description"] == schema.description(schema.DATASETS[name])
 
 
 def test_a_history_is_its_event_from_onset_to_end(runs):

@@ -55,6 +55,8 @@ BAD = {
     "uni_edge": ["nan", "inf", "-0.1", "0.6", "x"],
     "region_span": ["nan", "inf", "0", "-1", "1e400", "x"],
     "region_skip": ["nan", "inf", "-1", "1e400", "x"],
+    "task": ["nan", "inf", "-1", "2.5", "x", "10" + "0" * 30],
+    "index": ["nan", "-1", "0.5", "x", "10" + "0" * 30],
 }
 ENV = child_env(PYTHONPATH=str(ROOT))   # this checkout's packages, wherever the command runs
 OPTION = {dest: "--" + dest.replace("_", "-") for dest in BAD}
@@ -90,7 +92,8 @@ def base_args(command, d, out):
             "export": ["export", d / "cat.h5", "-o", out],
             "plot": ["plot", d / "sum.h5", "--figure", "magnitude", "-o", out],
             "report": ["report", d / "sum.h5"],
-            "paper": ["paper", d / "sum.h5"]}[command]
+            "paper": ["paper", d / "sum.h5"],
+            "history": ["history", d / "cat.h5", "-o", out]}[command]
 
 
 def refused(capsys, argv, code=2):
@@ -113,7 +116,7 @@ def test_every_numeric_option_is_checked_and_attacked():
         for a in p._actions:
             if a.option_strings and a.dest not in NOT_NUMERIC:
                 assert a.type is None, (command, a.dest)
-    assert {c for c, _ in found} == {"reduce", "compare"}   # plot, export, paper, report: none
+    assert {c for c, _ in found} == {"reduce", "compare", "history"}   # plot, export, paper, report: none
 
 
 @pytest.mark.parametrize("command,dest,value", [(c, d, v) for c, d in numeric_options() for v in BAD[d]])
