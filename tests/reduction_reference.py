@@ -195,6 +195,18 @@ def histogram(values, edges):
     return np.histogram(v[np.isfinite(v) & (v < edges[-1])], bins=edges)[0]
 
 
+def binned_sums(values, weights, edges):
+    """Sums of `weights` over the values in each half-open bin [e_k, e_k+1), the last one too, added one by one in
+    the values' order (the bin of each by np.digitize, not the statistics' searchsorted)."""
+    v, w = np.asarray(values, dtype=float), np.asarray(weights, dtype=float)
+    ok = np.isfinite(v) & (v < edges[-1])
+    sums = [0.0] * (len(edges) - 1)
+    for j, x in zip((np.digitize(v[ok], edges) - 1).tolist(), w[ok].tolist()):
+        if 0 <= j < len(sums):
+            sums[j] += x
+    return np.array(sums)
+
+
 def density(counts, edges, total):
     if total == 0:
         return np.full(len(edges) - 1, np.nan)
@@ -385,14 +397,12 @@ def statistics(mu, tnu, interior, event_slip, creep_mu, creep_log_duration, cree
                     "L_c": quotient(sum(float(x) for x in large[:, 4]), len(large)),
                     "t_nucleation": quotient(sum(float(x) for x in large[:, 3]), len(large))})
     with_columns = nuc[nuc[:, 1] > 0]
-    nuc_sums = [sum(float(r[4]) for r in with_columns if me[j] <= r[0] < me[j + 1]) for j in range(len(me) - 1)]
+    nuc_sums = binned_sums(with_columns[:, 0], with_columns[:, 4], me)
     nuc_in_bin = histogram(with_columns[:, 0], me)
     le = edges_of(opt, "lr_edges")
-    drop_sums = np.array([sum(float(x) for x, length in zip(drop[known], lr[known]) if le[j] <= length < le[j + 1])
-                          for j in range(len(le) - 1)])
+    drop_sums = binned_sums(lr[known], drop[known], le)
     drop_in_bin = histogram(lr[known], le)
-    slip_sums = np.array([sum(float(x) for x, length in zip(mean_slip, lr) if le[j] <= length < le[j + 1])
-                          for j in range(len(le) - 1)])
+    slip_sums = binned_sums(lr, mean_slip, le)
     in_bin = histogram(lr, le)
     ce, de = edges_of(opt, "creep_mu_edges"), edges_of(opt, "creep_duration_edges")
     curves = {"mu": density(histogram(mu, me), me, n),
