@@ -108,6 +108,7 @@ def test_a_full_buffer_keeps_the_end(runs):
                 np.testing.assert_array_equal(b[name][7], a[name][-1], err_msg=name)
 
 
+@pytest.mark.slow    # (a run under mpiexec, 6 s: the slower tier, run by CI)
 def test_two_ranks_write_the_same_histories(runs):
     d, out = runs
     mpi = d / "mpi.h5"
@@ -130,6 +131,7 @@ def same_histories(a, b):
                 np.testing.assert_array_equal(p[name], q[name], err_msg=name)
 
 
+@pytest.mark.slow    # (three runs, 10 s: the slower tier, run by CI)
 def test_a_run_killed_between_a_history_and_its_commit_resumes_to_the_same(runs):
     """Killed (as by kill -9) right after its first history's last write, before the commit of its event's row:
     the resumed run writes that history again, and the catalog is the uninterrupted one's."""
