@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from ensemble.store import reader, schema
+from ensemble.store.files import partial_path
 
 from .conftest import run_cli, write_config
 from .processes import ROOT, analysis_here, child_env, run_bounded
@@ -133,8 +134,9 @@ def same_histories(a, b):
 
 @pytest.mark.slow    # (three runs, 10 s: the slower tier, run by CI)
 def test_a_run_killed_between_a_history_and_its_commit_resumes_to_the_same(runs):
-    """Killed (as by kill -9) right after its first history's last write, before the commit of its event's row:
-    the resumed run writes that history again, and the catalog is the uninterrupted one's."""
+    """Killed (as by kill -9) just before the commit row of the batch with its first history (the history and the
+    events written and flushed): the history is not counted as kept, the resumed run writes it again, and the
+    catalog is the uninterrupted one's."""
     d, out = runs
     cfg = config(d, **HISTORY)
     log = d / "writes.log"
@@ -143,11 +145,19 @@ def test_a_run_killed_between_a_history_and_its_commit_resumes_to_the_same(runs)
     res = run_bounded([sys.executable, "-c", code], TIMEOUT, env=child_env())
     assert res.returncode == 0, res.stderr
     writes = log.read_text().splitlines()
-    at = next(int(line.split()[0]) for line in writes if line.split()[2:] == ["/histories/row"])
+    row = next(int(line.split()[0]) for line in writes if line.split()[2:] == ["/histories/row"])
+    # the commit row of that batch: its history and events written and flushed, the commit not
+    at = next(int(line.split()[0]) for line in writes if int(line.split()[0]) > row
+              and line.split()[2:] == ["/checkpoint/commit"]) - 1
     code = (f"import sys; sys.path.insert(0, {str(ROOT)!r}); from tests import inject; "
             f"inject.crash_at_write({at + 1}); inject.main(['run', {str(cfg)!r}, '-o', {str(d / 'killed.h5')!r}])")
     res = run_bounded([sys.executable, "-c", code], TIMEOUT, env=child_env())
     assert res.returncode == 99, res.stderr
+    # what the test stands on: the history is in the file, its event's row not committed
+    _, tasks, _ = reader.read(partial_path(d / "killed.h5"))
+    with h5py.File(partial_path(d / "killed.h5"), "r") as h5:
+        first = int(h5["histories/row"][0])
+    assert first >= tasks["events_written"][0], (first, tasks["events_written"])
     res = run_cli("resume", d / "killed.h5", timeout=TIMEOUT)
     assert res.returncode == 0, res.stdout + res.stderr
     assert_same_events(out["recorded"], d / "killed.h5")
