@@ -135,9 +135,9 @@ def same_histories(a, b):
 @pytest.mark.slow    # (three runs, 10 s: the slower tier, run by CI)
 def test_a_run_killed_between_a_history_and_its_commit_resumes_to_the_same(runs):
     """Killed (as by kill -9) just before the commit row of a batch with a history of task 0, after an earlier
-    commit (batches of 5 rows): the history and the events are written and flushed, not committed; the resumed
-    task counts only the histories of its committed rows as kept, writes that one again, and the catalog is the
-    uninterrupted one's."""
+    commit (batches of 5 rows): the history and the events are written and flushed, not committed; a reader sees
+    the histories of the committed rows alone, the resumed task writes that one again (the same: a run is
+    deterministic), and the catalog is the uninterrupted one's."""
     d, out = runs
     cfg = config(d, **HISTORY, batch=5)
     log = d / "writes.log"
@@ -160,6 +160,9 @@ def test_a_run_killed_between_a_history_and_its_commit_resumes_to_the_same(runs)
         slots = h5["histories/row"][:PER_TASK]
     written = tasks["events_written"][0]
     assert written > 0 and np.any((slots >= 0) & (slots < written)) and np.any(slots >= written), (slots, written)
+    # a reader of the killed run sees the histories of its committed rows alone
+    with reader.Reader(partial_path(d / "killed.h5")) as cat:
+        assert [h["row"] for h in cat.histories(0)] == [int(r) for r in slots if 0 <= r < written]
     res = run_cli("resume", d / "killed.h5", timeout=TIMEOUT)
     assert res.returncode == 0, res.stdout + res.stderr
     assert_same_events(out["recorded"], d / "killed.h5")
