@@ -421,7 +421,7 @@ MUTATIONS = (
     Mutation("histories-kept-counts-uncommitted", "ensemble/store/histories.py",
              "np.count_nonzero((rows >= 0) & (rows < written))", "np.count_nonzero(rows >= 0)",
              ("tests/test_histories.py::test_a_run_killed_between_a_history_and_its_commit_resumes_to_the_same",),
-             "a history written before a kill counted as kept: the resumed run skips a slot (or its quota)"),
+             "a history written before a kill, its row never committed, read and counted as kept"),
     Mutation("nucleation-widest-counts-touched", "ensemble/model/event.py",
              "    if na > event[EV_N_WIDEST]:\n        event[EV_N_WIDEST] = na\n",
              "    if nt > event[EV_N_WIDEST]:\n        event[EV_N_WIDEST] = nt\n",
