@@ -45,7 +45,7 @@ from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
 from .steppers import FIRST_KEPT, FIRST_LAST, FIRST_NEW
 from .transitions import (NO_CUT, ONSET_LOADING, ONSET_NEIGHBOUR, STICK, above_threshold, event_nu, force_now,
                           loading_cut, locate, pressed, rest_psi, velocity_slopes)
-from .history import begin as begin_history, snapshot
+from .history import begin as begin_history, recording_history, snapshot
 from .undo import clear_log, log_block
 from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D_ENERGY_SCALE, D_FIRST, D_LAST,
                         D_LOAD_WORK, D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_STRESS_DROP, D_VMAX, D_WORK,
@@ -291,6 +291,7 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
     # block started or stopped or the step was cut, and not at a call's first step (exact either way)
     unchanged = False
     at_last = (0.0, 0.0)
+    recording = recording_history(arrays)     # (decided between events: history.py)
     while na > 0:
         if used >= budget:
             _keep(event, PausedEvent(na=na, nt=nt, yrest=yrest, t_far=t_far, far=far, tau=tau, work=work,
@@ -425,7 +426,8 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
         if not unchanged:
             t_far, far = _reschedule(W, flag, stuck, since, tree, nstuck, n, t0, tau, p)
         _nucleation_step(event, na, nt, tau)
-        snapshot(arrays, n, na, nt, tau, na == 0)
+        if recording:
+            snapshot(arrays, n, na, nt, tau, na == 0)
     if profile.shape[0] == n:
         profile[:] = 0.0
         for k in range(nt):

@@ -33,6 +33,13 @@ def begin(arrays):
         hc[HC_V] = 0.0
 
 
+@nb.njit(cache=True, inline="always")
+def recording_history(arrays):
+    """Whether the event in progress takes snapshots (checked once per kernel call: a call per step would cost
+    the events without histories their share, benchmarks/results/revisions_histories_*)."""
+    return arrays.history.shape[0] > 0 and arrays.hctl[HC_ON] != 0.0
+
+
 @nb.njit(cache=True)
 def snapshot(arrays, n, na, nt, tau, final):
     """After an accepted step (final: the event has ended), a snapshot if one is due."""
