@@ -20,6 +20,7 @@
     export.py         catalogs and summaries as tables: numpy structured arrays, pandas DataFrames, CSV files
     export_tables.py  what each exported table's columns are, and their rows
     export_csv.py     CSV files of an export's tables (a format is one module export_<name>.py)
+    history.py        `history`: one event history of a catalog (output.history) drawn in space and time
     reduction.py      a reduction as one call: catalogs -> summary on the ranks of a communicator
     api.py            the Python front door: summarize (catalogs -> Summary), Summary, events, tasks
 """

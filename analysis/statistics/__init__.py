@@ -53,7 +53,8 @@ The statistics today (the registry finds a module by its STATISTIC; this list is
     regularity.py         how periodic the large events by rupture length recur (the comparison's)
     rupture_length.py     P(L_r) of the rupture lengths and its exponential tail: the correlation length L_0
     rupture_classes.py    unilateral and bilateral ruptures: their shares, R(mu), epicenters at a past rim
-    slip_scaling.py       the mean slip per block against the rupture length
+    slip_scaling.py       the mean slip per block and the stress drop against the rupture length
+    nucleation.py         the nucleation of large events: the onset zone, the initial phase, the widest zone
 """
 import importlib
 import math

@@ -8,6 +8,7 @@
     writers.py      the parallel (mpio) and the rank-0 writer, one API, and every collective step
     reader.py       Reader, read, read_tasks
     integrity.py    checksums and range checks of the events, checkpoints and commit rows
+    histories.py    the event histories (/histories, output.history): written before their commit, read verified
     tables.py       checks of the tables fixed at creation and of each task's record
     errors.py       CatalogError; a failed write as one
 
