@@ -65,6 +65,8 @@ def small(tmp_path_factory):
     return d, cfg
 
 
+@pytest.mark.slow    # (nine crashed runs and their resumes, 18 s: the slower tier, run by CI; make test keeps the
+#                      crash before a finish, the `crashed` fixture's, and tests/test_mpi.py's kill -9)
 def test_crash_at_each_kind_of_write_of_a_batch_resumes_to_the_uninterrupted_catalog(small):
     """kill -9 before each kind of write and each flush of task 0's second batch, and just after it.
 

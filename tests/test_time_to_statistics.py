@@ -39,6 +39,7 @@ def test_best_seeds_trades_transients_against_parallelism():
     assert seeds == 16 and wall == pytest.approx(100 + 12600 * 0.01) and core == pytest.approx(400 + 64 * 126)
 
 
+@pytest.mark.slow    # (a benchmark script's own run, 10 s: it tests the benchmark, not the product; CI runs it)
 def test_a_tiny_run_measures_calibrates_and_writes(tmp_path):
     """Calibration in this process, then three runs of `python -m ensemble` (the fixed cost, without and with
     branching), each of a few seconds: mostly the start-up of a process."""
