@@ -34,6 +34,8 @@ def pick(path, task=None, index=0):
                 h = kept[index]
                 row = k * cat.per_task + h["row"]
                 event = {name: ds[row] for name, ds in cat.layout.events.items()}
+                event["run"] = ", ".join(f"{name} = {cat.tasks[name][k]:g}" for name in ("N", "l", "a", "b")
+                                         if np.isfinite(cat.tasks[name][k]))
                 return k, index, h, event
     where = "any task" if task is None else f"task {task}"
     raise CatalogError(f"{path}: {where} has no event history {index} (output.history: the events whose "
@@ -75,9 +77,10 @@ def draw(path, output, task=None, index=0):
     lines = right.get_lines() + count.get_lines()
     right.legend(lines, [line.get_label() for line in lines], fontsize=FONT, loc="upper center", ncol=3,
                  bbox_to_anchor=(0.5, -0.14), frameon=False)
-    what = (f"task {k}, row {h['row']}: mu = {float(ev['mu']):.2f}, epicenter {int(ev['epicenter'])}, blocks "
+    what = (f"task {k} ({ev['run']}), row {h['row']}: mu = {float(ev['mu']):.2f}, epicenter {int(ev['epicenter'])}, "
+            f"blocks "
             f"{int(ev['first'])}..{int(ev['last'])}, duration {float(ev['duration']):.4g}, {len(time)} snapshots"
             + (f" ({h['dropped']} dropped)" if h["dropped"] else ""))
-    layout(fig, f"{path}: event history {j} of {what}", 0.15)
+    layout(fig, f"event history {j} of {what}", 0.15)
     save(fig, output)
     return what

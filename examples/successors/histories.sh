@@ -7,11 +7,8 @@ out=${2:-runs/successors}
 mkdir -p "$out"
 py=.venv/bin/python
 cat="$out/histories.h5"
-if [ -e "$cat.partial" ]; then
-    mpirun -n "$ranks" $py -m ensemble resume "$cat"
-elif [ ! -e "$cat" ]; then
-    mpirun -n "$ranks" $py -m ensemble run examples/successors/histories.toml -o "$cat"
-fi
+. examples/successors/run_or_resume.sh
+run_or_resume examples/successors/histories.toml "$cat" "$ranks"
 # task 0 is b = 15, task 1 b = 20 (the sweep's order)
 $py -m analysis history "$cat" --task 1 -o docs/successors/history_b20.png --force
 $py -m analysis history "$cat" --task 0 -o docs/successors/history_b15.png --force

@@ -7,10 +7,10 @@ out=${2:-runs/successors}
 mkdir -p "$out"
 py=.venv/bin/python
 cat="$out/nucleation.h5"
-if [ -e "$cat.partial" ]; then
-    mpirun -n "$ranks" $py -m ensemble resume "$cat"
-elif [ ! -e "$cat" ]; then
-    mpirun -n "$ranks" $py -m ensemble run examples/successors/nucleation.toml -o "$cat"
-fi
-$py -m analysis reduce "$cat" -o docs/successors/nucleation.summary.h5 --force
+. examples/successors/run_or_resume.sh
+# one point (b = 15, l = 12) fails: an event slides past integrator.max_duration (stable sliding, docs/successors.md);
+# the others are reduced as far as written
+run_or_resume examples/successors/nucleation.toml "$cat" "$ranks" || echo "note: a task failed; reducing the others"
+part="$cat"; [ -e "$cat" ] || part="$cat.partial"
+$py -m analysis reduce "$part" --partial -o docs/successors/nucleation.summary.h5 --force
 $py -m analysis report docs/successors/nucleation.summary.h5 > docs/successors/nucleation.report.txt

@@ -7,11 +7,8 @@ out=${2:-runs/successors}
 mkdir -p "$out"
 py=.venv/bin/python
 cat="$out/ruptures.h5"
-if [ -e "$cat.partial" ]; then
-    mpirun -n "$ranks" $py -m ensemble resume "$cat"
-elif [ ! -e "$cat" ]; then
-    mpirun -n "$ranks" $py -m ensemble run examples/successors/ruptures.toml -o "$cat"
-fi
+. examples/successors/run_or_resume.sh
+run_or_resume examples/successors/ruptures.toml "$cat" "$ranks"
 $py -m analysis reduce "$cat" -o docs/successors/ruptures.summary.h5 --force
 for lo in 50 300; do      # the L_0 fit's lower end: its sensitivity (docs/successors.md)
     $py -m analysis reduce "$cat" -o "$out/ruptures_lr$lo.summary.h5" --lr-min $lo --force
