@@ -177,7 +177,8 @@ def test_analysis_history_draws_one_and_says_which(runs, tmp_path):
     histories, _ = histories_of(out["recorded"])
     row = histories[1][2]["row"]
     mu = events["mu"][events["task"] == 1][row]
-    assert f"task 1, row {row}: mu = {mu:.2f}" in res.stdout and (tmp_path / "h.png").stat().st_size > 10_000
+    assert f"task 1 (N = 100, l = 3, a = 0, b = 20), row {row}: mu = {mu:.2f}" in res.stdout
+    assert (tmp_path / "h.png").stat().st_size > 10_000
     # none there: one line naming the file, exit 1, no figure
     for path, args in ((out["plain"], ()), (out["recorded"], ("--index", str(PER_TASK)))):
         res = analysis_here("history", path, *args, "-o", tmp_path / "none.png")
