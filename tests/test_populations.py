@@ -520,7 +520,9 @@ def test_the_docs_tables_are_the_committed_summaries(name):
         counts = s["per_task/mu"][s["tasks/point"] == i].sum(axis=(0, 1))
         for key, fn in (("best_two_decades", answer.best_decades), ("top_two_decades", answer.top_decades)):
             ks, lo, b = fn(counts, s["bins/mu"])
-            assert (row[key]["ks"][0], row[key]["lo"], row[key]["gr_b"]) == pytest.approx((ks, lo, b), rel=1e-9), key
+            # the golden-section search compares log-likelihoods on their flat top, where rounding decides: the
+            # maximum is found to about sqrt(eps) (3e-8 apart between two CPUs' numpy reductions), not to 1e-9
+            assert (row[key]["ks"][0], row[key]["lo"], row[key]["gr_b"]) == pytest.approx((ks, lo, b), rel=1e-6), key
     table = answer.table(rows)
     assert table == (docs / f"{name}-answer.md").read_text().strip()
     assert table in (docs.parent / "populations.md").read_text()
