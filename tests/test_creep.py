@@ -345,3 +345,20 @@ def test_a_block_that_stuck_on_its_threshold_does_not_creep_in_place():
             break
     assert done == 300
     assert np.sum(d[:, D_KIND] == KIND_CREEP) > 20
+
+
+def test_a_cluster_nearly_too_soft_creeps_on():
+    """N = 30, l = 12, b = 15: a creeping cluster of 9 blocks is 0.1 above the loss of stability (lambda_min(K_C)
+    = 15.1), and Newton's updates flip sign at the rounding of the forces for ever there (the rounding of one
+    force reaches every block through the run's smallest pivot). Its balanced forces are converged
+    (creep._newton_from); before, the cluster went to an event that slid at its creep velocities (1e-9) until
+    integrator.max_duration (row 625 of this seed). Every row comes, every event ends within 100 time units."""
+    from ensemble.config import loads
+    from ensemble.run.trajectory import Trajectory
+    from ensemble.sweep import task_list
+    cfg = loads("[model]\nN = 30\nl = 12.0\nb = 15.0\n[run]\nevents = 630\ntransient = 0\nseed = 1\n"
+                "[integrator]\nmax_duration = 2000.0\n")
+    _, _, d = Trajectory(cfg, task_list(cfg)[0]).advance(630)
+    events = d[d[:, D_KIND] == KIND_EVENT]
+    assert len(d) == 630 and len(events) > 100 and np.sum(d[:, D_KIND] == KIND_CREEP) > 400
+    assert events[:, D_DURATION].max() < 100
