@@ -72,6 +72,15 @@ here the slow and obvious way, from the raw events:
   and the means of n_onset (L_sc), n_widest (L_c) and t_widest; of those with a t_spread (not NaN) its mean and
   their share of the count; per mu bin, of all inertial events with n_onset > 0, the mean n_widest (the curve;
   NaN for an empty bin);
+- slow slip: mainshocks are the inertial events with mu >= mu_c; a mainshock has precursory creep if a creep episode
+  with ending 2 ends at its onset (within 8 spacings of the time) with its epicenter among the episode's blocks or
+  next to them; a
+  creep episode is afterslip of the last mainshock that ended (onset + duration) at or before its start if it began
+  at most afterslip_window (T nu) after that end and its blocks meet first - 1 .. last + 1 of the mainshock: the
+  mainshock then has afterslip (counted once, with its slip) and the episode's slip is summed; a silent earthquake
+  is a creep episode with ending 1 and mu >= mu_c (in its creep row's stretch); the numbers: the mainshocks, the
+  shares with precursory creep and with afterslip, the summed afterslip over the summed slip of the mainshocks
+  with afterslip, the silent earthquakes and their share of silent and mainshocks together;
 - a reduction is partial if a catalog's name ends in .partial or one of its tasks is not
   finished (status 1) or holds fewer than events_per_task events; the summary then states the
   events reduced of those expected and names those catalogs.
@@ -108,6 +117,8 @@ RUPTURE_NUMBERS = ("L0", "n_L0", "n_classified", "fraction_unilateral", "uni_at_
                    "t_nucleation")
 RUPTURE_CURVES = ("lr", "mu_uni", "mu_bi", "mean_slip", "mean_drop", "nucleation_length")
 CLASS_COLUMNS = ("n_classified", "n_uni", "n_bi", "n_uni_prev", "n_uni_rim", "n_bi_prev", "n_bi_rim")
+SLOW_SLIP_NUMBERS = ("n_main", "precursor_share", "afterslip_share", "afterslip_ratio", "n_silent", "silent_share")
+AFTERSLIP_WINDOW = 0.01    # the documented default of reduce --afterslip-window
 SEIS = {"seis_time_edges": np.linspace(-1000, 1000, 41), "seis_distance_edges": np.linspace(0, 40, 21),
         "seis_near": 2.0, "seis_ring": 10.0, "seis_short": 50.0, "seis_long": 500.0}
 # the chain's parameters and every friction law's keys (NaN where a key is not the task's law's)
@@ -265,7 +276,7 @@ def ks_distance(mu, edges, cut, b):
 
 
 def edges_of(opt, name):
-    return opt[name] if name in opt else {**CREEP_EDGES, **SEIS, **RUPTURE}[name]
+    return opt[name] if name in opt else {**CREEP_EDGES, **SEIS, **RUPTURE, "afterslip_window": AFTERSLIP_WINDOW}[name]
 
 
 def seis_cell(dt, d, te, de):
@@ -319,7 +330,7 @@ def correlation_length(n, excess, span):
 
 def statistics(mu, tnu, interior, event_slip, creep_mu, creep_log_duration, creep_taken, creep_slip, gaps,
                seis_cells, seis_exposure, block_span, lr, fit, cls, has_prev, at_rim, mean_slip, slip_half, drop,
-               nuc, opt):
+               nuc, mains, silent, opt):
     """Curves and numbers of pooled raw data: mu (all inertial events), tnu and interior
     (recurrences), event_slip (the inertial events' slips), the creep episodes' mu, log10(duration
     nu), taken over (ending 2) and slip, and the inter-event times (times nu) of the inertial events."""
@@ -396,6 +407,12 @@ def statistics(mu, tnu, interior, event_slip, creep_mu, creep_log_duration, cree
                     "spread_share": quotient(len(spread), len(large)),
                     "L_c": quotient(sum(float(x) for x in large[:, 4]), len(large)),
                     "t_nucleation": quotient(sum(float(x) for x in large[:, 3]), len(large))})
+    mains = np.asarray(mains, dtype=float).reshape(-1, 4)     # precursor, after, slip if after, afterslip
+    n_main, n_after, n_silent = len(mains), int(mains[:, 1].sum()), len(silent)
+    numbers.update({"n_main": n_main, "precursor_share": quotient(int(mains[:, 0].sum()), n_main),
+                    "afterslip_share": quotient(n_after, n_main),
+                    "afterslip_ratio": quotient(sum(float(x) for x in mains[:, 3]), sum(float(x) for x in mains[:, 2])),
+                    "n_silent": n_silent, "silent_share": quotient(n_silent, n_silent + n_main)})
     with_columns = nuc[nuc[:, 1] > 0]
     nuc_sums = binned_sums(with_columns[:, 0], with_columns[:, 4], me)
     nuc_in_bin = histogram(with_columns[:, 0], me)
@@ -465,6 +482,7 @@ class Task:
                                                                  "slip", "stress_drop", "n_onset", "t_spread",
                                                                  "t_widest", "n_widest")},
                       n_blocks, opt, k, n)
+        self.slow_slip(column, inertial, creep, nu, opt, k)
         ev = {name: column[name][inertial] for name in ("t", "mu", "epicenter", "boundary")}
         self.n = n
         self.mu = np.asarray(ev["mu"], dtype=float)
@@ -516,6 +534,37 @@ class Task:
         self.nuc = np.array([[float(ev[c][i]) for c in ("mu", "n_onset", "t_spread", "t_widest", "n_widest")]
                              for i in range(n)], dtype=float).reshape(-1, 5)
 
+    def slow_slip(self, column, inertial, creep, nu, opt, k):
+        """Per mainshock (mu >= mu_c) its row (precursory creep, afterslip, its slip if afterslip, the afterslip's
+        slip) and stretch; the silent earthquakes' stretches: every creep episode against every mainshock."""
+        n = len(inertial)
+        t, duration = column["t"], column["duration"]
+        mains = [(i, r) for i, r in enumerate(inertial) if float(column["mu"][r]) >= opt["mu_c"]]
+        rows = {r: [0.0, 0.0, 0.0, 0.0] for _, r in mains}
+        silent = []
+        for c, r in enumerate(creep):
+            start, first, last = float(t[r]), int(column["first"][r]), int(column["last"][r])
+            end = start + float(duration[r])
+            if int(column["ending"][r]) == 1 and float(column["mu"][r]) >= opt["mu_c"]:
+                silent.append(self.creep_stretch[c])
+            if int(column["ending"][r]) == 2:
+                for _, m in mains:
+                    if (abs(float(t[m]) - end) <= 8 * math.ulp(abs(end))
+                            and first - 1 <= int(column["epicenter"][m]) <= last + 1):
+                        rows[m][0] = 1.0
+            ended = [m for _, m in mains if float(t[m]) + float(duration[m]) <= start + 8 * math.ulp(abs(start))]
+            if not ended:
+                continue
+            m = ended[-1]
+            if ((start - (float(t[m]) + float(duration[m]))) * nu <= edges_of(opt, "afterslip_window")
+                    and first <= int(column["last"][m]) + 1 and int(column["first"][m]) - 1 <= last):
+                if not rows[m][1]:
+                    rows[m][1], rows[m][2] = 1.0, float(column["slip"][m])
+                rows[m][3] += float(column["slip"][r])
+        self.mains = np.array([rows[r] for _, r in mains], dtype=float).reshape(-1, 4)
+        self.main_stretch = np.array([i * k // n for i, _ in mains], dtype=np.int64)
+        self.silent = np.array(silent, dtype=np.int64)
+
     def seis(self, ev, nu, n_blocks, opt):
         """Every pair's cell and stretch (of its mainshock), every mainshock's exposure row and stretch."""
         T = [float(x) * nu for x in ev["t"]]
@@ -548,7 +597,7 @@ class Task:
         creep slip) of the whole task or of one stretch."""
         creep = (self.creep_mu, self.creep_log_duration, self.creep_taken, self.creep_slip)
         ruptures = (self.lr, self.fit, self.cls, self.has_prev, self.at_rim, self.mean_slip, self.slip_half,
-                    self.drop, self.nuc)
+                    self.drop, self.nuc, self.mains, self.silent)
         if stretch is None:
             return (self.mu, self.tnu, self.interior, self.event_slip, *creep, self.gaps, self.seis_cells,
                     self.seis_exposure, self.block_span, *ruptures)
@@ -557,7 +606,8 @@ class Task:
                 self.gaps[self.gap_stretch == stretch], self.seis_cells[self.seis_cell_stretch == stretch],
                 self.seis_exposure[self.seis_main_stretch == stretch], self.block_span[self.gap_stretch == stretch],
                 self.lr[e], self.fit[self.fit_stretch == stretch], self.cls[e], self.has_prev[e], self.at_rim[e],
-                self.mean_slip[e], self.slip_half[e], self.drop[e], self.nuc[e])
+                self.mean_slip[e], self.slip_half[e], self.drop[e], self.nuc[e], self.mains[self.main_stretch == stretch],
+                self.silent[self.silent == stretch])
 
     def per_stretch(self, opt):
         k, me, te = opt["blocks"], opt["mu_edges"], opt["tnu_edges"]
@@ -582,9 +632,13 @@ class Task:
         drop_columns = np.zeros((k, 4))
         nuc_columns, nuc_len = np.zeros((k, 6)), np.zeros((k, len(me) - 1))
         nuc_n = np.zeros((k, len(me) - 1), dtype=np.int64)
+        slow = np.zeros((k, 6))
         for s in range(k):
             (mu, tnu, interior, event_slip, creep_mu, creep_log_duration, taken, creep_slip, gaps, cells,
-             exposure, block_span, lr, fit, cls, has_prev, at_rim, mean_slip, slip_half, drop, nuc) = self.unit(s)
+             exposure, block_span, lr, fit, cls, has_prev, at_rim, mean_slip, slip_half, drop, nuc, mains,
+             silent) = self.unit(s)
+            slow[s] = [len(mains), mains[:, 0].sum(), mains[:, 1].sum(), mains[:, 2].sum(), mains[:, 3].sum(),
+                       len(silent)]
             large = nuc[(nuc[:, 0] >= opt["mu_c"]) & (nuc[:, 1] > 0)]
             spread = large[~np.isnan(large[:, 2])]
             nuc_columns[s] = [len(large), large[:, 1].sum(), len(spread), spread[:, 2].sum(), large[:, 4].sum(),
@@ -617,7 +671,7 @@ class Task:
                           interior.sum(), tnu[interior].sum(), len(gr), gr.sum(), (gr ** 2).sum()]
         return (mu_h, t_h, ti_h, numbers, cm_h, cd_h, creep, intervals, pairs, seis_exposure, seis_columns, lr_h,
                 fit_sums, classes, uni_h, bi_h, slip_h, slip_columns, drop_n, drop_h, drop_columns,
-                nuc_columns, nuc_n, nuc_len)
+                nuc_columns, nuc_n, nuc_len, slow)
 
 
 def _pool(units, pick):
@@ -776,7 +830,7 @@ def expected_summary(catalogs, opt):
     for j, name in enumerate(("mu", "tnu", "tnu_interior", "numbers", "creep_mu", "creep_duration", "creep",
                               "intervals", "seis_pairs", "seis_exposure", "seismicity", "lr", "rupture_length",
                               "rupture_classes", "mu_uni", "mu_bi", "slip_lr", "slip_scaling", "drop_n", "drop_lr",
-                              "stress_drop", "nucleation", "nuc_n", "nuc_len")):
+                              "stress_drop", "nucleation", "nuc_n", "nuc_len", "slow_slip")):
         exp[f"per_task/{name}"] = np.stack([s[j] for s in stacks])
     results = []
     for params, rows in points:
@@ -791,7 +845,7 @@ def expected_summary(catalogs, opt):
     for name in CURVES + RUPTURE_CURVES:
         for j, suffix in enumerate(("density", "lo", "hi")):
             exp[f"points/{name}_{suffix}"] = np.stack([r["curves"][name][j] for r in results])
-    for name in NUMBERS + CREEP_NUMBERS + SEISMICITY_NUMBERS + RUPTURE_NUMBERS:
+    for name in NUMBERS + CREEP_NUMBERS + SEISMICITY_NUMBERS + RUPTURE_NUMBERS + SLOW_SLIP_NUMBERS:
         exp[f"points/numbers/{name}"] = np.array([r["numbers"][name] for r in results], dtype=float)
     exp["points/seismicity_rate"] = np.stack([r["seismicity_rate"] for r in results])
     most = max([len(r["peaks"]) for r in results] + [1])
@@ -834,7 +888,8 @@ def check_summary(s, expected, opt):
     """Every dataset and attribute of summary `s` (read_summary) against expected_summary."""
     tasks = expected["tasks"]
     tasks_keys = {f"tasks/{k}" for k in tasks}
-    numbers = {f"points/numbers/{n}" for n in NUMBERS + CREEP_NUMBERS + SEISMICITY_NUMBERS + RUPTURE_NUMBERS}
+    numbers = {f"points/numbers/{n}" for n in NUMBERS + CREEP_NUMBERS + SEISMICITY_NUMBERS + RUPTURE_NUMBERS
+               + SLOW_SLIP_NUMBERS}
     curves = {f"points/{c}_{x}" for c in CURVES + RUPTURE_CURVES for x in ("density", "lo", "hi")}
     known = ({"bins/mu", "bins/tnu", "bins/creep_mu", "bins/creep_duration", "points/method", "points/units",
               "points/law", "bins/seis_time", "bins/seis_distance", "points/seismicity_rate",
@@ -843,14 +898,15 @@ def check_summary(s, expected, opt):
                                           "creep", "intervals", "seis_pairs", "seis_exposure", "seismicity", "lr",
                                           "rupture_length", "rupture_classes", "mu_uni", "mu_bi", "slip_lr",
                                           "slip_scaling", "drop_n", "drop_lr", "stress_drop", "nucleation", "nuc_n",
-                                          "nuc_len")}
+                                          "nuc_len", "slow_slip")}
              | {f"points/{p}" for p in PARAMS} | tasks_keys | numbers | curves)
     # a new output must get its brute-force check here
     assert set(s) == known, f"unchecked {set(s) - known}, missing {known - set(s)}"
     a = s["attrs"]
     for key in ("mu_c", "window", "b_cut", "bootstrap", "level", "blocks", "seed"):
         assert a[key] == opt[key], key
-    for key in ("seis_near", "seis_ring", "seis_short", "seis_long", "lr_min", "lr_max", "class_min", "uni_edge"):
+    for key in ("seis_near", "seis_ring", "seis_short", "seis_long", "lr_min", "lr_max", "class_min", "uni_edge",
+                "afterslip_window"):
         assert a[key] == edges_of(opt, key), key
     paths = expected["paths"]
     assert a["format"].startswith("bk-summary-")
@@ -901,8 +957,10 @@ def check_summary(s, expected, opt):
     np.testing.assert_array_equal(s["per_task/nuc_n"], expected["per_task/nuc_n"])
     counts = [0, 2]
     np.testing.assert_array_equal(s["per_task/nucleation"][..., counts], expected["per_task/nucleation"][..., counts])
+    np.testing.assert_array_equal(s["per_task/slow_slip"][..., [0, 1, 2, 5]],
+                                  expected["per_task/slow_slip"][..., [0, 1, 2, 5]], err_msg="per_task/slow_slip counts")
     for key in ("per_task/slip_lr", "per_task/slip_scaling", "per_task/drop_lr", "per_task/stress_drop",
-                "per_task/nucleation", "per_task/nuc_len"):
+                "per_task/nucleation", "per_task/nuc_len", "per_task/slow_slip"):
         np.testing.assert_allclose(s[key], expected[key], rtol=RTOL, atol=0, err_msg=key)
     np.testing.assert_allclose(s["per_task/rupture_length"], expected["per_task/rupture_length"], rtol=RTOL, atol=0)
     for key in sorted(numbers):

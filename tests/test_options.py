@@ -47,6 +47,7 @@ BAD = {
     "seis_near": ["nan", "inf", "-1", "1e400", "x"],
     "seis_ring": ["nan", "inf", "-1", "1e400"],
     "seis_short": ["nan", "inf", "-1", "1e400"],
+    "afterslip_window": ["nan", "inf", "-1", "1e400", "x"],
     "seis_long": ["nan", "inf", "-0.5", "1e400"],
     "lr_bins": ["0.5:nan:20", "0:1600", "1600:0:20", "0:1600:0", "0:1e308:10000000000"],
     "lr_min": ["nan", "inf", "0", "-3", "2.5", "10" + "0" * 30],

@@ -8,8 +8,7 @@ mkdir -p "$out"
 py=.venv/bin/python
 cat="$out/nucleation.h5"
 . examples/successors/run_or_resume.sh
-# one point (b = 15, l = 12) fails: an event slides past integrator.max_duration (stable sliding, docs/successors.md);
-# the others are reduced as far as written
+# (a failed task would be reported and the others reduced as far as written)
 run_or_resume examples/successors/nucleation.toml "$cat" "$ranks" || echo "note: a task failed; reducing the others"
 part="$cat"; [ -e "$cat" ] || part="$cat.partial"
 $py -m analysis reduce "$part" --partial -o docs/successors/nucleation.summary.h5 --force
