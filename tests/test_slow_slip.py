@@ -8,10 +8,14 @@ import numpy as np
 import pytest
 
 from analysis import options as reduce_options
-from analysis import reduce
+from analysis import plot, reduce, summary
 from analysis.statistics import slow_slip
 from ensemble.model.workspace import KIND_CREEP, KIND_EVENT
 from ensemble.store import schema
+
+from .conftest import ROOT
+from .processes import analysis_here
+from .test_figures import covered, crowded, small_text
 
 N_BLOCKS = 60
 NU = 1e-2
@@ -144,3 +148,37 @@ def test_without_creep_episodes_the_shares_are_zero_and_the_ratio_unknown():
     n_main, precursor_share, afterslip_share, ratio, n_silent, silent_share = slow_slip.estimate(u, opt)
     assert n_main > 50 and precursor_share == afterslip_share == n_silent == silent_share == 0
     assert math.isnan(ratio)
+
+
+NUCLEATION = ROOT / "docs/successors/nucleation.summary.h5"     # b x l, N = 400, a = 0
+
+
+def test_the_map_shows_each_points_numbers_in_its_cell(tmp_path):
+    """--figure slow_slip on the committed nucleation sweep (b and l vary): four panels over the b x l grid, each
+    cell's label its point's number and interval (and the count under it), nothing covered, no small text; the
+    command writes it; with three varying parameters (another summary's N beside it) it is a one-line error."""
+    s = summary.read(NUCLEATION)
+    fig = plot.figure(s, "slow_slip", names=[NUCLEATION])
+    try:
+        assert covered(fig) == [] and small_text(fig) == [] and crowded(fig) == []
+        panels = [ax for ax in fig.axes if ax.get_title()]
+        assert [ax.get_title() for ax in panels] == [label for _, label, _, _ in slow_slip.PANELS]
+        ls, bs = sorted(set(s["points/l"])), sorted(set(s["points/b"]))
+        for ax, (name, _, under, fmt) in zip(panels, slow_slip.PANELS):
+            assert [t.get_text() for t in ax.get_xticklabels()] == [f"{v:g}" for v in ls]
+            cells = {(round(t.get_position()[0]), round(t.get_position()[1])): t.get_text() for t in ax.texts}
+            assert len(cells) == len(s["points/b"])
+            for i in range(len(s["points/b"])):
+                est, lo, hi = s[f"points/numbers/{name}"][i]
+                text = cells[(ls.index(s["points/l"][i]), bs.index(s["points/b"][i]))]
+                assert text.startswith("-" if np.isnan(est) else f"{est:.2g}\n[{lo:.2g}, {hi:.2g}]"), (name, i, text)
+                if np.isfinite(s[f"points/numbers/{under}"][i][0]):
+                    assert text.endswith(fmt.format(s[f"points/numbers/{under}"][i][0]))
+    finally:
+        plot.plt.close(fig)
+    res = analysis_here("plot", NUCLEATION, "--figure", "slow_slip", "-o", tmp_path / "map.png")
+    assert res.returncode == 0 and (tmp_path / "map.png").stat().st_size > 10_000, res.stderr
+    res = analysis_here("plot", NUCLEATION, ROOT / "docs/paper/fig1_b.summary.h5", "--figure", "slow_slip",
+                        "-o", tmp_path / "none.png")
+    assert res.returncode == 1 and len(res.stderr.strip().splitlines()) == 1 and "slow-slip map" in res.stderr
+    assert not (tmp_path / "none.png").exists()

@@ -27,7 +27,7 @@ import numpy as np
 
 from ensemble.store import schema
 
-from . import Number, Option, Statistic, Table
+from . import Figure, Number, Option, Statistic, Table
 
 NAME = "slow_slip"
 COLUMNS = ("n_main", "n_precursor", "n_after", "sum_main_slip_after", "sum_afterslip", "n_silent")
@@ -103,6 +103,60 @@ def estimate(u, opt):
                 c["n_silent"] / (c["n_silent"] + c["n_main"])]
 
 
+# the map's panels: (number shown by colour, its label, the number written under it, how it is written)
+PANELS = (("aseismic_fraction", "aseismic slip fraction (1: stable sliding)", "n_main", "{:.0f} mainshocks"),
+          ("precursor_share", "mainshocks with precursory creep", "n_main", "of {:.0f}"),
+          ("afterslip_share", "mainshocks with afterslip", "afterslip_ratio", "slip ratio {:.2g}"),
+          ("silent_share", "silent share of the large slips", "n_silent", "{:.0f} silent"))
+
+
+def map_size(n):
+    return 11, 8.6
+
+
+def draw_map(summaries, fig, keys, labels, names, title):
+    """The regime map: one panel per kind of slip over the grid of the two varying parameters (a and b if both
+    vary), each cell coloured by its share and labelled with it, its interval and the count behind it; a cell
+    without the number (no mainshock, or a summary before the statistic) is left blank."""
+    from matplotlib import colormaps
+
+    from ..drawing import FONT, layout
+    from ..figure_labels import points_of
+    from ..summary import SummaryError
+    if not 1 <= len(keys) <= 2:
+        raise SummaryError(f"{', '.join(map(str, names))}: the slow-slip map needs one or two varying parameters, "
+                           f"not {len(keys)} ({', '.join(keys) or 'none'})")
+    x_key, y_key = (("a", "b") if set(keys) == {"a", "b"} else (keys[0], keys[1] if len(keys) == 2 else None))
+    points = points_of(summaries)
+    xs = sorted({float(s[f"points/{x_key}"][i]) for s, i in points})
+    ys = sorted({float(s[f"points/{y_key}"][i]) for s, i in points}) if y_key else [0.0]
+    cmap = colormaps["viridis"]
+    for ax, (name, label, under, fmt) in zip(fig.subplots(2, 2).flat, PANELS):
+        grid = np.full((len(ys), len(xs)), np.nan)
+        for s, i in points:
+            if f"points/numbers/{name}" not in s:
+                continue
+            x = xs.index(float(s[f"points/{x_key}"][i]))
+            y = ys.index(float(s[f"points/{y_key}"][i])) if y_key else 0
+            est, lo, hi = s[f"points/numbers/{name}"][i]
+            grid[y, x] = est
+            text = "-" if np.isnan(est) else f"{est:.2g}\n[{lo:.2g}, {hi:.2g}]"
+            if f"points/numbers/{under}" in s and np.isfinite(s[f"points/numbers/{under}"][i][0]):
+                text += "\n" + fmt.format(s[f"points/numbers/{under}"][i][0])
+            ax.text(x, y, text, ha="center", va="center", fontsize=FONT,
+                    color="white" if np.isfinite(est) and est < 0.5 else "black")
+        mesh = ax.pcolormesh(np.arange(len(xs) + 1) - 0.5, np.arange(len(ys) + 1) - 0.5, np.ma.masked_invalid(grid),
+                             cmap=cmap, vmin=0.0, vmax=1.0)
+        fig.colorbar(mesh, ax=ax, fraction=0.05)
+        ax.set_xticks(range(len(xs)), [f"{v:g}" for v in xs])
+        ax.set_yticks(range(len(ys)), [f"{v:g}" for v in ys] if y_key else [""])
+        ax.set_xlabel(x_key)
+        if y_key:
+            ax.set_ylabel(y_key)
+        ax.set_title(label, fontsize=FONT + 1)
+    layout(fig, title, 0.1)
+
+
 STATISTIC = Statistic(
     NAME, 96,
     tables=(Table(NAME, "count or sum", "mainshocks (mu >= mu_c), those with precursory creep and with afterslip, the "
@@ -122,6 +176,9 @@ STATISTIC = Statistic(
              Number("silent_share", "1", "silent earthquakes over silent earthquakes and mainshocks (the large slips "
                                          "that were silent)", "silent share")),
     feed=feed, estimate=estimate, uses_tables=(), uses_options=("mu_c",),
+    figures=(Figure("slow_slip", "the regime map of slow slip: the aseismic fraction, the shares of mainshocks with "
+                                 "precursory creep and with afterslip, and the silent share, over the grid of the two "
+                                 "varying parameters", map_size, draw_map),),
     options=(Option("afterslip_window", "number", 0.01, "model length",
                     "afterslip: a creep episode beginning at most this long (T nu) after a mainshock's end", 0.0,
                     1e9),))
