@@ -468,6 +468,13 @@ MUTATIONS = (
              'y = ys.index(float(s[f"points/{y_key}"][i])) if y_key else 0', "y = 0",
              ("tests/test_slow_slip.py::test_the_map_shows_each_points_numbers_in_its_cell",),
              "the regime map draws every point in its first row"),
+    Mutation("creep-hands-over-on-error", "ensemble/model/creep.py",
+             "        who = _accelerating(arrays, n, h, inertial)\n        if who >= 0:",
+             "        who = _accelerating(arrays, n, h, inertial)\n        if err > 1.0 and who < 0:\n"
+             "            who = arrays.crept[0]\n        if who >= 0:",
+             ("tests/test_creep.py::test_creep_relaxing_faster_than_inertia_creeps_on",),
+             "creep whose error wants steps below the inertial period hands over to an event though it does not "
+             "accelerate: the event slides at the creep's velocity until max_duration"),
     Mutation("points-pool-two-laws", "analysis/merge.py",
              "        bits = (law, *(np.float64", "        bits = (\"\", *(np.float64",
              ("tests/test_compare.py::test_two_laws_with_the_same_keys_are_two_points",),

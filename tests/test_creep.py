@@ -362,3 +362,21 @@ def test_a_cluster_nearly_too_soft_creeps_on():
     events = d[d[:, D_KIND] == KIND_EVENT]
     assert len(d) == 630 and len(events) > 100 and np.sum(d[:, D_KIND] == KIND_CREEP) > 400
     assert events[:, D_DURATION].max() < 100
+
+
+def test_creep_relaxing_faster_than_inertia_creeps_on():
+    """nu = 1e-4, a = 3, b = 5 (N = 100): a creeping block's velocity relaxes over a / (K - b) = 0.2, faster than
+    the inertial period 1.44, and the creep's error cannot meet creep_tol at one inertial period. The creep takes
+    that step rather than handing over (creep.continue_creep): before, the block went to an event that slid at
+    its creep velocity (6.5e-6) until integrator.max_duration (task 2, event 33 of this sweep)."""
+    from ensemble.config import loads
+    from ensemble.run.trajectory import Trajectory
+    from ensemble.sweep import task_list
+    cfg = loads("[model]\nN = 100\nnu = 1e-4\n[sweep]\na = [0.0, 3.0]\nb = [5.0, 8.0]\n[run]\nevents = 60\n"
+                "transient = 0\n[integrator]\nmax_duration = 2000.0\n")
+    task = task_list(cfg)[2]
+    assert (task.model.a, task.model.b) == (3.0, 5.0)
+    _, _, d = Trajectory(cfg, task).advance(60)
+    events = d[d[:, D_KIND] == KIND_EVENT]
+    assert len(events) > 5 and np.sum(d[:, D_KIND] == KIND_CREEP) > 20
+    assert events[:, D_DURATION].max() < 1000
