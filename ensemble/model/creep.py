@@ -518,15 +518,32 @@ def _solve(arrays, n, p, t, h):
 
 @nb.njit(cache=True)
 def _accelerating(arrays, n, h, inertial):
-    """A creeping block whose velocity grows by e within an inertial period over the step just
-    solved (v / (dv/dt) < inertial), or -1."""
+    """The fastest of the creeping blocks whose velocity grows by e within an inertial period over the step just
+    solved (v / (dv/dt) < inertial), or -1: where the creep runs away, the block that leads (not the first of the
+    list, which would put every such epicenter on one side of a cluster)."""
     C = arrays.creep
+    who = -1
     for k in range(creeping_list(arrays, n)):
         i = arrays.crept[k]
         grow = C[i, CR_VN] - C[i, CR_V]
-        if grow > 0.0 and C[i, CR_VN] * h < inertial * grow:
-            return i
-    return -1
+        if grow > 0.0 and C[i, CR_VN] * h < inertial * grow and (who < 0 or C[i, CR_VN] > C[who, CR_VN]):
+            who = i
+    return who
+
+
+@nb.njit(cache=True)
+def _leading(C, n, bad):
+    """The epicenter where a step's Newton failed at block `bad` (its run too soft to creep, at its fold): the
+    fastest block of the run at the step's start (the order of the tridiagonal sweep, which decides where a pivot
+    first turns non-negative, would put it at one end of every cluster); `bad` itself if none of it moves."""
+    if not creeping(C, bad):
+        return bad
+    lo, hi = run_of(C, n, bad)
+    who = bad
+    for i in range(lo, hi + 1):
+        if C[i, CR_V] > C[who, CR_V]:
+            who = i
+    return who
 
 
 @nb.njit(cache=True)
@@ -598,7 +615,7 @@ def continue_creep(arrays, clock, n, p, budget):
             h = max(h * max(_SHRINK, 0.9 / math.sqrt(err)), h * 0.25, inertial)
         if not solved:
             # no creep: the cluster became too soft where Newton failed
-            return HANDOVER, used, bad
+            return HANDOVER, used, _leading(C, n, bad)
         # creep that accelerates on inertia's time scale is no longer quasi-static: an event
         who = _accelerating(arrays, n, h, inertial)
         if who >= 0:
@@ -643,7 +660,7 @@ def continue_creep(arrays, clock, n, p, budget):
                 solved, work, _, bad = _solve(arrays, n, p, t, h)
                 used += work
                 if not solved:
-                    return HANDOVER, used, bad
+                    return HANDOVER, used, _leading(C, n, bad)
         if h > 0.0:
             t_new[0], t_new[1] = t[0], t[1]
             advance_clock(t_new, h)
