@@ -475,6 +475,14 @@ MUTATIONS = (
              ("tests/test_creep.py::test_creep_relaxing_faster_than_inertia_creeps_on",),
              "creep whose error wants steps below the inertial period hands over to an event though it does not "
              "accelerate: the event slides at the creep's velocity until max_duration"),
+    Mutation("creep-epicenter-at-the-pivot", "ensemble/model/creep.py",
+             "            # no creep: the cluster became too soft where Newton failed\n"
+             "            return HANDOVER, used, _leading(C, n, bad)",
+             "            # no creep: the cluster became too soft where Newton failed\n"
+             "            return HANDOVER, used, bad",
+             ("tests/test_slip_law.py::test_two_blocks_at_the_paper_rate_alternate_without_small_events",),
+             "a hand-over where Newton fails starts at the block of the first non-negative pivot (one end of the "
+             "cluster), not at its fastest block"),
     Mutation("points-pool-two-laws", "analysis/merge.py",
              "        bits = (law, *(np.float64", "        bits = (\"\", *(np.float64",
              ("tests/test_compare.py::test_two_laws_with_the_same_keys_are_two_points",),
