@@ -15,6 +15,6 @@ for l in 3 12; do
     part="$out/$name.h5"; [ -e "$part" ] || part="$part.partial"
     $py -m analysis reduce "$part" --partial -o "docs/successors/$name.summary.h5" --force
     $py -m analysis report "docs/successors/$name.summary.h5" > "docs/successors/$name.report.txt"
-    $py -m analysis plot "docs/successors/$name.summary.h5" --figure slow_slip -o "docs/successors/$name.png"
+    $py -m analysis plot "docs/successors/$name.summary.h5" --figure slow_slip -o "docs/successors/$name.png" --force
   done
 done
