@@ -110,6 +110,22 @@ PANELS = (("aseismic_fraction", "aseismic slip fraction (1: stable sliding)", "n
           ("silent_share", "silent share of the large slips", "n_silent", "{:.0f} silent"))
 
 
+def describe_map(summaries):
+    """The title's words: the parameters every point shares (what was run), the events behind the points, mu_c and
+    the afterslip window, and what a cell says."""
+    from ..report import size_text
+    shared = []
+    for key in ("N", "l", "nu", "c"):
+        values = {float(v) for s in summaries for v in s[f"points/{key}"]}
+        if len(values) == 1:
+            shared.append(f"{key} = {values.pop():g}")
+    sizes = " / ".join(dict.fromkeys(size_text(s) for s in summaries))
+    mu_c = " / ".join(dict.fromkeys(f"{s['attrs']['mu_c']:g}" for s in summaries))
+    window = " / ".join(dict.fromkeys(f"{s['attrs'].get('afterslip_window', np.nan):g}" for s in summaries))
+    return (f"{', '.join(shared)}; {sizes}, mainshocks mu >= {mu_c}, afterslip window {window} T nu; each cell: "
+            "the number [its interval] and the count behind it")
+
+
 def map_size(n):
     return 11, 8.6
 
@@ -178,7 +194,7 @@ STATISTIC = Statistic(
     feed=feed, estimate=estimate, uses_tables=(), uses_options=("mu_c",),
     figures=(Figure("slow_slip", "the regime map of slow slip: the aseismic fraction, the shares of mainshocks with "
                                  "precursory creep and with afterslip, and the silent share, over the grid of the two "
-                                 "varying parameters", map_size, draw_map),),
+                                 "varying parameters", map_size, draw_map, describe=describe_map),),
     options=(Option("afterslip_window", "number", 0.01, "model length",
                     "afterslip: a creep episode beginning at most this long (T nu) after a mainshock's end", 0.0,
                     1e9),))
