@@ -1,4 +1,4 @@
-"""python -m analysis reduce|plot|report|paper|export|compare|history ...
+"""python -m analysis reduce|plot|report|paper|successors|export|compare|history ...
 
 reduce streams one or more catalogs into per-task histograms (ranks split the tasks of all
 catalogs under mpirun and rank 0 merges them), pools the tasks of equal parameters (N, l, nu and
@@ -7,7 +7,8 @@ merged densities and summary numbers with bootstrap intervals and writes a summa
 large-event magnitude default to the friction law's scale (Law.scales). The same trajectory (random
 stream and parameters) in two catalogs is refused; so is an unfinished run (a *.partial
 catalog, unfinished tasks) unless --partial is given. plot overlays the points of one or more
-summaries; report prints a summary's numbers; paper sets the paper's claims beside them; export
+summaries; report prints a summary's numbers; paper sets the paper's claims beside them; successors
+sets the claims of its authors' three later papers beside them (analysis/successors.py); export
 writes a catalog's or a summary's tables; compare sets the points of catalogs of several friction
 laws side by side (analysis/compare.py); history draws an event history a run kept (analysis/history.py).
 
@@ -88,6 +89,12 @@ def _parser():
                                       "labelled full size or reduced (analysis/paper.py)")
     pa.add_argument("summaries", nargs="+", metavar="summary",
                     help="each claim reads the summary with the most of the points it needs (the first of equals)")
+    su = sub.add_parser("successors", help="the claims of the seed's authors' later papers (rupture statistics, "
+                                           "nucleation, slow slip) beside the numbers of summaries "
+                                           "(analysis/successors.py)")
+    su.add_argument("summaries", nargs="*", metavar="summary",
+                    help="default: the committed summaries of docs/successors; each claim reads the summary with the "
+                         "most of the points it needs, the slow-slip claims every point")
     from .export import FORMATS
     ex = sub.add_parser("export", help="catalog (events, tasks) or summary (curves, numbers, peaks, seismicity) -> "
                                        "tables for other tools (docs/running.md)")
@@ -162,6 +169,16 @@ def _paper(args):
     return 0
 
 
+def _successors(args):
+    from .successors import committed, text
+    paths = args.summaries or committed()
+    if not paths:
+        raise summary.SummaryError("no summary given, and no committed one (docs/successors: a source checkout's)")
+    names = args.summaries or [f"docs/successors/{p.name}" for p in paths]     # as from the checkout's root
+    print(text([summary.read(path) for path in paths], names))
+    return 0
+
+
 def _history(args):
     from .history import draw
     check_numbers(args)
@@ -181,7 +198,8 @@ def main(argv=None):
     args = _parser().parse_args(argv)
     try:
         return {"reduce": _reduce, "plot": _plot, "report": _report, "export": _export,
-                "compare": _compare, "paper": _paper, "history": _history}[args.command](args)
+                "compare": _compare, "paper": _paper, "successors": _successors,
+                "history": _history}[args.command](args)
     except BrokenPipeError:
         raise   # the reader of stdout went away: not a file error; __main__ ends quietly
     except (CatalogError, summary.SummaryError, ValueError, OSError) as err:

@@ -113,6 +113,7 @@ QUICK = {
                                    "test_the_correlation_length_recovers_the_scale_of_exponential_draws",
                                    "test_a_hand_built_sequence_gives_its_classes"],
     "test_slow_slip.py": ["test_the_table_is_the_rows_whatever_the_chunks"],
+    "test_successors.py": ["test_the_regimes_name_a_point_that_breaks_them"],
 }
 NOT_QUICK = {   # test files with no test in the quick tier, and why
     "test_sequences.py": "every test needs a serial catalog and a full-chain reference (10 s and more)",
