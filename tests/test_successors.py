@@ -120,7 +120,7 @@ def test_slow_slip_counts_are_every_points(committed):
     s["points/numbers/afterslip_share"][i] = (0.5, 0.4, 0.6)
     s["points/numbers/afterslip_ratio"][i] = (0.125, 0.1, 0.15)
     rows = rows_of(successors.text(summaries, names), successors.PAPERS[2].reference)
-    main = below = below_pre = above = above_pre = after = points = with_main = 0
+    main = below = below_pre = above = above_pre = after = points = with_main = with_after = 0
     for s_, name in zip(summaries, names):
         if "points/numbers/n_main" not in s_:
             continue
@@ -132,6 +132,7 @@ def test_slow_slip_counts_are_every_points(committed):
             with_main += 1
             main += n
             after += n * s_["points/numbers/afterslip_share"][p][0]
+            with_after += s_["points/numbers/afterslip_share"][p][0] > 0
             stiff = 1 + 2 * s_["points/l"][p] ** 2
             if s_["points/b"][p] < stiff:
                 below, below_pre = below + n, below_pre + n * share
@@ -143,7 +144,8 @@ def test_slow_slip_counts_are_every_points(committed):
         rows["precursory nucleation"]
     assert f"b above it: {above_pre:.0f} of {above:.0f} mainshocks" in rows["precursory nucleation"]
     n_main = s["points/numbers/n_main"][i][0]
-    assert rows["afterslip"].startswith(f"afterslip after {after:.0f} of {main:.0f} mainshocks, at 3 of {with_main}")
+    assert rows["afterslip"].startswith(f"afterslip after {after:.0f} of {main:.0f} mainshocks, at {with_after} of "
+                                      f"{with_main}")
     assert (f"0.5 [0.4, 0.6] of {n_main:.0f}, its slip 0.125 of theirs (N = 100, l = 12, nu = 0.0001, a = 3, b = 15, "
             "slow_slip_l12_nu1e-4)") in rows["afterslip"]
     assert rows["silent earthquakes"] == (
