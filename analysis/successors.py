@@ -7,11 +7,12 @@ written in its statistic's module (docs/successors.md).
 
 A claim of the first two papers (PAPERS) reads the one summary with the most distinct values of the parameters it
 runs over among its points that match (the first of equals: SUMMARIES is the committed ones' order), as the seed's
-claims do, and only a summary that holds the numbers it needs (one reduced before their statistic does not). The slow-slip claims read every point of every
-summary given that holds the slow-slip numbers: the paper's claim is that varying a few parameters gives every
-kind. Numbers the summary holds are printed with its intervals; the few computed here from its per-stretch tables
-(each class's share of large events, the widest zone's dependence on magnitude) get percentile intervals from
-paper.RESAMPLES resamples of the same units, seed 0. The nucleation section ends with a table of every point.
+claims do, and only a summary that holds the numbers it needs (one reduced before their statistic does not). The
+slow-slip claims read every point of every summary given that holds the slow-slip numbers: the paper's claim is
+that varying a few parameters gives every kind. Numbers the summary holds are printed with its intervals; the few
+computed here from its per-stretch tables (each class's share of large events, the widest zone's dependence on
+magnitude) get percentile intervals from paper.RESAMPLES resamples of the same units, seed 0. The nucleation section
+ends with a table of every point.
 """
 from dataclasses import dataclass
 from pathlib import Path
