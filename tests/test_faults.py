@@ -386,11 +386,12 @@ def test_signal_during_kernel_compilation_is_acknowledged_at_once(small, tmp_pat
 
 def test_kernel_calls_paused_in_the_middle_of_events_give_the_same_catalog(small, tmp_path):
     """Kernel calls of 1000 block-steps (worker.MIN_BUDGET) from a task's first call on, and
-    poll_seconds so short that they stay about a millisecond long: calls end inside an event more often
-    than there are events (the run counts them), and the catalog is the one of `small`, whose calls (of
-    250k block-steps at first) end between events."""
+    poll_seconds so short (1e-5) that they stay at that budget on any machine: calls end inside an event more
+    often than there are events (the run counts them), and the catalog is the one of `small`, whose calls (of
+    250k block-steps at first) end between events. (At poll_seconds = 1e-3 the budget grew to a millisecond's
+    work, and on a fast machine the pauses fell below the bound: 117 on 2026-12-04.)"""
     d, cfg = small
-    fast = ["--set", "run.poll_seconds=0.001"]
+    fast = ["--set", "run.poll_seconds=1e-5"]
     out = tmp_path / "paused.h5"
     count = tmp_path / "pauses.txt"
     res = injected(f"inject.count_pauses({str(count)!r}, first_budget=1000)", "run", cfg, "-o", out, *fast)
