@@ -53,7 +53,7 @@ MUTATIONS = (
              "deg = (1 if i > 0 else 0) + (1 if i < n - 1 else 0)", "deg = 2",
              ("tests/test_sequences.py",),
              "free ends treated as interior blocks in the force update after an event"),
-    Mutation("kernel-mirror-right-end", "ensemble/model/geometry.py",
+    Mutation("kernel-mirror-right-end", "ensemble/model/geometry/chain.py",
              "return i + 1 if i < n - 1 else i\n", "return i + 1 if i < n - 1 else i - 1\n",
              ("tests/test_physics.py", "tests/test_sequences.py"),
              "a mirror neighbour (u_{N} = u_{N-2}) at the right end instead of a free end"),

@@ -13,7 +13,7 @@
     creep.py        quasi-static creep, the third scene beside rest and inertial events
     undo.py         the undo log of the event in progress: the between-events state while an event is paused
     history.py      event histories: snapshots of an event's velocity and slip while it runs (output.history)
-    geometry.py     the chain's geometry and the spring force on one block
+    geometry/       the geometries, one file each (today the chain), and the calls through which the kernels use one
     params.py       the kernels' parameters as one record, passed from the runner to the innermost step
     workspace.py    the work arrays shared by the kernels (their columns named), and the codes they return
     laws/           the friction laws, one file each, and the calls through which the kernels use a law

@@ -32,7 +32,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .geometry import left, right
+from .geometry.chain import left, right
 from .laws import (creep_state, creep_weakening, creeps, friction, friction_slopes, onset_delay, rest_state, state_rate,
                    threshold)
 from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set

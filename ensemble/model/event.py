@@ -38,7 +38,7 @@ import numpy as np
 
 from .control import accepted, next_step_size, record, retry_size
 from .creep import possible, run_of, slow_enough
-from .geometry import left, right
+from .geometry.chain import left, right
 from .laws import loader_moves, onset_delay, rest_state, rk4_unstable, stiff_limit
 from .methods import adaptive, take_step
 from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set

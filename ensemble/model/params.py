@@ -7,9 +7,9 @@ ensemble.integrators.kernel_params builds it from the config.
 """
 from collections import namedtuple
 
-_Fields = namedtuple("KernelParams", "l2 nu law method dt rtol atol max_step max_duration max_steps creep_tol")
+_Fields = namedtuple("KernelParams", "l2 nu geom law method dt rtol atol max_step max_duration max_steps creep_tol")
 _INTEGERS = ("max_steps",)
-_RECORDS = ("law", "method")     # records of their own classes (below); the others are float64
+_RECORDS = ("geom", "law", "method")     # records of their own classes (below); the others are float64
 
 
 class KernelParams(_Fields):
@@ -17,6 +17,9 @@ class KernelParams(_Fields):
 
     l2            l^2, the stiffness of the springs between blocks relative to the driver spring
     nu            loading velocity of the driver plate
+    geom          the geometry's record, a namedtuple of that geometry's class (model/geometry/): the kernels are
+                  compiled once per geometry, and each call of a geometry function resolves to it (the chain's
+                  holds l2 too: the kernels not yet moved to the geometry read p.l2)
     law           the friction law's parameters, a namedtuple of that law's class (model/laws/): the
                   kernels are compiled once per law, and each call of a law function resolves to it
     method        the integrator's record (model/methods.py, MethodRecord: index, adaptive,

@@ -26,7 +26,7 @@ from typing import NamedTuple
 import numba as nb
 import numpy as np
 
-from .geometry import left, right, spring_force
+from .geometry import spring_force
 from .laws import friction, has_state, implicit_state, loader_moves, state_rate
 from .workspace import (ARK_A, ARK_G, ARK_V, F0, K1V, KP, KV, KY, P, P0, PS, SP, SV, SY, V, V0,
                         VS, Y, Y0, YS)
@@ -58,8 +58,7 @@ def stage_rates(W, act, na, n, tau, p, yrest, with_state=True):
         psi = W[i, PS]
         phi = friction(p.law, v, psi)
         W[i, KY] = v
-        W[i, KV] = spring_force(W[i, F0], tau, nu, p.l2, W[left(i), YS], W[i, YS],
-                                W[right(i, n), YS]) - phi
+        W[i, KV] = spring_force(p.geom, W, YS, i, n, W[i, F0], tau, nu) - phi
         if with_state and has_state(p.law):
             W[i, KP] = state_rate(p.law, v, psi)
         if v > 0.0:

@@ -9,7 +9,8 @@ for an onset.
 """
 import numba as nb
 
-from .geometry import left, right, spring_force
+from .geometry import spring_force
+from .geometry.chain import left, right, spring_force_of
 from .laws import friction, loader_moves, rest_state, threshold
 from .workspace import F0, HD0, HD1, K1V, P, SLIDING, TR, V, V0, Y, Y0
 
@@ -46,7 +47,7 @@ def rest_psi(W, j, tau, p):
 @nb.njit(cache=True)
 def force_now(W, n, j, tau, p):
     """Force on block j at local time tau, with the slips of the blocks as they are now."""
-    return spring_force(W[j, F0], tau, event_nu(p), p.l2, W[left(j), Y], W[j, Y], W[right(j, n), Y])
+    return spring_force(p.geom, W, Y, j, n, W[j, F0], tau, event_nu(p))
 
 
 @nb.njit(cache=True)
@@ -90,8 +91,7 @@ def loading_cut(x_cut, who, kind, t_far, far, tau, h):
 @nb.njit(cache=True, inline="always")
 def velocity_slopes(W, n, i, tau, h, p):
     """Slopes, per unit fraction of the step, of sliding block i's velocity at the step's ends."""
-    a_end = spring_force(W[i, F0], tau + h, event_nu(p), p.l2, W[left(i), Y], W[i, Y],
-                         W[right(i, n), Y]) - friction(p.law, W[i, V], W[i, P])
+    a_end = spring_force(p.geom, W, Y, i, n, W[i, F0], tau + h, event_nu(p)) - friction(p.law, W[i, V], W[i, P])
     return h * W[i, K1V], h * a_end
 
 
@@ -132,4 +132,4 @@ def _excess(W, flag, n, j, tau, h, x, p):
     s = tau + x * h
     yl = _slip_at(W, flag, left(j), x)
     yr = _slip_at(W, flag, right(j, n), x)
-    return spring_force(W[j, F0], s, event_nu(p), p.l2, yl, W[j, Y], yr) - threshold(p.law, rest_psi(W, j, s, p))
+    return spring_force_of(W[j, F0], s, event_nu(p), p.l2, yl, W[j, Y], yr) - threshold(p.law, rest_psi(W, j, s, p))
