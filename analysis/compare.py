@@ -69,7 +69,7 @@ def compare_point(per_task, params, rows, opt):
             "size_edges": log_bins(n_blocks), "size_density": size[0], "size_lo": size[1], "size_hi": size[2],
             "mu_density": mu[0], "mu_lo": mu[1], "mu_hi": mu[2],
             "T": result["sums"]["T_n"], "method": result["method"], "units": result["units"],
-            "fit_share": sizes[opt.n_min:opt.n_large].sum() / max(sizes.sum(), 1)}
+            "fit_share": sizes[opt.n_min:opt.n_large].sum() / max(sizes.sum(), 1), "n_blocks": n_blocks}
 
 
 def label(law, params):

@@ -28,10 +28,17 @@ def _legend(ax):
     ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
 
 
+def _chains(points):
+    """' at N = 800' (the points' chain length), or ' at N = 400-1600'."""
+    sizes = sorted({int(p["n_blocks"]) for p in points})
+    return f" at N = {sizes[0]}" if len(sizes) == 1 else f" at N = {sizes[0]}-{sizes[-1]}"
+
+
 def figures(points, opt, out_dir, mu_edges):
     """size.png, magnitude.png and recurrence.png of the points; mu_edges: the magnitude bins of their
     R(mu) (the options' mu_edges, passed in)."""
     colors = _colors(len(points))
+    at = _chains(points)
 
     fig, ax = plt.subplots(figsize=(9.6, 4.4))
     for p, color in zip(points, colors):
@@ -46,7 +53,7 @@ def figures(points, opt, out_dir, mu_edges):
     ax.axvline(opt.n_large, color="0.5", lw=0.8, ls="--")
     ax.set_ylim(bottom=min(p["size_density"][p["size_density"] > 0].min() for p in points) / 3)
     ax.set(xscale="log", yscale="log", xlabel="blocks slipped in an event, n", ylabel="R(log10 n)",
-           title=f"rupture length (dotted: power law fitted below n = {opt.n_large})")
+           title=f"rupture length{at} (dotted: power law fitted below n = {opt.n_large})")
     _legend(ax)
     fig.tight_layout()
     save(fig, os.path.join(out_dir, "size.png"))
@@ -55,9 +62,12 @@ def figures(points, opt, out_dir, mu_edges):
     for p, color in zip(points, colors):
         band(ax, centers(mu_edges), p["mu_density"], p["mu_lo"], p["mu_hi"], _with_events(p), color, log=True)
     lowest = min(p["mu_density"][p["mu_density"] > 0].min() for p in points)
-    ax.set_ylim(bottom=lowest / 3)      # a lower bound of 0 would stretch the axis to 1e-300
+    highest = max(np.nanmax(p["mu_density"]) for p in points)
+    # (a lower bound of 0 would stretch the axis to 1e-300; the top is set too: autoscaling after a bound cut
+    # the Carlson-Langer curves' small-mu end)
+    ax.set_ylim(bottom=lowest / 3, top=highest * 3)
     ax.set(yscale="log", xlabel="mu = log10(total slip) (each law's own scale)", ylabel="R(mu)",
-           title="magnitude distribution")
+           title=f"magnitude distribution{at}")
     _legend(ax)
     fig.tight_layout()
     save(fig, os.path.join(out_dir, "magnitude.png"))
@@ -72,7 +82,7 @@ def figures(points, opt, out_dir, mu_edges):
                     label=f"{p['label']} ({len(T)} recurrences, CV {p['numbers'][6]:.2f})")
     ax.plot(x, np.log(2.0) * 2.0 ** -x, "k:", lw=1, label="Poisson (exponential)")
     ax.set(xlabel=f"T / median(T), large events (n >= {opt.n_large}) within {opt.window} blocks",
-           ylabel="density", title="local recurrence time")
+           ylabel="density", title=f"local recurrence time{at}")
     _legend(ax)
     fig.tight_layout()
     save(fig, os.path.join(out_dir, "recurrence.png"))

@@ -210,14 +210,18 @@ def _matching(s, claim):
     laws = summary.point_laws(s)
     rows = [i for i in range(len(s["points/N"]))
             if laws[i] == PAPER_LAW and all(s[f"points/{k}"][i] in values for k, values in claim.where.items())]
-    return rows, len({float(s[f"points/{claim.vary}"][i]) for i in rows})
+    vary = (claim.vary,) if isinstance(claim.vary, str) else claim.vary
+    return rows, len({tuple(float(s[f"points/{k}"][i]) for k in vary) for i in rows})
 
 
 def points_for(claim, summaries):
-    """(summary, its points) that test `claim`: the summary with the most values of claim.vary
-    among its matching points (the first of equals), or None if none has claim.least."""
+    """(summary, its points) that test `claim`: the summary with the most values of claim.vary (one parameter, or
+    a tuple of them, distinct together) among its matching points (the first of equals), or None if none has
+    claim.least. A claim with `needs` (numbers by name) reads only a summary that holds them all."""
     best = None
     for s in summaries:
+        if not all(f"points/numbers/{n}" in s for n in getattr(claim, "needs", ())):
+            continue
         rows, values = _matching(s, claim)
         if values >= claim.least and (best is None or values > best[2]):
             best = (s, rows, values)

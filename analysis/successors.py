@@ -21,7 +21,7 @@ from typing import Callable
 import numpy as np
 
 from . import stats, summary
-from .paper import PAPER_LAW, RESAMPLES, WORDS, fmt, number, transients, with_interval
+from .paper import PAPER_LAW, RESAMPLES, WORDS, fmt, number, points_for, transients, with_interval
 from .reduce import PARAMS
 from .report import level_text, partial_text, point_label, size_text
 
@@ -398,26 +398,6 @@ PAPERS = (
 
 def holds(s, names):
     return all(f"points/numbers/{n}" in s for n in names)
-
-
-def _matching(s, claim):
-    laws = summary.point_laws(s)
-    rows = [i for i in range(len(s["points/N"]))
-            if laws[i] == PAPER_LAW and all(s[f"points/{k}"][i] in v for k, v in claim.where.items())]
-    return rows, len({tuple(float(s[f"points/{k}"][i]) for k in claim.vary) for i in rows})
-
-
-def points_for(claim, summaries):
-    """(summary, its points) that test `claim`: of the summaries holding its numbers, the one with the most values
-    of claim.vary (distinct together) among its matching points (the first of equals); None if none has claim.least."""
-    best = None
-    for s in summaries:
-        if not holds(s, claim.needs):
-            continue
-        rows, values = _matching(s, claim)
-        if values >= claim.least and (best is None or values > best[2]):
-            best = (s, rows, values)
-    return None if best is None else best[:2]
 
 
 def _needs(claim):
