@@ -38,7 +38,7 @@ import numpy as np
 
 from .control import accepted, next_step_size, record, retry_size
 from .creep import possible, run_of, slow_enough
-from .geometry.chain import left, right
+from .geometry import along, around, drop_stiffness, neighbours, spring_energy, stiffness, coupling
 from .laws import loader_moves, onset_delay, rest_state, rk4_unstable, stiff_limit
 from .methods import adaptive, take_step
 from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
@@ -70,15 +70,18 @@ RK4_STABILITY = 2.785
 
 
 @nb.njit(cache=True)
-def _adjacent_to_active(flag, n, j):
-    return flag[left(j)] == SLIDING or flag[right(j, n)] == SLIDING
+def _adjacent_to_active(flag, n, j, p):
+    for k in neighbours(p.geom, j, n):
+        if flag[k] == SLIDING:
+            return True
+    return False
 
 
 @nb.njit(cache=True)
 def _loading_onset(W, flag, n, j, tau, p):
     """Local time at which resting block j starts by loading alone (inf if it is watched, or if
     the loader stands still during events)."""
-    if not loader_moves(p.law) or flag[j] == SLIDING or _adjacent_to_active(flag, n, j):
+    if not loader_moves(p.law) or flag[j] == SLIDING or _adjacent_to_active(flag, n, j, p):
         return np.inf
     return tau + onset_delay(p.law, force_now(W, n, j, tau, p), rest_psi(W, j, tau, p), p.nu)
 
@@ -114,7 +117,7 @@ def _watch(W, since, tree, event, undo, t0, p, j):
 def _start(arrays, na, nt, t0, p, j, tau, yrest):
     """Block j starts to slide at local time tau; returns (na, nt, yrest)."""
     W, flag = arrays.W, arrays.flag
-    for k in (left(j), j, right(j, W.shape[0])):
+    for k in around(p.geom, j, W.shape[0]):
         _watch(W, arrays.since, arrays.tree, arrays.event, arrays.undo, t0, p, k)
     if flag[j] == STOPPED:
         yrest -= W[j, Y]
@@ -344,7 +347,7 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
                     x_cut, who, kind = x, i, STICK
         for k in range(na):
             i = act[k]
-            for j in (left(i), right(i, n)):
+            for j in neighbours(p.geom, i, n):
                 if j != i and above_threshold(W, flag, n, j, tau + h, p):
                     x = locate(ONSET_NEIGHBOUR, W, flag, n, j, tau, h, 0.0, 0.0, 0.0, 0.0, p)
                     if x < x_cut:
@@ -409,7 +412,7 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
         # have crossed its threshold in the redo).
         for k in range(m + nstuck):
             i = act[k] if k < m else stuck[k - m]
-            for j in (left(i), right(i, n)):
+            for j in neighbours(p.geom, i, n):
                 if j != i and above_threshold(W, flag, n, j, tau, p):
                     na, nt, yrest = _start(arrays, na, nt, t0, p, j, tau, yrest)
         # -- the hand-back: sliding blocks slow enough to creep stop here and creep from here on
@@ -472,7 +475,7 @@ def _reschedule(W, flag, stuck, since, tree, nstuck, n, t0, tau, p):
     the earliest such onset."""
     for k in range(nstuck):
         i = stuck[k]
-        for j in (left(i), i, right(i, n)):
+        for j in around(p.geom, i, n):
             tree_set(tree, j, t0[0] + (t0[1] + _loading_onset(W, flag, n, j, tau, p)))
     return _far_onset(W, flag, n, since, tree, t0, tau, p)
 
@@ -495,16 +498,11 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, p, work, slip_t
         if y > 0.0:
             slip += y
             nslip += 1
-            first = min(first, i)
-            last = max(last, i)
-            outside = (1 if i > 0 and not W[i - 1, Y] > 0.0 else 0) + (1 if i < n - 1 and not W[i + 1, Y] > 0.0 else 0)
-            drop += y * (1.0 + p.l2 * outside)
+            first = min(first, along(p.geom, i))
+            last = max(last, along(p.geom, i))
+            drop += y * drop_stiffness(p.geom, W, i, n)
         # the non-negative terms (own and spring energies) count alike in both sums
-        stored = 0.5 * y * y
-        if i + 1 < n:
-            stored += 0.5 * p.l2 * (W[i + 1, Y] - y) ** 2
-        if i - 1 >= 0 and flag[i - 1] == UNTOUCHED:
-            stored += 0.5 * p.l2 * (y - W[i - 1, Y]) ** 2
+        stored = spring_energy(p.geom, W, flag, i, n, 0.5 * y * y, y)
         e_change += stored - y * W[i, F0]
         gross += stored + abs(y * W[i, F0])
     elastic = e_change     # the terms apart (workspace.py): D_ELASTIC, D_LOAD_WORK
@@ -537,12 +535,10 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, p, work, slip_t
     for k in range(nt):
         i = touched[k]
         y = W[i, Y]
-        deg = (1 if i > 0 else 0) + (1 if i < n - 1 else 0)
-        W[i, F0] -= (1.0 + p.l2 * deg) * y
-        if i > 0:
-            W[i - 1, F0] += p.l2 * y
-        if i < n - 1:
-            W[i + 1, F0] += p.l2 * y
+        W[i, F0] -= stiffness(p.geom, i, n) * y
+        for j in neighbours(p.geom, i, n):
+            if j != i:
+                W[j, F0] += coupling(p.geom, i, j) * y
     for k in range(nt):
         i = touched[k]
         W[i, Y] = 0.0
@@ -552,5 +548,5 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, p, work, slip_t
         flag[i] = UNTOUCHED
     for k in range(nt):
         i = touched[k]
-        for j in (left(i), i, right(i, n)):
+        for j in around(p.geom, i, n):
             tree_set(tree, j, onset_key(W, since, j, p))

@@ -9,8 +9,7 @@ for an onset.
 """
 import numba as nb
 
-from .geometry import spring_force
-from .geometry.chain import left, right, spring_force_of
+from .geometry import spring_force, spring_force_by
 from .laws import friction, loader_moves, rest_state, threshold
 from .workspace import F0, HD0, HD1, K1V, P, SLIDING, TR, V, V0, Y, Y0
 
@@ -130,6 +129,5 @@ def _slip_at(W, flag, j, x):
 def _excess(W, flag, n, j, tau, h, x, p):
     """Force above the static threshold of resting block j at fraction x of the step."""
     s = tau + x * h
-    yl = _slip_at(W, flag, left(j), x)
-    yr = _slip_at(W, flag, right(j, n), x)
-    return spring_force_of(W[j, F0], s, event_nu(p), p.l2, yl, W[j, Y], yr) - threshold(p.law, rest_psi(W, j, s, p))
+    force = spring_force_by(p.geom, _slip_at, W, flag, x, j, n, W[j, F0], s, event_nu(p))
+    return force - threshold(p.law, rest_psi(W, j, s, p))

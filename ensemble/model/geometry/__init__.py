@@ -8,9 +8,12 @@ function (numba.extending.overload, inlined), as the friction laws' calls do (la
 the geometry at run time, and a geometry's kernels are its own (the chain's arithmetic is not a special case of
 another's: docs/design/geometry.md measures what that would cost).
 
-Today the chain is the one geometry, and the kernels' steps call it through here; the event's and the creep
+Today the chain is the one geometry; the kernels' steps and the event's loops call it through here, the creep
 phase's neighbour loops still import the chain's left and right from geometry/chain.py until they go through the
 geometry too (docs/design/geometry.md, the order of work).
+
+A geometry's blocks are numbered 0..n-1; a missing neighbour (a free edge) is the block itself, so loops over
+`neighbours` skip j == i and a spring to a missing neighbour is never stretched (the ghost u_{-1} = u_0).
 """
 import importlib
 import pkgutil
@@ -33,6 +36,18 @@ class Geometry:
     spring_force: object  # (g, W, col, i, n, F0, tau, nu) -> the force on block i at local time tau of an event,
                           # with the slips since its start in column col of W (n blocks), F0 the block's force at
                           # the start (c-free frame), nu the loader's velocity during the event
+    spring_force_by: object   # (g, slip, W, flag, x, i, n, F0, tau, nu) -> the same with the neighbours' slips
+                              # slip(W, flag, j, x) and the block's own W[i, Y] (a resting block's)
+    neighbours: object    # (g, i, n) -> tuple of block i's neighbours, in a fixed order (i where one is missing)
+    around: object        # (g, i, n) -> tuple of block i and its neighbours (the blocks whose onset i's slip moves)
+    stiffness: object     # (g, i, n) -> K_ii: the loader's spring 1 and the springs to i's neighbours
+    coupling: object      # (g, i, j) -> the spring between neighbours i and j (-K_ij)
+    along: object         # (g, i) -> block i's position along strike (an event's first and last block)
+    drop_stiffness: object    # (g, W, i, n) -> 1 and the springs from block i to neighbours that did not slip
+                              # (W[j, Y] not > 0): the force an event's slip of i takes off i alone
+    spring_energy: object     # (g, W, flag, i, n, stored, y) -> stored plus the energy of block i's springs,
+                              # each spring counted once over an event's touched blocks (a spring to a touched
+                              # neighbour counted at one of its two ends, flag UNTOUCHED the others)
 
     def kernel_params(self, model):
         """The geometry's record for the kernels from a config's model section."""
@@ -59,11 +74,26 @@ def get(name):
     return GEOMETRIES[name]
 
 
-def spring_force(g, W, col, i, n, F0, tau, nu):
-    """The force on block i (Geometry.spring_force), resolved to the geometry of the record g."""
+def _dispatch(name, args):
+    """The call `name` of the geometry of the record g (the first argument): a stub for the kernels, resolved
+    at compile time by numba.extending.overload to the geometry's own function (inlined)."""
+    src = (f"def {name}({args}):\n    pass\n"
+           f"def _impl({args}):\n    fn = _BY_PARAMS[g.instance_class].{name}\n"
+           f"    return lambda {args}: fn({args})\n")
+    scope = {"_BY_PARAMS": _BY_PARAMS}
+    exec(src, scope)
+    stub = scope[name]
+    stub.__doc__ = f"Geometry.{name}, resolved to the geometry of the record g."
+    overload(stub, inline="always")(scope["_impl"])
+    return stub
 
 
-@overload(spring_force, inline="always")
-def _spring_force(g, W, col, i, n, F0, tau, nu):
-    fn = _BY_PARAMS[g.instance_class].spring_force
-    return lambda g, W, col, i, n, F0, tau, nu: fn(g, W, col, i, n, F0, tau, nu)
+spring_force = _dispatch("spring_force", "g, W, col, i, n, F0, tau, nu")
+spring_force_by = _dispatch("spring_force_by", "g, slip, W, flag, x, i, n, F0, tau, nu")
+neighbours = _dispatch("neighbours", "g, i, n")
+around = _dispatch("around", "g, i, n")
+stiffness = _dispatch("stiffness", "g, i, n")
+coupling = _dispatch("coupling", "g, i, j")
+along = _dispatch("along", "g, i")
+drop_stiffness = _dispatch("drop_stiffness", "g, W, i, n")
+spring_energy = _dispatch("spring_energy", "g, W, flag, i, n, stored, y")
