@@ -70,7 +70,7 @@ def simulate(arrays, clock, p, n_events, budget, out_t, out_epicenter, out_diag)
             return NONFINITE, 0
         build_schedule(W, since, tree, p)
         if possible(p, n):
-            off_schedule(arrays, n)
+            off_schedule(arrays, n, p)
     onset = np.empty(2)
     k = 0
     spent = 0

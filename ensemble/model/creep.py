@@ -32,7 +32,8 @@ import math
 import numba as nb
 import numpy as np
 
-from .geometry.chain import left, right
+from .geometry import (CREEPING, SLIDING_NOW, around, cluster, coupling, creep_force, creep_load, creep_solve,
+                       fastest_creep, max_stiffness, neighbours, stable, stiffness)
 from .laws import (creep_state, creep_weakening, creeps, friction, friction_slopes, onset_delay, rest_state, state_rate,
                    threshold)
 from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
@@ -42,7 +43,7 @@ from .workspace import (CR_DIAG, CR_DPSI, CR_DU, CR_EP, CR_H, CR_HB, CR_LEFT, CR
                         E_NBLOCKS, E_RUNNING, E_RUPTURED, E_SERIAL, E_SLIP, E_START_HI, E_START_LO, E_STATE, E_STOPPED,
                         E_VMAX, E_WORK, F0, P, D_BLOCK_STEPS, D_DURATION, D_ELASTIC, D_ENDING, D_ENERGY_SCALE, D_FIRST,
                         D_KIND, D_LAST, D_LOAD_WORK, D_NSLIP, D_RESIDUAL, D_SLIP, D_STRESS_DROP, D_T_WIDEST,
-                        D_T_SPREAD, D_VMAX, D_WORK, EV_NT, KIND_CREEP, PAUSED, SLIDING, V)
+                        D_T_SPREAD, D_VMAX, D_WORK, EV_NT, KIND_CREEP, PAUSED, V)
 
 # what continue_creep returns besides PAUSED
 REACHED = 10      # creep is integrated up to the onset of the schedule's next block (or nothing creeps)
@@ -55,12 +56,6 @@ _GROW = 5.0       # the step grows at most fivefold, ...
 _SHRINK = 0.2     # ... and shrinks at most fivefold, per step
 
 
-@nb.njit(cache=True, inline="always")
-def stiffness(i, n, l2):
-    """K_ii, the diagonal of the chain's stiffness: the loader's spring and one or two of l^2."""
-    return 1.0 + l2 * ((1.0 if i > 0 else 0.0) + (1.0 if i < n - 1 else 0.0))
-
-
 @nb.njit(cache=True)
 def possible(p, n):
     """Some block of this chain can creep under these parameters: its law creeps, and the stiffest
@@ -70,14 +65,14 @@ def possible(p, n):
     block alone), and the kernels run exactly as without a creep phase."""
     if not creeps(p.law):
         return False
-    k_max = stiffness(min(1, n - 1), n, p.l2)
+    k_max = max_stiffness(p.geom, n)
     return creep_weakening(p.law, 0.0, 0.0) < k_max
 
 
 @nb.njit(cache=True)
 def alone_creeps(arrays, n, p, j):
     """Block j, starting from rest with its state, may creep alone: stiffer than its weakening."""
-    return stiffness(j, n, p.l2) > creep_weakening(p.law, 0.0, arrays.W[j, P])
+    return stiffness(p.geom, j, n) > creep_weakening(p.law, 0.0, arrays.W[j, P])
 
 
 @nb.njit(cache=True)
@@ -86,7 +81,7 @@ def loaded_past_threshold(p, n, psi):
     over an inertial period: it starts to move (creep). Otherwise it is on its threshold only for an
     instant (an event's block that stuck on it, its threshold then outrunning the loader), and the
     kernels treat it as they always have: an event, in which it stays pressed without slipping."""
-    dt = 2.0 * math.pi / math.sqrt(stiffness(min(1, n - 1), n, p.l2))
+    dt = 2.0 * math.pi / math.sqrt(max_stiffness(p.geom, n))
     return p.nu * dt > threshold(p.law, rest_state(p.law, psi, dt)) - threshold(p.law, psi)
 
 
@@ -96,56 +91,28 @@ def creeping(C, i):
 
 
 @nb.njit(cache=True)
-def run_of(C, n, j):
-    """(lo, hi): the run of creeping blocks around block j, j counted as creeping."""
-    lo = j
-    while lo > 0 and creeping(C, lo - 1):
-        lo -= 1
-    hi = j
-    while hi < n - 1 and creeping(C, hi + 1):
-        hi += 1
-    return lo, hi
+def cluster_of(arrays, n, p, j):
+    """The number m of blocks in the cluster of creeping blocks around block j (j counted as creeping),
+    arrays.cluster[:m] holding them in increasing order."""
+    m = cluster(p.geom, arrays.creep, arrays.flag, CREEPING, n, j, arrays.cluster, arrays.seen)
+    forget(arrays, m)
+    return m
 
 
 @nb.njit(cache=True)
-def stable(C, n, l2, lo, hi):
-    """The cluster lo..hi may creep: K_C - diag(C[lo..hi, CR_W]), its stiffness less each block's
-    weakening, is positive definite (every pivot of its tridiagonal LDL^T factorisation positive)."""
-    pivot = 1.0
-    for i in range(lo, hi + 1):
-        d = stiffness(i, n, l2) - C[i, CR_W]
-        if i > lo:
-            d -= l2 * l2 / pivot
-        if not d > 0.0:
-            return False
-        pivot = d
-    return True
+def forget(arrays, m):
+    """Clear the marks a cluster left in arrays.seen (arrays.cluster[:m])."""
+    for k in range(m):
+        arrays.seen[arrays.cluster[k]] = 0
 
 
 @nb.njit(cache=True)
-def fastest_creep(C, n, l2, nu, lo, hi):
-    """C[lo..hi, CR_RES] = (K_C - diag(max(CR_W, 0)))^-1 nu 1 for the stable cluster lo..hi: a bound of
-    the fastest creep it can sustain (docs/numerics.md: the creep velocities solve M v = nu - s with
-    M's diagonal no smaller and s >= 0, and such an M^-1 has positive entries). Thomas' algorithm,
-    the pivots in CR_DIAG."""
-    for i in range(lo, hi + 1):
-        d = stiffness(i, n, l2) - max(C[i, CR_W], 0.0)
-        r = nu
-        if i > lo:
-            m = -l2 / C[i - 1, CR_DIAG]
-            d += m * l2
-            r -= m * C[i - 1, CR_RES]
-        C[i, CR_DIAG] = d
-        C[i, CR_RES] = r
-    C[hi, CR_RES] /= C[hi, CR_DIAG]
-    for i in range(hi - 1, lo - 1, -1):
-        C[i, CR_RES] = (C[i, CR_RES] + l2 * C[i + 1, CR_RES]) / C[i, CR_DIAG]
-
-
-@nb.njit(cache=True)
-def _watched(C, n, j):
+def _watched(C, n, j, p):
     """Block j is creeping or beside a creeping block: off the onset schedule."""
-    return creeping(C, j) or creeping(C, left(j)) or creeping(C, right(j, n))
+    for k in around(p.geom, j, n):
+        if creeping(C, k):
+            return True
+    return False
 
 
 @nb.njit(cache=True)
@@ -164,28 +131,31 @@ def creeping_list(arrays, n):
 
 
 @nb.njit(cache=True, inline="always")
-def _first_visit(C, n, i, j):
+def _first_visit(C, n, p, i, j):
     """Resting block j beside creeping block i is met here first in a pass over the creeping blocks
-    in increasing order (a block between two creeping ones is met once)."""
+    in increasing order: i is its creeping neighbour of lowest index (a block between two creeping ones is met once)."""
     if j == i or creeping(C, j):
         return False
-    return j > i or j == 0 or not creeping(C, j - 1)
+    for q in neighbours(p.geom, j, n):
+        if q < i and q != j and creeping(C, q):
+            return False
+    return True
 
 
 @nb.njit(cache=True)
 def rekey(arrays, n, p, j):
     """Block j's onset key: inf while creep watches it, else its onset by loading alone."""
-    if _watched(arrays.creep, n, j):
+    if _watched(arrays.creep, n, j, p):
         tree_set(arrays.tree, j, np.inf)
     else:
         tree_set(arrays.tree, j, onset_key(arrays.W, arrays.since, j, p))
 
 
 @nb.njit(cache=True)
-def off_schedule(arrays, n):
+def off_schedule(arrays, n, p):
     """Creeping blocks and their neighbours off the onset schedule (after it was built anew)."""
     for j in range(n):
-        if _watched(arrays.creep, n, j):
+        if _watched(arrays.creep, n, j, p):
             tree_set(arrays.tree, j, np.inf)
 
 
@@ -210,20 +180,21 @@ def _new_episode(E, cs, t, j):
 @nb.njit(cache=True)
 def join(arrays, n, p, j, v0, t):
     """Block j starts to creep at time t (two floats; its F0 and P hold there) with velocity v0:
-    into the episode of a creeping neighbour (the left one first), or a new episode."""
+    into the episode of a creeping neighbour (the first in the geometry's order: the left one), or a new episode."""
     C, E, cs, W, since = arrays.creep, arrays.episodes, arrays.cstate, arrays.W, arrays.since
     if cs[CS_NCREEP] == 0.0:
         # a new creep phase: its first step from the state's own time scale
-        cs[CS_H] = p.creep_tol * math.exp(W[j, P]) + 2.0 * math.pi / math.sqrt(stiffness(min(1, n - 1), n, p.l2))
+        cs[CS_H] = p.creep_tol * math.exp(W[j, P]) + 2.0 * math.pi / math.sqrt(max_stiffness(p.geom, n))
     if cs[CS_NCREEP] == 0.0 or (t[0] - cs[CS_T_HI]) + (t[1] - cs[CS_T_LO]) > 0.0:
         # the creep's clock: never behind a creeping block's own time (the others step from theirs)
         cs[CS_T_HI] = t[0]
         cs[CS_T_LO] = t[1]
-    if j > 0 and creeping(C, j - 1):
-        slot = int(C[j - 1, CR_EP]) - 1
-    elif j < n - 1 and creeping(C, j + 1):
-        slot = int(C[j + 1, CR_EP]) - 1
-    else:
+    slot = -1
+    for k in neighbours(p.geom, j, n):
+        if k != j and creeping(C, k):
+            slot = int(C[k, CR_EP]) - 1
+            break
+    if slot < 0:
         slot = _new_episode(E, cs, t, j)
     C[j, CR_EP] = slot + 1
     C[j, CR_V] = v0
@@ -234,7 +205,7 @@ def join(arrays, n, p, j, v0, t):
         E[slot, E_NBLOCKS] += 1.0
     cs[CS_NCREEP] += 1.0
     cs[CS_DIRTY] = 1.0
-    for k in (left(j), j, right(j, n)):
+    for k in around(p.geom, j, n):
         if k != j and not creeping(C, k):
             materialize(W, since, k, t, p)      # a watched neighbour stays at the creep's time
         tree_set(arrays.tree, k, np.inf)
@@ -256,7 +227,7 @@ def leave(arrays, n, p, i, t, outcome):
         E[slot, E_END_HI] = t[0]
         E[slot, E_END_LO] = t[1]
         cs[CS_ENDED] += 1.0
-    for k in (left(i), i, right(i, n)):
+    for k in around(p.geom, i, n):
         rekey(arrays, n, p, k)
 
 
@@ -305,7 +276,6 @@ def _newton_from(arrays, n, p, m_c):
     slid at its creep velocities until integrator.max_duration."""
     C, W = arrays.creep, arrays.W
     lst = arrays.crept
-    l2 = p.l2
     # the rounding of the cluster's forces (~1e-14 of the largest) reaches every block through the
     # springs: the scale of the convergence test
     scale = 1.0
@@ -332,28 +302,18 @@ def _newton_from(arrays, n, p, m_c):
             h = C[i, CR_H]
             v = C[i, CR_VN]
             psi = C[i, CR_PSI]
-            du_l = C[i - 1, CR_DU] if i > 0 and creeping(C, i - 1) else 0.0
-            du_r = C[i + 1, CR_DU] if i < n - 1 and creeping(C, i + 1) else 0.0
-            force = W[i, F0] + p.nu * h - stiffness(i, n, l2) * C[i, CR_DU] + l2 * (du_l + du_r)
+            force = creep_force(p.geom, C, W, i, n, p.nu, h)
             f_v, f_psi = friction_slopes(p.law, v, psi)
-            d = -stiffness(i, n, l2) * h - f_v - f_psi * C[i, CR_DPSI]
             r = -(force - friction(p.law, v, psi))
             balanced = balanced and abs(r) <= 1e-14 * scale
-            if i > 0 and creeping(C, i - 1):
-                m = l2 * C[i - 1, CR_H] / C[i - 1, CR_DIAG]     # J[i, i-1] / pivot[i-1]
-                d -= m * l2 * h                                   # J[i-1, i] = l2 h_i
-                r -= m * C[i - 1, CR_RES]
-            if not d < 0.0:
-                return i
-            C[i, CR_DIAG] = d
+            C[i, CR_DIAG] = -stiffness(p.geom, i, n) * h - f_v - f_psi * C[i, CR_DPSI]
             C[i, CR_RES] = r
+        bad = creep_solve(p.geom, C, lst, m_c, n)
+        if bad >= 0:
+            return bad
         for k in range(m_c - 1, -1, -1):
             i = lst[k]
-            r = C[i, CR_RES]
-            if i < n - 1 and creeping(C, i + 1):
-                r -= l2 * C[i + 1, CR_H] * C[i + 1, CR_UPPER]
-            delta = r / C[i, CR_DIAG]
-            C[i, CR_UPPER] = delta          # the step of block i, read by block i - 1
+            delta = C[i, CR_UPPER]
             v = C[i, CR_VN] + delta
             C[i, CR_VN] = v
             # converged: the update is below 1e-12 of v, or below what the rounding of the forces
@@ -377,11 +337,7 @@ def _excess(W, C, since, n, p, j, t, h, x):
     h from time t (two floats): loading since its own time, and x of its creeping neighbours'
     slips over the step (backward Euler: linear in time)."""
     dt = (t[0] - since[j, 0]) + (t[1] - since[j, 1]) + x * h
-    slip = 0.0
-    for k in (left(j), right(j, n)):
-        if k != j and creeping(C, k):
-            slip += C[k, CR_DU]
-    return W[j, F0] + p.nu * dt + p.l2 * x * slip - threshold(p.law, rest_state(p.law, W[j, P], dt))
+    return W[j, F0] + p.nu * dt + creep_load(p.geom, C, j, n, x) - threshold(p.law, rest_state(p.law, W[j, P], dt))
 
 
 @nb.njit(cache=True)
@@ -434,7 +390,7 @@ def _error(arrays, n, p):
         g_start = _rate(p.law, C[i, CR_V], W[i, P])
         dv = C[i, CR_VN] - C[i, CR_V]
         w = friction_slopes(p.law, C[i, CR_VN], C[i, CR_PSI])[1]
-        e = 0.5 * C[i, CR_H] * (abs(g_end - g_start) + stiffness(i, n, p.l2) * abs(dv) / w) / p.creep_tol
+        e = 0.5 * C[i, CR_H] * (abs(g_end - g_start) + stiffness(p.geom, i, n) * abs(dv) / w) / p.creep_tol
         err = max(err, e)
     return err
 
@@ -450,21 +406,17 @@ def _commit(arrays, n, p, t_new):
     C, E, W, since = arrays.creep, arrays.episodes, arrays.W, arrays.since
     lst = arrays.crept
     m = creeping_list(arrays, n)
-    l2 = p.l2
     for k in range(m):
         i = lst[k]
-        h = C[i, CR_H]
-        du_l = C[i - 1, CR_DU] if i > 0 and creeping(C, i - 1) else 0.0
-        du_r = C[i + 1, CR_DU] if i < n - 1 and creeping(C, i + 1) else 0.0
-        C[i, CR_RES] = W[i, F0] + p.nu * h - stiffness(i, n, l2) * C[i, CR_DU] + l2 * (du_l + du_r)
+        C[i, CR_RES] = creep_force(p.geom, C, W, i, n, p.nu, C[i, CR_H])
     for k in range(m):
         i = lst[k]
-        for j in (left(i), right(i, n)):
-            if _first_visit(C, n, i, j):
+        for j in neighbours(p.geom, i, n):
+            if _first_visit(C, n, p, i, j):
                 materialize(W, since, j, t_new, p)
-                for q in (left(j), right(j, n)):
+                for q in neighbours(p.geom, j, n):
                     if q != j and creeping(C, q):
-                        W[j, F0] += l2 * C[q, CR_DU]
+                        W[j, F0] += coupling(p.geom, j, q) * C[q, CR_DU]
     for k in range(m):
         i = lst[k]
         force = W[i, F0]        # at the step's start
@@ -532,15 +484,16 @@ def _accelerating(arrays, n, h, inertial):
 
 
 @nb.njit(cache=True)
-def _leading(C, n, bad):
-    """The epicenter where a step's Newton failed at block `bad` (its run too soft to creep, at its fold): the
-    fastest block of the run at the step's start (the order of the tridiagonal sweep, which decides where a pivot
-    first turns non-negative, would put it at one end of every cluster); `bad` itself if none of it moves."""
+def _leading(arrays, n, p, bad):
+    """The epicenter where a step's Newton failed at block `bad` (its cluster too soft to creep, at its fold): the
+    fastest block of the cluster at the step's start (the order of the sweep, which decides where a pivot first
+    turns non-negative, would put it at one end of every cluster); `bad` itself if none of it moves."""
+    C = arrays.creep
     if not creeping(C, bad):
         return bad
-    lo, hi = run_of(C, n, bad)
     who = bad
-    for i in range(lo, hi + 1):
+    for k in range(cluster_of(arrays, n, p, bad)):
+        i = arrays.cluster[k]
         if C[i, CR_V] > C[who, CR_V]:
             who = i
     return who
@@ -556,7 +509,7 @@ def continue_creep(arrays, clock, n, p, budget):
     creep's time; PAUSED when the budget (block-steps, as events count them) ran out before a step.
     `clock` follows the creep's time."""
     C, cs, W, since, tree = arrays.creep, arrays.cstate, arrays.W, arrays.since, arrays.tree
-    inertial = 2.0 * math.pi / math.sqrt(stiffness(min(1, n - 1), n, p.l2))
+    inertial = 2.0 * math.pi / math.sqrt(max_stiffness(p.geom, n))
     t = np.empty(2)
     t_new = np.empty(2)
     used = 0
@@ -615,7 +568,7 @@ def continue_creep(arrays, clock, n, p, budget):
             h = max(h * max(_SHRINK, 0.9 / math.sqrt(err)), h * 0.25, inertial)
         if not solved:
             # no creep: the cluster became too soft where Newton failed
-            return HANDOVER, used, _leading(C, n, bad)
+            return HANDOVER, used, _leading(arrays, n, p, bad)
         # creep that accelerates on inertia's time scale is no longer quasi-static: an event
         who = _accelerating(arrays, n, h, inertial)
         if who >= 0:
@@ -637,8 +590,8 @@ def continue_creep(arrays, clock, n, p, budget):
         lst = arrays.crept
         for k in range(creeping_list(arrays, n)):
             i = lst[k]
-            for j in (left(i), right(i, n)):
-                if not _first_visit(C, n, i, j):
+            for j in neighbours(p.geom, i, n):
+                if not _first_visit(C, n, p, i, j):
                     continue
                 if C[j, CR_LEFT] != 0.0:
                     C[j, CR_LEFT] = 0.0     # stopped in this step: its onset is looked for from the next
@@ -660,7 +613,7 @@ def continue_creep(arrays, clock, n, p, budget):
                 solved, work, _, bad = _solve(arrays, n, p, t, h)
                 used += work
                 if not solved:
-                    return HANDOVER, used, _leading(C, n, bad)
+                    return HANDOVER, used, _leading(arrays, n, p, bad)
         if h > 0.0:
             t_new[0], t_new[1] = t[0], t[1]
             advance_clock(t_new, h)
@@ -671,12 +624,41 @@ def continue_creep(arrays, clock, n, p, budget):
             continue
         # -- a resting neighbour starts: it creeps with its cluster, or the cluster ruptures
         t[0], t[1] = cs[CS_T_HI], cs[CS_T_LO]
-        lo, hi = run_of(C, n, who)
-        for i in range(lo, hi + 1):
+        m = cluster_of(arrays, n, p, who)
+        for k in range(m):
+            i = arrays.cluster[k]
             C[i, CR_W] = creep_weakening(p.law, C[i, CR_V] if creeping(C, i) else 0.0, W[i, P])
-        if not stable(C, n, p.l2, lo, hi):
+        if not stable(p.geom, C, n, arrays.cluster, m):
             return HANDOVER, used, who
         join(arrays, n, p, who, 0.0, t)
+
+
+@nb.njit(cache=True)
+def _fastest_sliding(arrays, n, p, na):
+    """slow_enough's clusters of sliding blocks (act[:na]), each met once (arrays.seen marks the ones met, the
+    caller clears it): the fastest creep one of them can sustain, or -1 if one cannot creep, or a block of it
+    moves faster than that."""
+    W, act, flag, C, lst = arrays.W, arrays.act, arrays.flag, arrays.creep, arrays.cluster
+    fastest = 0.0
+    for k in range(na):
+        if arrays.seen[act[k]] != 0:
+            continue        # its cluster was met already
+        m = cluster(p.geom, C, flag, SLIDING_NOW, n, act[k], lst, arrays.seen)
+        for q in range(m):
+            i = lst[q]
+            C[i, CR_W] = creep_weakening(p.law, W[i, V], W[i, P])
+        if not stable(p.geom, C, n, lst, m):
+            return -1.0
+        for q in range(m):
+            i = lst[q]
+            C[i, CR_W] = creep_weakening(p.law, 0.0, W[i, P])
+        fastest_creep(p.geom, C, n, p.nu, lst, m)
+        for q in range(m):
+            i = lst[q]
+            if W[i, V] > C[i, CR_RES]:
+                return -1.0
+            fastest = max(fastest, C[i, CR_RES])
+    return fastest
 
 
 @nb.njit(cache=True)
@@ -689,29 +671,15 @@ def slow_enough(arrays, n, p, na, vmax):
     soft to creep handed over must first leave the creep's range: handed back before, it would find
     no creep again). The event then hands its blocks back to creep; the kinetic energy it drops is
     at most that of those creep velocities."""
-    W, act, flag, C = arrays.W, arrays.act, arrays.flag, arrays.creep
+    W, act = arrays.W, arrays.act
     for k in range(na):
         if not W[act[k], V] >= 0.0:
             return False
-    fastest = 0.0
+    fastest = _fastest_sliding(arrays, n, p, na)
     for k in range(na):
-        lo = act[k]
-        if lo > 0 and flag[lo - 1] == SLIDING:
-            continue        # not the first block of its run
-        hi = lo
-        while hi < n - 1 and flag[hi + 1] == SLIDING:
-            hi += 1
-        for i in range(lo, hi + 1):
-            C[i, CR_W] = creep_weakening(p.law, W[i, V], W[i, P])
-        if not stable(C, n, p.l2, lo, hi):
-            return False
-        for i in range(lo, hi + 1):
-            C[i, CR_W] = creep_weakening(p.law, 0.0, W[i, P])
-        fastest_creep(C, n, p.l2, p.nu, lo, hi)
-        for i in range(lo, hi + 1):
-            if W[i, V] > C[i, CR_RES]:
-                return False
-            fastest = max(fastest, C[i, CR_RES])
+        arrays.seen[act[k]] = 0
+    if not fastest >= 0.0:
+        return False
     return vmax > fastest
 
 
@@ -744,7 +712,7 @@ def after_event(arrays, n, p, onset, clock):
         cs[CS_T_HI], cs[CS_T_LO] = clock[0], clock[1]
     for k in range(nt):
         i = touched[k]
-        for j in (left(i), i, right(i, n)):
+        for j in around(p.geom, i, n):
             rekey(arrays, n, p, j)
 
 

@@ -37,7 +37,7 @@ import numba as nb
 import numpy as np
 
 from .control import accepted, next_step_size, record, retry_size
-from .creep import possible, run_of, slow_enough
+from .creep import cluster_of, possible, slow_enough
 from .geometry import along, around, drop_stiffness, neighbours, spring_energy, stiffness, coupling
 from .laws import loader_moves, onset_delay, rest_state, rk4_unstable, stiff_limit
 from .methods import adaptive, take_step
@@ -185,12 +185,12 @@ def begin_handover(arrays, t0, n, epicenter, p):
     creep.after_event)."""
     W, event, C = arrays.W, arrays.event, arrays.creep
     na, nt, yrest = _start(arrays, 0, 0, t0, p, epicenter, 0.0, 0.0)
-    lo, hi = run_of(C, n, epicenter)
     vmax = 0.0
     if C[epicenter, CR_V] > 0.0:
         W[epicenter, V] = C[epicenter, CR_V]
         vmax = W[epicenter, V]
-    for i in range(lo, hi + 1):
+    for k in range(cluster_of(arrays, n, p, epicenter)):
+        i = arrays.cluster[k]
         if i != epicenter and C[i, CR_V] > 0.0:
             na, nt, yrest = _start(arrays, na, nt, t0, p, i, 0.0, yrest)
             W[i, V] = C[i, CR_V]

@@ -266,6 +266,8 @@ WorkArrays = namedtuple("WorkArrays", [
     "episodes", # (2 n, NEPISODE) float64: creep episodes running or waiting to be reported (E_*)
     "cstate",   # (NCSTATE,) float64: the creep phase's scalars (CS_*)
     "crept",    # (n,) int: the creeping blocks in increasing order, crept[:cstate[CS_NCREEP]] (creep.py)
+    "cluster",  # (n,) int: scratch, the blocks of one cluster (geometry.cluster)
+    "seen",     # (n,) int8: scratch, 1 for the blocks a cluster walk has met (0 between the kernels' calls)
     "history",  # (snapshots, H_VALUES + 2 n) float64: the event's snapshots (history.py); 0 rows: none taken
     "hctl",     # (NHCTL,) float64: the histories' control (HC_*)
 ])
@@ -302,6 +304,8 @@ class Workspace:
         self.episodes = np.zeros((2 * n, NEPISODE))
         self.cstate = np.zeros(NCSTATE)
         self.crept = np.zeros(n, dtype=np.int64)
+        self.cluster = np.zeros(n, dtype=np.int64)
+        self.seen = np.zeros(n, dtype=np.int8)
         self.history = np.zeros((snapshots, H_VALUES + 2 * n))
         self.hctl = np.zeros(NHCTL)
 
@@ -311,6 +315,7 @@ class Workspace:
         return WorkArrays(W=self.W, act=self.act, flag=self.flag, touched=self.touched, stuck=self.stuck,
                           since=self.since, tree=self.tree, diag=self.diag, event=self.event, undo=self.undo,
                           creep=self.creep, episodes=self.episodes, cstate=self.cstate, crept=self.crept,
+                          cluster=self.cluster, seen=self.seen,
                           history=self.history, hctl=self.hctl)
 
     def load(self, force, psi, since=None, creep=None):

@@ -19,7 +19,10 @@ import importlib
 import pkgutil
 from dataclasses import dataclass
 
+import numba as nb
 from numba.extending import overload
+
+from ..workspace import CR_EP, SLIDING
 
 # The smallest eigenvalue of a geometry's stiffness operator where every block is on the loader's spring 1: every
 # block moving together stretches only the loader's springs. No cluster of creeping blocks is softer, so a law
@@ -48,10 +51,35 @@ class Geometry:
     spring_energy: object     # (g, W, flag, i, n, stored, y) -> stored plus the energy of block i's springs,
                               # each spring counted once over an event's touched blocks (a spring to a touched
                               # neighbour counted at one of its two ends, flag UNTOUCHED the others)
+    max_stiffness: object     # (g, n) -> the largest K_ii (the shortest inertial period)
+    # the creep phase's clusters (creep.py): connected sets of blocks, their stiffness K_C the rows and columns of K
+    cluster: object       # (g, C, flag, kind, n, j, out, seen) -> m: the connected blocks around j that are
+                          # members of kind (member(), j counted) into out[:m] in increasing order, each marked
+                          # seen[i] = 1
+    stable: object        # (g, C, n, lst, m) -> K_C - diag(C[lst, CR_W]) is positive definite (lst[:m] a cluster)
+    fastest_creep: object     # (g, C, n, nu, lst, m): C[lst, CR_RES] = (K_C - diag(max(CR_W, 0)))^-1 nu 1
+    creep_force: object   # (g, C, W, i, n, nu, h) -> creeping block i's force after its step h (creep slips CR_DU)
+    creep_load: object    # (g, C, j, n, x) -> the force on resting block j from x of its creeping neighbours' CR_DU
+    creep_solve: object   # (g, C, lst, m, n) -> -1 or the block of the first non-negative pivot: the creep's Newton
+                          # update of the creeping blocks lst[:m] into CR_UPPER (Jacobian diagonal CR_DIAG, residual
+                          # CR_RES, J[i, j] = K_ij h_j; pivots into CR_DIAG)
 
     def kernel_params(self, model):
         """The geometry's record for the kernels from a config's model section."""
         return self.record(model)
+
+
+# what a cluster is made of (Geometry.cluster): creeping blocks (creep arrays C), or sliding ones (an event's flag)
+CREEPING = 0
+SLIDING_NOW = 1
+
+
+@nb.njit(cache=True, inline="always")
+def member(C, flag, kind, i):
+    """Block i belongs to a cluster of this kind."""
+    if kind == CREEPING:
+        return C[i, CR_EP] != 0.0
+    return flag[i] == SLIDING
 
 
 def _discover():
@@ -97,3 +125,10 @@ coupling = _dispatch("coupling", "g, i, j")
 along = _dispatch("along", "g, i")
 drop_stiffness = _dispatch("drop_stiffness", "g, W, i, n")
 spring_energy = _dispatch("spring_energy", "g, W, flag, i, n, stored, y")
+max_stiffness = _dispatch("max_stiffness", "g, n")
+cluster = _dispatch("cluster", "g, C, flag, kind, n, j, out, seen")
+stable = _dispatch("stable", "g, C, n, lst, m")
+fastest_creep = _dispatch("fastest_creep", "g, C, n, nu, lst, m")
+creep_force = _dispatch("creep_force", "g, C, W, i, n, nu, h")
+creep_load = _dispatch("creep_load", "g, C, j, n, x")
+creep_solve = _dispatch("creep_solve", "g, C, lst, m, n")
