@@ -49,8 +49,8 @@ class Mutation:
 
 MUTATIONS = (
     # -- kernel: the event ------------------------------------------------------------------
-    Mutation("kernel-free-end-degree", "ensemble/model/event.py",
-             "deg = (1 if i > 0 else 0) + (1 if i < n - 1 else 0)", "deg = 2",
+    Mutation("kernel-free-end-degree", "ensemble/model/geometry/chain.py",
+             "return 1.0 + g.l2 * ((1.0 if i > 0 else 0.0) + (1.0 if i < n - 1 else 0.0))", "return 1.0 + g.l2 * 2.0",
              ("tests/test_sequences.py",),
              "free ends treated as interior blocks in the force update after an event"),
     Mutation("kernel-mirror-right-end", "ensemble/model/geometry/chain.py",
@@ -391,8 +391,8 @@ MUTATIONS = (
              "(s_hi / n_hi) / (s_lo / n_lo)", "(s_lo / n_lo) / (s_hi / n_hi)",
              ("tests/test_rupture_statistics.py::test_the_tables_are_the_events_whatever_the_chunks",),
              "the lower half's mean slip over the upper's: a falling mean slip read as a rising one"),
-    Mutation("stress-drop-without-springs", "ensemble/model/event.py",
-             "drop += y * (1.0 + p.l2 * outside)", "drop += y",
+    Mutation("stress-drop-without-springs", "ensemble/model/geometry/chain.py",
+             "return 1.0 + g.l2 * outside", "return 1.0",
              ("tests/test_physics.py::test_stress_drop_is_the_slipped_blocks_mean_force_drop",),
              "an event's stress drop without the springs to the blocks that did not slip (their pull on the rim)"),
     Mutation("stress-drop-counts-unknown", "analysis/statistics/slip_scaling.py",
@@ -501,7 +501,7 @@ MUTATIONS = (
              "accelerate: the event slides at the creep's velocity until max_duration"),
     Mutation("creep-epicenter-at-the-pivot", "ensemble/model/creep.py",
              "            # no creep: the cluster became too soft where Newton failed\n"
-             "            return HANDOVER, used, _leading(C, n, bad)",
+             "            return HANDOVER, used, _leading(arrays, n, p, bad)",
              "            # no creep: the cluster became too soft where Newton failed\n"
              "            return HANDOVER, used, bad",
              ("tests/test_slip_law.py::test_two_blocks_at_the_paper_rate_alternate_without_small_events",),

@@ -91,19 +91,20 @@ def creeping(C, i):
 
 
 @nb.njit(cache=True)
-def cluster_of(arrays, n, p, j):
+def cluster_of(C, flag, lst, seen, n, p, j):
     """The number m of blocks in the cluster of creeping blocks around block j (j counted as creeping),
-    arrays.cluster[:m] holding them in increasing order."""
-    m = cluster(p.geom, arrays.creep, arrays.flag, CREEPING, n, j, arrays.cluster, arrays.seen)
-    forget(arrays, m)
+    lst[:m] holding them in increasing order (lst, seen: WorkArrays.cluster and .seen; the work arrays go to
+    the hot calls one by one, not as the record, whose every array each call counts a reference of)."""
+    m = cluster(p.geom, C, flag, CREEPING, n, j, lst, seen)
+    forget(lst, seen, m)
     return m
 
 
 @nb.njit(cache=True)
-def forget(arrays, m):
-    """Clear the marks a cluster left in arrays.seen (arrays.cluster[:m])."""
+def forget(lst, seen, m):
+    """Clear the marks a cluster lst[:m] left in seen."""
     for k in range(m):
-        arrays.seen[arrays.cluster[k]] = 0
+        seen[lst[k]] = 0
 
 
 @nb.njit(cache=True)
@@ -116,15 +117,15 @@ def _watched(C, n, j, p):
 
 
 @nb.njit(cache=True)
-def creeping_list(arrays, n):
-    """The number m of creeping blocks, arrays.crept[:m] holding them in increasing order (made again
-    after blocks joined or left: O(n) per change of the set, not per step)."""
-    cs = arrays.cstate
+def creeping_list(C, cs, crept, n):
+    """The number m of creeping blocks, crept[:m] holding them in increasing order (made again after blocks
+    joined or left: O(n) per change of the set, not per step). C, cs, crept: the work arrays creep, cstate,
+    crept."""
     if cs[CS_DIRTY] != 0.0:
         m = 0
         for i in range(n):
-            if arrays.creep[i, CR_EP] != 0.0:
-                arrays.crept[m] = i
+            if C[i, CR_EP] != 0.0:
+                crept[m] = i
                 m += 1
         cs[CS_DIRTY] = 0.0
     return int(cs[CS_NCREEP])
@@ -252,7 +253,7 @@ def _newton(arrays, n, p):
     converged."""
     C = arrays.creep
     lst = arrays.crept
-    m_c = creeping_list(arrays, n)
+    m_c = creeping_list(arrays.creep, arrays.cstate, arrays.crept, n)
     for k in range(m_c):
         i = lst[k]
         C[i, CR_VN] = C[i, CR_V]
@@ -384,7 +385,7 @@ def _error(arrays, n, p):
     C, W = arrays.creep, arrays.W
     err = 0.0
     lst = arrays.crept
-    for k in range(creeping_list(arrays, n)):
+    for k in range(creeping_list(arrays.creep, arrays.cstate, arrays.crept, n)):
         i = lst[k]
         g_end = _rate(p.law, C[i, CR_VN], C[i, CR_PSI])
         g_start = _rate(p.law, C[i, CR_V], W[i, P])
@@ -405,7 +406,7 @@ def _commit(arrays, n, p, t_new):
     counts from the episode's start, the slip at the step's middle (workspace.E_LOAD_WORK)."""
     C, E, W, since = arrays.creep, arrays.episodes, arrays.W, arrays.since
     lst = arrays.crept
-    m = creeping_list(arrays, n)
+    m = creeping_list(arrays.creep, arrays.cstate, arrays.crept, n)
     for k in range(m):
         i = lst[k]
         C[i, CR_RES] = creep_force(p.geom, C, W, i, n, p.nu, C[i, CR_H])
@@ -449,7 +450,7 @@ def _solve(arrays, n, p, t, h):
     work = 0
     stopped = 0
     while cs[CS_NCREEP] > 0.0:
-        m = creeping_list(arrays, n)
+        m = creeping_list(arrays.creep, arrays.cstate, arrays.crept, n)
         _step_sizes(C, arrays.since, arrays.crept, m, t, h)
         work += m
         bad = _newton(arrays, n, p)
@@ -475,7 +476,7 @@ def _accelerating(arrays, n, h, inertial):
     list, which would put every such epicenter on one side of a cluster)."""
     C = arrays.creep
     who = -1
-    for k in range(creeping_list(arrays, n)):
+    for k in range(creeping_list(arrays.creep, arrays.cstate, arrays.crept, n)):
         i = arrays.crept[k]
         grow = C[i, CR_VN] - C[i, CR_V]
         if grow > 0.0 and C[i, CR_VN] * h < inertial * grow and (who < 0 or C[i, CR_VN] > C[who, CR_VN]):
@@ -492,7 +493,7 @@ def _leading(arrays, n, p, bad):
     if not creeping(C, bad):
         return bad
     who = bad
-    for k in range(cluster_of(arrays, n, p, bad)):
+    for k in range(cluster_of(C, arrays.flag, arrays.cluster, arrays.seen, n, p, bad)):
         i = arrays.cluster[k]
         if C[i, CR_V] > C[who, CR_V]:
             who = i
@@ -541,7 +542,7 @@ def continue_creep(arrays, clock, n, p, budget):
             used += work
             if not solved:
                 return HANDOVER, used, bad
-            for k in range(creeping_list(arrays, n)):
+            for k in range(creeping_list(arrays.creep, arrays.cstate, arrays.crept, n)):
                 i = arrays.crept[k]
                 C[i, CR_V] = C[i, CR_VN]
         if cs[CS_NCREEP] == 0.0:
@@ -588,7 +589,7 @@ def continue_creep(arrays, clock, n, p, budget):
         x_cut = 2.0
         who = -1
         lst = arrays.crept
-        for k in range(creeping_list(arrays, n)):
+        for k in range(creeping_list(arrays.creep, arrays.cstate, arrays.crept, n)):
             i = lst[k]
             for j in neighbours(p.geom, i, n):
                 if not _first_visit(C, n, p, i, j):
@@ -624,7 +625,7 @@ def continue_creep(arrays, clock, n, p, budget):
             continue
         # -- a resting neighbour starts: it creeps with its cluster, or the cluster ruptures
         t[0], t[1] = cs[CS_T_HI], cs[CS_T_LO]
-        m = cluster_of(arrays, n, p, who)
+        m = cluster_of(C, arrays.flag, arrays.cluster, arrays.seen, n, p, who)
         for k in range(m):
             i = arrays.cluster[k]
             C[i, CR_W] = creep_weakening(p.law, C[i, CR_V] if creeping(C, i) else 0.0, W[i, P])
@@ -634,16 +635,15 @@ def continue_creep(arrays, clock, n, p, budget):
 
 
 @nb.njit(cache=True)
-def _fastest_sliding(arrays, n, p, na):
+def _fastest_sliding(W, act, flag, C, lst, seen, n, p, na):
     """slow_enough's clusters of sliding blocks (act[:na]), each met once (arrays.seen marks the ones met, the
     caller clears it): the fastest creep one of them can sustain, or -1 if one cannot creep, or a block of it
     moves faster than that."""
-    W, act, flag, C, lst = arrays.W, arrays.act, arrays.flag, arrays.creep, arrays.cluster
     fastest = 0.0
     for k in range(na):
-        if arrays.seen[act[k]] != 0:
+        if seen[act[k]] != 0:
             continue        # its cluster was met already
-        m = cluster(p.geom, C, flag, SLIDING_NOW, n, act[k], lst, arrays.seen)
+        m = cluster(p.geom, C, flag, SLIDING_NOW, n, act[k], lst, seen)
         for q in range(m):
             i = lst[q]
             C[i, CR_W] = creep_weakening(p.law, W[i, V], W[i, P])
@@ -675,7 +675,7 @@ def slow_enough(arrays, n, p, na, vmax):
     for k in range(na):
         if not W[act[k], V] >= 0.0:
             return False
-    fastest = _fastest_sliding(arrays, n, p, na)
+    fastest = _fastest_sliding(W, act, arrays.flag, arrays.creep, arrays.cluster, arrays.seen, n, p, na)
     for k in range(na):
         arrays.seen[act[k]] = 0
     if not fastest >= 0.0:

@@ -189,7 +189,7 @@ def begin_handover(arrays, t0, n, epicenter, p):
     if C[epicenter, CR_V] > 0.0:
         W[epicenter, V] = C[epicenter, CR_V]
         vmax = W[epicenter, V]
-    for k in range(cluster_of(arrays, n, p, epicenter)):
+    for k in range(cluster_of(C, arrays.flag, arrays.cluster, arrays.seen, n, p, epicenter)):
         i = arrays.cluster[k]
         if i != epicenter and C[i, CR_V] > 0.0:
             na, nt, yrest = _start(arrays, na, nt, t0, p, i, 0.0, yrest)

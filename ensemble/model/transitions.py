@@ -9,9 +9,10 @@ for an onset.
 """
 import numba as nb
 
-from .geometry import spring_force, spring_force_by
+from .geometry import spring_force, spring_force_at
+from .interpolant import hermite
 from .laws import friction, loader_moves, rest_state, threshold
-from .workspace import F0, HD0, HD1, K1V, P, SLIDING, TR, V, V0, Y, Y0
+from .workspace import F0, K1V, P, SLIDING, TR, V, V0, Y
 
 # the transition that ends a step early
 NO_CUT = 0            # none inside the step
@@ -20,15 +21,6 @@ ONSET_NEIGHBOUR = 2   # a resting neighbour of a sliding block reaches its thres
 ONSET_LOADING = 3     # a block nobody watches reaches its threshold by loading alone (t_far)
 
 _BISECT = 60          # halvings: a transition is located to 2^-60 of the step
-
-
-@nb.njit(cache=True, inline="always")
-def _hermite(x, y0, y1, d0, d1):
-    """Cubic Hermite on [0, 1] with end values y0, y1 and end slopes d0, d1 (per unit x)."""
-    x2 = x * x
-    x3 = x2 * x
-    return ((2 * x3 - 3 * x2 + 1) * y0 + (x3 - 2 * x2 + x) * d0
-            + (3 * x2 - 2 * x3) * y1 + (x3 - x2) * d1)
 
 
 @nb.njit(cache=True, inline="always")
@@ -107,7 +99,7 @@ def locate(kind, W, flag, n, j, tau, h, v0, v1, d0, d1, p):
     for _ in range(_BISECT):
         mid = 0.5 * (lo + hi)
         if kind == STICK:
-            happened = not (_hermite(mid, v0, v1, d0, d1) > 0.0)
+            happened = not (hermite(mid, v0, v1, d0, d1) > 0.0)
         else:
             happened = _excess(W, flag, n, j, tau, h, mid, p) > 0.0
         if happened:
@@ -118,16 +110,8 @@ def locate(kind, W, flag, n, j, tau, h, v0, v1, d0, d1, p):
 
 
 @nb.njit(cache=True)
-def _slip_at(W, flag, j, x):
-    """Slip of block j at fraction x of the current step (Hermite if it slides)."""
-    if flag[j] != SLIDING:
-        return W[j, Y]
-    return _hermite(x, W[j, Y0], W[j, Y], W[j, HD0], W[j, HD1])
-
-
-@nb.njit(cache=True)
 def _excess(W, flag, n, j, tau, h, x, p):
     """Force above the static threshold of resting block j at fraction x of the step."""
     s = tau + x * h
-    force = spring_force_by(p.geom, _slip_at, W, flag, x, j, n, W[j, F0], s, event_nu(p))
+    force = spring_force_at(p.geom, W, flag, x, j, n, W[j, F0], s, event_nu(p))
     return force - threshold(p.law, rest_psi(W, j, s, p))

@@ -39,8 +39,8 @@ class Geometry:
     spring_force: object  # (g, W, col, i, n, F0, tau, nu) -> the force on block i at local time tau of an event,
                           # with the slips since its start in column col of W (n blocks), F0 the block's force at
                           # the start (c-free frame), nu the loader's velocity during the event
-    spring_force_by: object   # (g, slip, W, flag, x, i, n, F0, tau, nu) -> the same with the neighbours' slips
-                              # slip(W, flag, j, x) and the block's own W[i, Y] (a resting block's)
+    spring_force_at: object   # (g, W, flag, x, i, n, F0, tau, nu) -> the same at fraction x of the event's step,
+                              # the neighbours' slips on its interpolant (interpolant.slip_at), the block's W[i, Y]
     neighbours: object    # (g, i, n) -> tuple of block i's neighbours, in a fixed order (i where one is missing)
     around: object        # (g, i, n) -> tuple of block i and its neighbours (the blocks whose onset i's slip moves)
     stiffness: object     # (g, i, n) -> K_ii: the loader's spring 1 and the springs to i's neighbours
@@ -117,7 +117,7 @@ def _dispatch(name, args):
 
 
 spring_force = _dispatch("spring_force", "g, W, col, i, n, F0, tau, nu")
-spring_force_by = _dispatch("spring_force_by", "g, slip, W, flag, x, i, n, F0, tau, nu")
+spring_force_at = _dispatch("spring_force_at", "g, W, flag, x, i, n, F0, tau, nu")
 neighbours = _dispatch("neighbours", "g, i, n")
 around = _dispatch("around", "g, i, n")
 stiffness = _dispatch("stiffness", "g, i, n")

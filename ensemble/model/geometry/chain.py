@@ -9,6 +9,7 @@ from collections import namedtuple
 import numba as nb
 
 from ..workspace import CR_DIAG, CR_DU, CR_EP, CR_H, CR_RES, CR_UPPER, CR_W, F0, UNTOUCHED, Y
+from ..interpolant import slip_at
 from . import Geometry, member
 
 
@@ -47,9 +48,9 @@ def spring_force(g, W, col, i, n, F0, tau, nu):
 
 
 @nb.njit(cache=True)
-def spring_force_by(g, slip, W, flag, x, i, n, F0, tau, nu):
-    yl = slip(W, flag, left(i), x)
-    yr = slip(W, flag, right(i, n), x)
+def spring_force_at(g, W, flag, x, i, n, F0, tau, nu):
+    yl = slip_at(W, flag, left(i), x)
+    yr = slip_at(W, flag, right(i, n), x)
     return spring_force_of(F0, tau, nu, g.l2, yl, W[i, Y], yr)
 
 
@@ -210,6 +211,6 @@ def _record(model):
     return ChainParams(l2=float(model.l) ** 2)
 
 
-GEOMETRY = Geometry("chain", ChainParams, _record, spring_force, spring_force_by, neighbours, around, stiffness,
+GEOMETRY = Geometry("chain", ChainParams, _record, spring_force, spring_force_at, neighbours, around, stiffness,
                     coupling, along, drop_stiffness, spring_energy, max_stiffness, cluster, stable, fastest_creep,
                     creep_force, creep_load, creep_solve)
