@@ -4,31 +4,60 @@ Full chain, physical variables (u, v, psi) with c kept, classical RK4 on every
 block, sticking by clamping v at the end of a step (second order), onset by
 checking every block after every step. Slow but simple; shares no code with
 ensemble.model.
+
+The blocks may also lie on a plane (`nx` along strike, rows of nx across it, springs l^2 along and
+l_y^2 across, free edges): block i at x = i % nx, y = i // nx. A chain is one row (nx = n), whose
+across-strike springs never stretch.
 """
 import numba as nb
 import numpy as np
 
 
-def displacements_for(force, t, model):
+def stiffness_matrix(n, l, nx=None, l_y=None):
+    """K, dense: the loader's spring 1 on the diagonal and a spring l^2 (along) or l_y^2 (across) per pair of
+    neighbours (free ends and edges)."""
+    nx = n if nx is None else nx
+    K = np.eye(n)
+    for i in range(n):
+        links = []
+        if i % nx < nx - 1 and i + 1 < n:
+            links.append((i + 1, l ** 2))
+        if i + nx < n:
+            links.append((i + nx, (l if l_y is None else l_y) ** 2))
+        for j, k2 in links:
+            K[i, j] = K[j, i] = -k2
+            K[i, i] += k2
+            K[j, j] += k2
+    return K
+
+
+def displacements_for(force, t, model, nx=None, l_y=None):
     """u with (nu t - u) + l^2 lap u - c = force (free ends)."""
-    n = len(force)
-    A = np.eye(n) * (1.0 + 2 * model.l ** 2)
-    A[0, 0] = A[-1, -1] = 1.0 + model.l ** 2
-    idx = np.arange(n - 1)
-    A[idx, idx + 1] = A[idx + 1, idx] = -model.l ** 2
+    A = stiffness_matrix(len(force), model.l, nx, l_y)
     return np.linalg.solve(A, model.nu * t - model.c - np.asarray(force))
 
 
 @nb.njit(cache=True)
-def _rates(t, u, v, psi, moving, nu, l2, a, b, c, du, dv, dpsi):
+def _springs(u, i, l2, l2y, nx):
+    """l^2 (u_right - 2 u_i + u_left) + l_y^2 (u_up - 2 u_i + u_down), a missing neighbour the block itself."""
     n = u.shape[0]
+    x = i % nx
+    left = u[i - 1] if x > 0 else u[i]
+    right = u[i + 1] if x < nx - 1 else u[i]
+    down = u[i - nx] if i >= nx else u[i]
+    up = u[i + nx] if i + nx < n else u[i]
+    return l2 * (left - 2 * u[i] + right) + l2y * (down - 2 * u[i] + up)
+
+
+@nb.njit(cache=True)
+def _rates(t, u, v, psi, moving, nu, springs, a, b, c, du, dv, dpsi):
+    n = u.shape[0]
+    l2, l2y, nx = springs
     for i in range(n):
-        left = u[i - 1] if i > 0 else u[i]
-        right = u[i + 1] if i < n - 1 else u[i]
         if moving[i]:
             vp = max(v[i], 0.0)
             du[i] = v[i]
-            dv[i] = (nu * t - u[i]) + l2 * (left - 2 * u[i] + right) - (c + a * np.log1p(vp) + b * psi[i])
+            dv[i] = (nu * t - u[i]) + _springs(u, i, l2, l2y, nx) - (c + a * np.log1p(vp) + b * psi[i])
             dpsi[i] = np.exp(-psi[i]) - vp
         else:
             du[i] = 0.0
@@ -37,7 +66,7 @@ def _rates(t, u, v, psi, moving, nu, l2, a, b, c, du, dv, dpsi):
 
 
 @nb.njit(cache=True)
-def _event(t, u, v, psi, moving, nu, l2, a, b, c, dt, max_steps):
+def _event(t, u, v, psi, moving, nu, springs, a, b, c, dt, max_steps):
     n = u.shape[0]
     k = [np.zeros((3, n)) for _ in range(4)]
     t0 = t
@@ -52,7 +81,7 @@ def _event(t, u, v, psi, moving, nu, l2, a, b, c, dt, max_steps):
                 su = base[0] + frac * dt * k[s - 1][0]
                 sv = base[1] + frac * dt * k[s - 1][1]
                 sp = base[2] + frac * dt * k[s - 1][2]
-            _rates(t + frac * dt, su, sv, sp, moving, nu, l2, a, b, c, k[s][0], k[s][1], k[s][2])
+            _rates(t + frac * dt, su, sv, sp, moving, nu, springs, a, b, c, k[s][0], k[s][1], k[s][2])
         u[:] = base[0] + dt / 6 * (k[0][0] + 2 * k[1][0] + 2 * k[2][0] + k[3][0])
         v[:] = base[1] + dt / 6 * (k[0][1] + 2 * k[1][1] + 2 * k[2][1] + k[3][1])
         psi[:] = base[2] + dt / 6 * (k[0][2] + 2 * k[1][2] + 2 * k[2][2] + k[3][2])
@@ -63,9 +92,7 @@ def _event(t, u, v, psi, moving, nu, l2, a, b, c, dt, max_steps):
                 v[i] = 0.0
         for i in range(n):
             if not moving[i]:
-                left = u[i - 1] if i > 0 else u[i]
-                right = u[i + 1] if i < n - 1 else u[i]
-                force = (nu * t - u[i]) + l2 * (left - 2 * u[i] + right)
+                force = (nu * t - u[i]) + _springs(u, i, *springs)
                 if force > c + b * psi[i]:
                     moving[i] = True
     return t - t0
@@ -79,7 +106,7 @@ def reference_event(force, psi, epicenter, model, dt, v_start=0.0, t_start=1.0e3
     v[epicenter] = v_start
     moving = np.zeros(len(u), dtype=np.bool_)
     moving[epicenter] = True
-    duration = _event(t_start, u, v, np.array(psi, dtype=float), moving, model.nu, model.l ** 2,
+    duration = _event(t_start, u, v, np.array(psi, dtype=float), moving, model.nu, (model.l ** 2, 0.0, len(u)),
                       model.a, model.b, model.c, dt, 10**8)
     return {"profile": u - u0, "duration": duration}
 
@@ -108,7 +135,7 @@ _BISECTIONS = 60
 
 
 @nb.njit(cache=True)
-def _rk4_step(t, t_lo, h, u, v, psi, moving, nu, l2, a, b, c):
+def _rk4_step(t, t_lo, h, u, v, psi, moving, nu, springs, a, b, c):
     """(u, v, psi) after one classical RK4 step of length h from time t + t_lo (new arrays)."""
     n = u.shape[0]
     ku = np.zeros((4, n))
@@ -123,7 +150,7 @@ def _rk4_step(t, t_lo, h, u, v, psi, moving, nu, l2, a, b, c):
             su = u + f * ku[s - 1]
             sv = v + f * kv[s - 1]
             sp = psi + f * kp[s - 1]
-        _rates(t + (t_lo + fracs[s] * h), su, sv, sp, moving, nu, l2, a, b, c, ku[s], kv[s], kp[s])
+        _rates(t + (t_lo + fracs[s] * h), su, sv, sp, moving, nu, springs, a, b, c, ku[s], kv[s], kp[s])
     w = h / 6.0
     return (u + w * (ku[0] + 2 * ku[1] + 2 * ku[2] + ku[3]),
             v + w * (kv[0] + 2 * kv[1] + 2 * kv[2] + kv[3]),
@@ -131,16 +158,13 @@ def _rk4_step(t, t_lo, h, u, v, psi, moving, nu, l2, a, b, c):
 
 
 @nb.njit(cache=True)
-def _driving_force(t, u, i, nu, l2):
-    """(nu t - u_i) + l^2 (u_{i+1} - 2 u_i + u_{i-1}), free ends (missing neighbour = the block)."""
-    n = u.shape[0]
-    left = u[i - 1] if i > 0 else u[i]
-    right = u[i + 1] if i < n - 1 else u[i]
-    return (nu * t - u[i]) + l2 * (left - 2 * u[i] + right)
+def _driving_force(t, u, i, nu, springs):
+    """(nu t - u_i) + the springs' force (_springs), free ends (missing neighbour = the block)."""
+    return (nu * t - u[i]) + _springs(u, i, *springs)
 
 
 @nb.njit(cache=True)
-def _changes(t, u, v, psi, moving, nu, l2, b, c):
+def _changes(t, u, v, psi, moving, nu, springs, b, c):
     """Number of blocks whose regime changes in this state: sliding with v <= 0, or resting
     with the driving force above the static threshold c + b psi."""
     count = 0
@@ -148,13 +172,13 @@ def _changes(t, u, v, psi, moving, nu, l2, b, c):
         if moving[i]:
             if v[i] <= 0.0:
                 count += 1
-        elif _driving_force(t, u, i, nu, l2) > c + b * psi[i]:
+        elif _driving_force(t, u, i, nu, springs) > c + b * psi[i]:
             count += 1
     return count
 
 
 @nb.njit(cache=True)
-def _sequence(u, v, psi, t, n_events, nu, l2, a, b, c, dt, alpha, max_steps,
+def _sequence(u, v, psi, t, n_events, nu, springs, a, b, c, dt, alpha, max_steps,
               onset, epicenter, duration, slip):
     """Integrate from the state (u, v, psi) at time t (every block at rest) through n_events events.
 
@@ -175,18 +199,18 @@ def _sequence(u, v, psi, t, n_events, nu, l2, a, b, c, dt, alpha, max_steps,
             h = min(h, alpha * np.exp(psi[i]))
             if moving[i] and v[i] > 0.0:
                 h = min(h, alpha / v[i])
-        u1, v1, psi1 = _rk4_step(t, t_lo, h, u, v, psi, moving, nu, l2, a, b, c)
-        if _changes(t + (t_lo + h), u1, v1, psi1, moving, nu, l2, b, c) > 0:
+        u1, v1, psi1 = _rk4_step(t, t_lo, h, u, v, psi, moving, nu, springs, a, b, c)
+        if _changes(t + (t_lo + h), u1, v1, psi1, moving, nu, springs, b, c) > 0:
             lo, hi = 0.0, h
             for _ in range(_BISECTIONS):
                 mid = 0.5 * (lo + hi)
-                um, vm, psim = _rk4_step(t, t_lo, mid, u, v, psi, moving, nu, l2, a, b, c)
-                if _changes(t + (t_lo + mid), um, vm, psim, moving, nu, l2, b, c) > 0:
+                um, vm, psim = _rk4_step(t, t_lo, mid, u, v, psi, moving, nu, springs, a, b, c)
+                if _changes(t + (t_lo + mid), um, vm, psim, moving, nu, springs, b, c) > 0:
                     hi = mid
                 else:
                     lo = mid
             h = hi
-            u1, v1, psi1 = _rk4_step(t, t_lo, h, u, v, psi, moving, nu, l2, a, b, c)
+            u1, v1, psi1 = _rk4_step(t, t_lo, h, u, v, psi, moving, nu, springs, a, b, c)
         was_sliding = moving.any()
         u, v, psi = u1, v1, psi1
         s = t + h     # two-sum: t + t_lo += h exactly
@@ -202,7 +226,7 @@ def _sequence(u, v, psi, t, n_events, nu, l2, a, b, c, dt, alpha, max_steps,
         largest = 0.0
         for i in range(n):
             if resting[i]:
-                excess = _driving_force(t + t_lo, u, i, nu, l2) - (c + b * psi[i])
+                excess = _driving_force(t + t_lo, u, i, nu, springs) - (c + b * psi[i])
                 if excess > 0.0:
                     moving[i] = True
                     if excess > largest:
@@ -221,10 +245,11 @@ def _sequence(u, v, psi, t, n_events, nu, l2, a, b, c, dt, alpha, max_steps,
 
 
 def reference_sequence(u, theta, t, n_events, *, nu, l, a, b, c, dt=1e-3, alpha=0.02,
-                       max_steps=10**8):
+                       max_steps=10**8, nx=None, l_y=None):
     """The first n_events events from displacements u and states theta at time t, all at rest.
 
-    Plain parameters only (the chain's N is len(u), both ends free). Returns a dict of arrays:
+    Plain parameters only (the chain's N is len(u), both ends free; on a plane nx blocks along strike and
+    l_y across, l_y = l if not given). Returns a dict of arrays:
     "t" onset times, "epicenter" the block that started each event (the one furthest above
     its threshold if several start at once), "duration", "profile" (events x N) the slip
     Delta u_i of every block, "slip" its sum.
@@ -235,7 +260,8 @@ def reference_sequence(u, theta, t, n_events, *, nu, l, a, b, c, dt=1e-3, alpha=
     epicenter = np.full(n_events, -1, dtype=np.int64)
     duration = np.full(n_events, np.nan)
     profile = np.full((n_events, len(u)), np.nan)
-    done = _sequence(u, np.zeros(len(u)), psi, float(t), n_events, nu, l ** 2, a, b, c, dt, alpha,
+    springs = (l ** 2, (l if l_y is None else l_y) ** 2 if nx is not None else 0.0, len(u) if nx is None else nx)
+    done = _sequence(u, np.zeros(len(u)), psi, float(t), n_events, nu, springs, a, b, c, dt, alpha,
                      max_steps, onset, epicenter, duration, profile)
     if done < n_events:
         raise RuntimeError(f"reference: only {done} of {n_events} events within {max_steps} steps")
