@@ -13,10 +13,10 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field, fields
 
 from . import filekind, population as populations
-from .config_rules import ConfigError, check_overflow, coerce, point_values
+from .config_rules import MAX_BLOCKS, ConfigError, check_overflow, coerce, point_values
 from .integrators import INTEGRATORS
 from .integrators import KEYS as INTEGRATOR_KEYS
-from .model import laws
+from .model import geometry, laws
 from .model.geometry import SOFTEST_STIFFNESS
 from .sections import POPULATION, SECTION_NAMES, SWEEP
 
@@ -28,14 +28,27 @@ __all__ = ["Config", "ConfigError", "DECORRELATION_PER_BLOCK", "Integrator", "LA
 @dataclass(frozen=True)
 class _Chain:
     """Dimensionless Burridge-Knopoff chain; the friction law's own keys follow (model/laws/)."""
-    N: int = 800         # number of blocks (free ends)
+    N: int = 800         # number of blocks (free ends); on a lattice, blocks along strike
     l: float = 3.0       # stiffness of the springs between blocks (l^2 relative to the driver spring)
     nu: float = 1e-8     # loading velocity of the driver plate
     law: str = laws.DEFAULT   # friction law: one of model/laws/ (aging: the paper's)
+    geometry: str = geometry.DEFAULT   # how the blocks are joined: chain (a line), lattice (N x M, a fault plane)
+    M: int = 1           # lattice: blocks across strike (M rows of N; free edges)
+    l_across: float = None    # lattice: stiffness of the springs across strike (default: l)
 
     def __post_init__(self):
         """Resolve the law's keys: a key left out takes the law's default; a key of another law
-        (not None) is an error naming it."""
+        (not None) is an error naming it. The same for the geometry's keys (M, l_across: the lattice's)."""
+        if self.geometry not in geometry.GEOMETRIES:
+            raise ConfigError(f"model.geometry must be one of {', '.join(sorted(geometry.GEOMETRIES))}, "
+                              f"got {self.geometry!r}")
+        if self.geometry == "chain" and (self.M != 1 or self.l_across is not None):
+            key = "M" if self.M != 1 else "l_across"
+            raise ConfigError(f"model.{key} belongs to model.geometry = 'lattice' (a chain has one row)")
+        if self.geometry == "lattice" and self.l_across is None:
+            object.__setattr__(self, "l_across", self.l)
+        if self.N * self.M > MAX_BLOCKS:
+            raise ConfigError(f"model.N * model.M must be at most {MAX_BLOCKS} blocks, got {self.N} x {self.M}")
         if self.law not in laws.LAWS:
             raise ConfigError(f"model.law must be one of {', '.join(sorted(laws.LAWS))}, got {self.law!r}")
         own = laws.get(self.law).keys
@@ -46,6 +59,11 @@ class _Chain:
             elif name not in own and value is not None:
                 raise ConfigError(f"model.{name} does not belong to model.law = {self.law!r} "
                                   f"(its keys: {', '.join(own)})")
+
+    @property
+    def blocks(self):
+        """The number of blocks: N on a chain, N x M on a lattice."""
+        return self.N * self.M
 
     def law_keys(self):
         """The [model] keys of this model's law, in order."""
@@ -133,8 +151,9 @@ class Config:
 
     def __post_init__(self):
         """Resolve run.transient and run.decorrelation left out: TRANSIENT_PER_BLOCK and
-        DECORRELATION_PER_BLOCK events per block of the largest N."""
-        largest = max(int(n) for n in point_values(self, "model.N")[1])
+        DECORRELATION_PER_BLOCK events per block of the largest N (of N x M blocks on a lattice)."""
+        largest = (max(int(n) for n in point_values(self, "model.N")[1])
+                   * max(int(m) for m in point_values(self, "model.M")[1]))
         if self.run.transient is None:
             object.__setattr__(self, "run", dataclasses.replace(self.run, transient=TRANSIENT_PER_BLOCK * largest))
         if self.run.decorrelation is None:
@@ -223,9 +242,9 @@ def _sweep(raw, overridden, law_keys):
                 out.append((key, _distinct(key, tuple(populations.parse_draw(drawn, v, types, law_keys, f"sweep.{key}")
                                                       for v in values))))
                 continue
-            if key not in types or key == "law":
+            if key not in types or key in ("law", "geometry"):
                 raise ConfigError(f"unknown key sweep.{key} (only [model] keys can be swept: "
-                                  f"{', '.join(k for k in types if k != 'law')})")
+                                  f"{', '.join(k for k in types if k not in ('law', 'geometry'))})")
             if not isinstance(values, list) or not values:
                 raise ConfigError(f"sweep.{key} must be a non-empty list of values, e.g. {key} = [20, 40] "
                                   f"(on the command line: --set 'sweep.{key}=[20, 40]'), got {values!r}")

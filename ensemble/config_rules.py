@@ -39,6 +39,8 @@ RULES = {   # (section, key) -> (value -> bool, what it requires)
     ("model", "N"): (lambda x: 1 <= x <= MAX_BLOCKS, f"an integer in [1, {MAX_BLOCKS}] (a rank holds about 500 "
                                                       f"bytes per block)"),
     ("model", "l"): (_positive, "> 0"),
+    ("model", "M"): (lambda x: 1 <= x <= MAX_BLOCKS, f"an integer in [1, {MAX_BLOCKS}]"),
+    ("model", "l_across"): (_positive, "> 0"),
     # the plate must be slow against slip, whose velocities are of order 1 in these units (the paper:
     # 1e-8); faster loading is not this model, and from about 1e8 on the kernels' floats fail
     ("model", "nu"): (lambda x: 0 < x <= MAX_NU, f"in (0, {MAX_NU:g}] (loading slow against slip; the paper: 1e-8)"),

@@ -74,7 +74,7 @@ def kernel_params(model, integrator):
     (config dataclasses): a key of KEYS the kernels read is the field of the same name (the method
     becomes its record)."""
     max_steps = int(min(2 * integrator.max_duration / integrator.dt + 1e6, 2**62))
-    return KernelParams(l2=model.l ** 2, nu=model.nu, geom=geometry.get(geometry.DEFAULT).kernel_params(model),
+    return KernelParams(l2=model.l ** 2, nu=model.nu, geom=geometry.get(model.geometry).kernel_params(model),
                         law=laws.get(model.law).kernel_params(model),
                         method=INTEGRATORS[integrator.method].kernel_params(), max_steps=max_steps,
                         **{name: getattr(integrator, name) for name in KEYS

@@ -32,12 +32,13 @@ import math
 import numba as nb
 import numpy as np
 
-from .geometry import (CREEPING, SLIDING_NOW, around, cluster, coupling, creep_force, creep_load, creep_solve,
-                       fastest_creep, max_stiffness, neighbours, stable, stiffness)
+from .geometry import (CREEPING, SLIDING_NOW, across, along, around, cluster, coupling, creep_force, creep_load,
+                       creep_solve, fastest_creep, max_stiffness, neighbours, stable, stiffness)
 from .laws import (creep_state, creep_weakening, creeps, friction, friction_slopes, onset_delay, rest_state, state_rate,
                    threshold)
 from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
-from .workspace import (CR_DIAG, CR_DPSI, CR_DU, CR_EP, CR_H, CR_HB, CR_LEFT, CR_PSI, CR_RES, CR_SERIAL, CR_UPPER, CR_V,
+from .workspace import (D_ACROSS_FIRST, D_ACROSS_LAST, E_ACROSS_FIRST, E_ACROSS_LAST, CR_DIAG, CR_DPSI, CR_DU,
+                        CR_EP, CR_H, CR_HB, CR_LEFT, CR_PSI, CR_RES, CR_SERIAL, CR_UPPER, CR_V,
                         CR_VN, CR_W, CS_DIRTY, CS_ENDED, CS_FRESH, CS_H, CS_NCREEP, CS_SERIAL, CS_T_HI, CS_T_LO,
                         E_ACTIVE, E_BLOCK_STEPS, E_END_HI, E_END_LO, E_EPICENTER, E_FIRST, E_LAST, E_LOAD_WORK,
                         E_NBLOCKS, E_RUNNING, E_RUPTURED, E_SERIAL, E_SLIP, E_START_HI, E_START_LO, E_STATE, E_STOPPED,
@@ -161,7 +162,7 @@ def off_schedule(arrays, n, p):
 
 
 @nb.njit(cache=True)
-def _new_episode(E, cs, t, j):
+def _new_episode(E, cs, t, j, g):
     """A free slot of the episode table for an episode starting at block j at time t (two floats)."""
     slot = 0
     while E[slot, E_STATE] != 0.0:
@@ -171,8 +172,8 @@ def _new_episode(E, cs, t, j):
     E[slot, E_START_HI] = t[0]
     E[slot, E_START_LO] = t[1]
     E[slot, E_EPICENTER] = j
-    E[slot, E_FIRST] = j
-    E[slot, E_LAST] = j
+    E[slot, E_FIRST] = E[slot, E_LAST] = along(g, j)
+    E[slot, E_ACROSS_FIRST] = E[slot, E_ACROSS_LAST] = across(g, j)
     cs[CS_SERIAL] += 1.0
     E[slot, E_SERIAL] = cs[CS_SERIAL]
     return slot
@@ -196,7 +197,7 @@ def join(arrays, n, p, j, v0, t):
             slot = int(C[k, CR_EP]) - 1
             break
     if slot < 0:
-        slot = _new_episode(E, cs, t, j)
+        slot = _new_episode(E, cs, t, j, p.geom)
     C[j, CR_EP] = slot + 1
     C[j, CR_V] = v0
     cs[CS_FRESH] = 1.0
@@ -435,8 +436,10 @@ def _commit(arrays, n, p, t_new):
         E[slot, E_BLOCK_STEPS] += 1.0
         if du > 0.0:
             E[slot, E_SLIP] += du
-            E[slot, E_FIRST] = min(E[slot, E_FIRST], i)
-            E[slot, E_LAST] = max(E[slot, E_LAST], i)
+            E[slot, E_FIRST] = min(E[slot, E_FIRST], along(p.geom, i))
+            E[slot, E_LAST] = max(E[slot, E_LAST], along(p.geom, i))
+            E[slot, E_ACROSS_FIRST] = min(E[slot, E_ACROSS_FIRST], across(p.geom, i))
+            E[slot, E_ACROSS_LAST] = max(E[slot, E_ACROSS_LAST], across(p.geom, i))
         if v > E[slot, E_VMAX]:
             E[slot, E_VMAX] = v
 
@@ -736,6 +739,8 @@ def report(arrays, n, out_t, out_epicenter, out_diag, k):
             out_diag[k, D_SLIP] = E[slot, E_SLIP]
             out_diag[k, D_FIRST] = E[slot, E_FIRST]
             out_diag[k, D_LAST] = E[slot, E_LAST]
+            out_diag[k, D_ACROSS_FIRST] = E[slot, E_ACROSS_FIRST]
+            out_diag[k, D_ACROSS_LAST] = E[slot, E_ACROSS_LAST]
             out_diag[k, D_NSLIP] = E[slot, E_NBLOCKS]
             out_diag[k, D_VMAX] = E[slot, E_VMAX]
             out_diag[k, D_BLOCK_STEPS] = E[slot, E_BLOCK_STEPS]

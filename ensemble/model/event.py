@@ -38,7 +38,7 @@ import numpy as np
 
 from .control import accepted, next_step_size, record, retry_size
 from .creep import cluster_of, possible, slow_enough
-from .geometry import along, around, drop_stiffness, neighbours, spring_energy, stiffness, coupling
+from .geometry import across, along, around, drop_stiffness, neighbours, spring_energy, stiffness, coupling
 from .laws import loader_moves, onset_delay, rest_state, rk4_unstable, stiff_limit
 from .methods import adaptive, take_step
 from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
@@ -47,7 +47,8 @@ from .transitions import (NO_CUT, ONSET_LOADING, ONSET_NEIGHBOUR, STICK, above_t
                           loading_cut, locate, pressed, rest_psi, velocity_slopes)
 from .history import begin as begin_history, recording_history, snapshot
 from .undo import clear_log, log_block
-from .workspace import (BETWEEN, D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D_ENERGY_SCALE, D_FIRST, D_LAST,
+from .workspace import (BETWEEN, D_ACROSS_FIRST, D_ACROSS_LAST,
+                        D_BLOCK_STEPS, D_CUTS, D_DURATION, D_ELASTIC, D_ENERGY_SCALE, D_FIRST, D_LAST,
                         D_LOAD_WORK, D_NSLIP, D_REJECTED, D_RESIDUAL, D_SLIP, D_STEPS, D_STRESS_DROP, D_VMAX, D_WORK,
                         D_N_ONSET, D_T_SPREAD, D_T_WIDEST, D_N_WIDEST, EV_N_ONSET, EV_T_SPREAD, EV_T_WIDEST,
                         EV_N_WIDEST, EV_BLOCK_STEPS, EV_CUTS, EV_EPICENTER, EV_ERR_PREV, EV_FAR, EV_H_NEXT, EV_NA,
@@ -486,6 +487,8 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, p, work, slip_t
     slip = 0.0
     first = n
     last = -1
+    across_first = n
+    across_last = -1
     nslip = 0
     drop = 0.0       # sum of the slipped blocks' force drops by the slip (workspace.py: D_STRESS_DROP)
     # Energy balance in the c-free frame (derivation in docs of workspace.py):
@@ -500,6 +503,8 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, p, work, slip_t
             nslip += 1
             first = min(first, along(p.geom, i))
             last = max(last, along(p.geom, i))
+            across_first = min(across_first, across(p.geom, i))
+            across_last = max(across_last, across(p.geom, i))
             drop += y * drop_stiffness(p.geom, W, i, n)
         # the non-negative terms (own and spring energies) count alike in both sums
         stored = spring_energy(p.geom, W, flag, i, n, 0.5 * y * y, y)
@@ -513,6 +518,8 @@ def _finish_event(W, flag, touched, nt, since, tree, t0, n, tau, p, work, slip_t
     diag[D_SLIP] = slip
     diag[D_FIRST] = first
     diag[D_LAST] = last
+    diag[D_ACROSS_FIRST] = across_first
+    diag[D_ACROSS_LAST] = across_last
     diag[D_NSLIP] = nslip
     diag[D_WORK] = work
     diag[D_RESIDUAL] = e_change + work

@@ -92,8 +92,10 @@ NCOLS = X_THETA + 1
 # entries of the per-event diagnostics vector
 (D_DURATION, D_SLIP, D_FIRST, D_LAST, D_NSLIP, D_WORK, D_RESIDUAL, D_STEPS, D_VMAX,
  D_BLOCK_STEPS, D_REJECTED, D_CUTS, D_ENERGY_SCALE, D_ELASTIC, D_LOAD_WORK, D_KIND, D_ENDING,
- D_STRESS_DROP, D_N_ONSET, D_T_SPREAD, D_T_WIDEST, D_N_WIDEST) = range(22)
-NDIAG = 22
+ D_STRESS_DROP, D_N_ONSET, D_T_SPREAD, D_T_WIDEST, D_N_WIDEST, D_ACROSS_FIRST, D_ACROSS_LAST) = range(24)
+NDIAG = 24
+# D_FIRST, D_LAST: the lowest and highest position along strike of a block that slipped (geometry.along: on the
+# chain its index); D_ACROSS_FIRST, D_ACROSS_LAST the same across strike (geometry.across: 0 on the chain)
 # D_KIND: what a row of the kernels' output is; D_ENDING: how a creep episode ended (1 its blocks
 # stopped, 2 an inertial event took them; 0 for an event)
 # D_STRESS_DROP: an event's stress drop, the mean over the blocks that slipped (the set S) of the drop of
@@ -184,7 +186,7 @@ E_STATE = 0     # 0 free, E_RUNNING, E_STOPPED (its blocks stopped), E_RUPTURED 
 E_START_HI, E_START_LO = 1, 2      # two-float time at which it began
 E_EPICENTER = 3                    # its first block
 E_SLIP = 4                         # sum of its blocks' slips
-E_FIRST, E_LAST = 5, 6             # lowest and highest block that slipped in it
+E_FIRST, E_LAST = 5, 6             # lowest and highest position along strike that slipped in it
 E_NBLOCKS = 7                      # blocks that crept in it
 E_VMAX = 8                         # largest creep velocity
 E_ACTIVE = 9                       # blocks creeping in it now
@@ -193,7 +195,9 @@ E_END_HI, E_END_LO = 11, 12        # two-float time at which it ended
 E_BLOCK_STEPS = 13                 # creep steps of its blocks
 E_WORK = 14        # friction work of its blocks' steps, c-free frame (creep._commit: trapezoidal in each step)
 E_LOAD_WORK = 15   # the driver's work on its blocks' slips since its start: nu sum(du (t_mid - start)) (D_LOAD_WORK)
-NEPISODE = 16
+E_ACROSS_FIRST, E_ACROSS_LAST = 16, 17   # lowest and highest position across strike that slipped in it (E_FIRST,
+                                         # E_LAST: along strike)
+NEPISODE = 18
 E_RUNNING, E_STOPPED, E_RUPTURED = 1.0, 2.0, 3.0
 # The creep phase's own scalars `cstate`
 CS_NCREEP = 0   # blocks creeping

@@ -22,8 +22,8 @@ def initial_state(cfg, task):
     """
     rng = rng_for(cfg, task)
     law = laws.get(task.model.law)
-    psi = np.zeros(task.model.N)
-    force = law.threshold(law.kernel_params(task.model), 0.0) - cfg.run.init_stress * rng.random(task.model.N)
+    psi = np.zeros(task.model.blocks)
+    force = law.threshold(law.kernel_params(task.model), 0.0) - cfg.run.init_stress * rng.random(task.model.blocks)
     return force, psi
 
 

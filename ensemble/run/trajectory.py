@@ -12,7 +12,8 @@ import numpy as np
 from ..config import ConfigError, parse_section, section_lines
 from ..integrators import INTEGRATORS, kernel_params
 from ..model.chain import simulate
-from ..model.workspace import (CS_H, CS_NCREEP, CS_T_HI, CS_T_LO, D_DURATION, D_ENDING, D_FIRST, D_KIND, D_LAST, H_HI,
+from ..model.workspace import (D_ACROSS_FIRST, D_ACROSS_LAST,
+                               CS_H, CS_NCREEP, CS_T_HI, CS_T_LO, D_DURATION, D_ENDING, D_FIRST, D_KIND, D_LAST, H_HI,
                                H_NA, H_LO, H_TAU, H_VALUES, HC_COUNT, HC_DROPPED, HC_DT, HC_ON, HC_RATIO, HC_READY,
                                HC_SLIP_MIN, D_NSLIP, D_SLIP, D_STRESS_DROP, D_N_ONSET, D_T_SPREAD, D_T_WIDEST,
                                D_N_WIDEST, EV_NA, EV_PHASE, EV_STEPS, EV_TAU, EV_VMAX, IN_EVENT, NDIAG, OK, PAUSED,
@@ -41,7 +42,7 @@ class Trajectory:
         self.history_quota = out.history if histories is not None else 0
         self.histories_kept = histories or 0
         self.new_histories = []       # (slot, history) taken since the caller last collected them
-        self.ws = Workspace(task.model.N, out.history_snapshots if self.history_quota else 0)
+        self.ws = Workspace(task.model.blocks, out.history_snapshots if self.history_quota else 0)
         hctl = self.ws.hctl
         hctl[HC_SLIP_MIN], hctl[HC_DT] = 10.0 ** out.history_mu, out.history_dt
         hctl[HC_RATIO] = 10.0 ** out.history_dlogv
@@ -66,7 +67,7 @@ class Trajectory:
     def where(self):
         """Where the chain is now, in words: the event in progress (kernel calls pause inside one) or the creep
         phase, for a run that has gone long without a row (worker.py)."""
-        ev, cs, n = self.ws.arrays.event, self.ws.arrays.cstate, self.task.model.N
+        ev, cs, n = self.ws.arrays.event, self.ws.arrays.cstate, self.task.model.blocks
         row = f"row {self.done}{' (transient)' if self.done < self.discarded else ''}"
         if ev[EV_PHASE] == IN_EVENT:
             return (f"{row}: an event in progress, {ev[EV_STEPS]:.3g} steps over a model time of {ev[EV_TAU]:.3g} "
@@ -112,7 +113,7 @@ class Trajectory:
 
     def _history(self, row):
         """The snapshots in the workspace as a history of recorded row `row` (ensemble/store/histories.py)."""
-        hctl, n = self.ws.hctl, self.task.model.N
+        hctl, n = self.ws.hctl, self.task.model.blocks
         H = self.ws.history[:int(hctl[HC_COUNT])]
         velocity, slip = np.zeros((len(H), n)), np.zeros((len(H), n))
         for r, snap in enumerate(H):
@@ -128,15 +129,20 @@ def event_rows(task, t, epicenter, diag):
     """Kernel output -> catalog columns (EVENT_FIELDS, ensemble/store/schema.py)."""
     first = diag[:, D_FIRST].astype(np.int64)
     last = diag[:, D_LAST].astype(np.int64)
+    across_first = diag[:, D_ACROSS_FIRST].astype(np.int64)
+    across_last = diag[:, D_ACROSS_LAST].astype(np.int64)
     return {
         "task": np.full(len(t), task.index, dtype=np.int64), "t": t, "epicenter": epicenter,
         "mu": np.log10(diag[:, D_SLIP]), "slip": diag[:, D_SLIP], "first": first, "last": last,
         "n_slipped": diag[:, D_NSLIP].astype(np.int64),
-        "boundary": (first == 0) | (last == task.model.N - 1), "duration": diag[:, D_DURATION],
+        "boundary": ((first == 0) | (last == task.model.N - 1) | (across_first == 0 if task.model.M > 1 else False)
+                     | (across_last == task.model.M - 1 if task.model.M > 1 else False)),
+        "duration": diag[:, D_DURATION],
         "kind": diag[:, D_KIND].astype(np.int8), "ending": diag[:, D_ENDING].astype(np.int8),
         "stress_drop": diag[:, D_STRESS_DROP], "n_onset": diag[:, D_N_ONSET].astype(np.int64),
         "t_spread": diag[:, D_T_SPREAD], "t_widest": diag[:, D_T_WIDEST],
         "n_widest": diag[:, D_N_WIDEST].astype(np.int64),
+        "across_first": across_first, "across_last": across_last,
     }
 
 

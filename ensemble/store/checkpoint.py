@@ -15,7 +15,7 @@ def carries_creep(model):
     from ..config import Integrator
     from ..integrators import kernel_params
     from ..model.creep import possible
-    return bool(possible(kernel_params(model, Integrator()), model.N))
+    return bool(possible(kernel_params(model, Integrator()), model.blocks))
 
 
 def state_size(n, creep=False, episode_columns=NEPISODE):

@@ -47,6 +47,7 @@ def create_layout(h5, cfg, tasks, integrator_text, software=""):
                   for t in tasks]
         tg.create_dataset(name, data=np.asarray([np.nan if v is None else v for v in values], dtype=dtype))
     tg.create_dataset("law", data=np.array([fixed_text(t.model.law) for t in tasks], dtype=f"S{LAW_BYTES}"))
+    tg.create_dataset("geometry", data=np.array([fixed_text(t.model.geometry) for t in tasks], dtype=f"S{LAW_BYTES}"))
     tg["law"].attrs["conventions"] = "\n".join(f"{law.name}: {law.convention}" for law in laws.LAWS.values()
                                                if any(t.model.law == law.name for t in tasks))
     tg.create_dataset("events_written", data=np.zeros(len(tasks), dtype=np.int64))
@@ -63,7 +64,7 @@ def create_layout(h5, cfg, tasks, integrator_text, software=""):
         sg.create_dataset("N", data=np.array([t.model.N for t in spinups], dtype=np.int64))
     records = list(tasks) + spinups
     creep = np.array([carries_creep(t.model) for t in records], dtype=np.int8)
-    sizes = np.array([2 * state_size(t.model.N, c) for t, c in zip(records, creep)], dtype=np.int64)
+    sizes = np.array([2 * state_size(t.model.blocks, c) for t, c in zip(records, creep)], dtype=np.int64)
     offset = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
     cp = h5.create_group("checkpoint")
     cp.create_dataset("state", shape=(int(sizes.sum()),), dtype=np.float64, fillvalue=np.nan,
@@ -90,7 +91,7 @@ def _create_histories(h5, cfg, tasks):
     if per_task == 0:
         return
     slots = len(tasks) * per_task
-    blocks = max(t.model.N for t in tasks)
+    blocks = max(t.model.blocks for t in tasks)
     g = h5.create_group(histories.GROUP)
     g.attrs["per_task"] = per_task
     g.attrs["snapshots"] = snapshots
@@ -117,9 +118,9 @@ def estimate_bytes(cfg, tasks):
     """An upper bound of the size of the catalog of `tasks` (what space.check_fits asks for)."""
     records = list(tasks) + spinup_points(cfg, tasks)
     data = (len(tasks) * cfg.run.events * sum(np.dtype(t).itemsize for t in EVENT_FIELDS.values())
-            + 8 * sum(2 * state_size(t.model.N, carries_creep(t.model)) for t in records)   # checkpoint slots
+            + 8 * sum(2 * state_size(t.model.blocks, carries_creep(t.model)) for t in records)   # checkpoint slots
             + len(records) * (8 * (2 * NCOMMIT + 1) + 1)                      # commit rows, offsets, creep
-            + len(tasks) * (8 * (len(TASK_FIELDS) + len(PROVENANCE_FIELDS) + 5) + 2 * TEXT_BYTES + LAW_BYTES))
+            + len(tasks) * (8 * (len(TASK_FIELDS) + len(PROVENANCE_FIELDS) + 5) + 2 * TEXT_BYTES + 2 * LAW_BYTES))
     data += histories.size_bound(cfg, tasks)
     metadata = 4096 * (len(DATASETS) + 4) + 2 * len(cfg.to_toml()) + 64 * 1024
     return int(data * 1.01) + metadata

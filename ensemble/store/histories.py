@@ -32,7 +32,7 @@ def size_bound(cfg, tasks):
     """Bytes the /histories of `tasks` may take at most."""
     if cfg.output.history == 0:
         return 0
-    blocks = max(t.model.N for t in tasks)
+    blocks = max(t.model.blocks for t in tasks)
     return len(tasks) * cfg.output.history * (8 * len(SCALARS) + 8 * cfg.output.history_snapshots * (2 + 2 * blocks))
 
 

@@ -52,7 +52,7 @@ class Layout:
             self.commit = h5["checkpoint"]["commit"]
             self.per_task = int(h5.attrs["events_per_task"])
             self.transient = int(h5.attrs["transient"])
-            self.n_blocks = self.tasks["N"][...]
+            self.n_blocks = self.tasks["N"][...] * (self.tasks["M"][...] if "M" in self.tasks else 1)
             # spin-ups (run.branch): records n_tasks + point of /checkpoint, after the tasks'
             self.spinup_events = int(h5.attrs.get("spinup", 0))
             self.spinup = {name: ds[...] for name, ds in h5["spinup"].items()} if "spinup" in h5 else {}

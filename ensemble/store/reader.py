@@ -61,7 +61,11 @@ class Reader:
         for name in LAW_KEYS:
             self.tasks.setdefault(name, np.full(n, np.nan))
         self.tasks.setdefault("branch_of", np.full(n, -1, dtype=np.int64))   # catalogs before run.branch
-        for name in ("error", "integrator", "law"):
+        # catalogs before bk-catalog-8 ran chains
+        self.tasks.setdefault("geometry", np.full(n, b"chain"))
+        self.tasks.setdefault("M", np.ones(n, dtype=np.int64))
+        self.tasks.setdefault("l_across", np.full(n, np.nan))
+        for name in ("error", "integrator", "law", "geometry"):
             self.tasks[name] = np.array([x.decode(errors="replace") for x in self.tasks[name]])
 
     def task_events(self, task, chunk=READ_CHUNK, kind=None):

@@ -30,14 +30,18 @@ from ..config import LAW_KEYS
 from ..model import laws
 from ..model.workspace import KIND_CREEP, KIND_EVENT, NEPISODE
 
-FORMAT = "bk-catalog-7"
-# older formats this version reads (not resumes), and what they lack: bk-catalog-6 has no /events/stress_drop and
-# no nucleation columns (the reader supplies NaN, and 0 for the counts); bk-catalog-5 keeps a creep state of
-# another layout in its checkpoints (its episode table without the episodes' energy, EPISODE_COLUMNS);
+FORMAT = "bk-catalog-8"
+# older formats this version reads (not resumes), and what they lack: bk-catalog-7 ran chains only (no
+# /tasks/geometry, /tasks/M, /tasks/l_across, /events/across_first, /events/across_last: the reader supplies
+# chain, 1, NaN, 0, 0) and keeps its checkpoints' episode tables without the extents across strike; bk-catalog-6
+# has no /events/stress_drop and no nucleation columns (the reader supplies NaN, and 0 for the counts);
+# bk-catalog-5 keeps a creep state of another layout in its checkpoints (its episode table without the episodes'
+# energy, EPISODE_COLUMNS);
 # bk-catalog-4 has no /events/kind and /events/ending (every row an inertial event; the reader supplies kind 0,
 # ending 0) and no creep state in its checkpoints; bk-catalog-3 lacks also tables_crc and /tasks/record_crc (its
 # tables are checked against its config only). Only FORMAT is written and resumed.
 OLDER = {
+    "bk-catalog-7": "written before the geometry was a choice (a chain; another creep state in its checkpoints)",
     "bk-catalog-6": "written before events kept their stress drop and nucleation (no /events/stress_drop)",
     "bk-catalog-5": "written before creep episodes kept their energy (another creep state in its checkpoints)",
     "bk-catalog-4": "written before the creep phase (no /events/kind, no creep state in its checkpoints)",
@@ -45,10 +49,10 @@ OLDER = {
 }
 READABLE = {*OLDER, FORMAT}
 # formats with tables_crc and /tasks/record_crc; with /events/kind, /events/ending and /checkpoint/creep
-CHECKSUMMED = {"bk-catalog-4", "bk-catalog-5", "bk-catalog-6", FORMAT}
-WITH_CREEP = {"bk-catalog-5", "bk-catalog-6", FORMAT}
+CHECKSUMMED = {"bk-catalog-4", "bk-catalog-5", "bk-catalog-6", "bk-catalog-7", FORMAT}
+WITH_CREEP = {"bk-catalog-5", "bk-catalog-6", "bk-catalog-7", FORMAT}
 # columns of the episode table in a checkpoint's creep state (Workspace.creep_state), by format
-EPISODE_COLUMNS = {"bk-catalog-5": 14, "bk-catalog-6": NEPISODE, FORMAT: NEPISODE}
+EPISODE_COLUMNS = {"bk-catalog-5": 14, "bk-catalog-6": 16, "bk-catalog-7": 16, FORMAT: NEPISODE}
 
 # /events/kind: what a row is, KIND_EVENT (0) or KIND_CREEP (1) (ensemble/model/workspace.py, imported above)
 # /events/ending: 0 an inertial event; a creep episode 1 whose blocks all stopped, 2 taken over by an event
@@ -58,21 +62,24 @@ EVENT_FIELDS = {
     "slip": np.float64, "first": np.int64, "last": np.int64, "n_slipped": np.int64,
     "boundary": np.bool_, "duration": np.float64, "kind": np.int8, "ending": np.int8, "stress_drop": np.float64,
     "n_onset": np.int64, "t_spread": np.float64, "t_widest": np.float64, "n_widest": np.int64,
+    "across_first": np.int64, "across_last": np.int64,
 }
 # the columns each format stores (its events CRC covers these, in this order); the reader supplies the others
 # as SUPPLIED says
 STORED_EVENT_FIELDS = {
     "bk-catalog-3": tuple(EVENT_FIELDS)[:10], "bk-catalog-4": tuple(EVENT_FIELDS)[:10],
-    "bk-catalog-5": tuple(EVENT_FIELDS)[:12], "bk-catalog-6": tuple(EVENT_FIELDS)[:12], FORMAT: tuple(EVENT_FIELDS),
+    "bk-catalog-5": tuple(EVENT_FIELDS)[:12], "bk-catalog-6": tuple(EVENT_FIELDS)[:12],
+    "bk-catalog-7": tuple(EVENT_FIELDS)[:17], FORMAT: tuple(EVENT_FIELDS),
 }
 SUPPLIED = {"kind": KIND_EVENT, "ending": ENDING_EVENT, "stress_drop": np.nan, "n_onset": 0, "t_spread": np.nan,
-            "t_widest": np.nan, "n_widest": 0}
+            "t_widest": np.nan, "n_widest": 0, "across_first": 0, "across_last": 0}
 TASK_FIELDS = {
     "point": np.int64, "seed_index": np.int64, "N": np.int64, "l": np.float64, "nu": np.float64,
+    "M": np.int64, "l_across": np.float64,     # the lattice's (model.geometry); a chain: 1, NaN
     # every friction law's keys (model/laws/); NaN for a key of another law than the task's
     **{name: np.float64 for name in LAW_KEYS},
 }
-LAW_BYTES = 64        # /tasks/law: fixed-length text
+LAW_BYTES = 64        # /tasks/law and /tasks/geometry: fixed-length text
 PROVENANCE_FIELDS = {
     "rank": np.int64, "wall_time": np.float64, "events_per_second": np.float64,
     "seed_entropy": np.int64, "spawn_key": np.int64,
@@ -92,10 +99,11 @@ DATASETS = {
     "events/epicenter": ("index", _EVENT_ROWS, "first block to slide (0-based; of a creep episode: to creep)"),
     "events/mu": ("log10 model length", _EVENT_ROWS, "magnitude log10(slip)"),
     "events/slip": ("model length", _EVENT_ROWS, "sum of the slips of all blocks"),
-    "events/first": ("index", _EVENT_ROWS, "lowest block that slipped"),
-    "events/last": ("index", _EVENT_ROWS, "highest block that slipped"),
+    "events/first": ("index", _EVENT_ROWS, "lowest block that slipped (on a lattice: position along strike, "
+                                           "0..N-1; block i lies at i % N along, i // N across)"),
+    "events/last": ("index", _EVENT_ROWS, "highest block that slipped (on a lattice: along strike)"),
     "events/n_slipped": ("count", _EVENT_ROWS, "number of blocks that slipped"),
-    "events/boundary": ("bool", _EVENT_ROWS, "the rupture reached block 0 or N-1"),
+    "events/boundary": ("bool", _EVENT_ROWS, "the rupture reached block 0 or N-1 (on a lattice: an edge)"),
     "events/duration": ("model time", _EVENT_ROWS, "time from onset until all blocks are at rest (of a creep "
                                                    "episode: from its start until it ended)"),
     "events/kind": ("code", _EVENT_ROWS, f"{KIND_EVENT} an inertial event, {KIND_CREEP} a creep episode "
@@ -115,9 +123,17 @@ DATASETS = {
                                                    "(NaN: a creep episode; before bk-catalog-7)"),
     "events/n_widest": ("count", _EVENT_ROWS, "the most blocks sliding at once (the nucleation's widest zone in a "
                                               "large event; 0: a creep episode, before bk-catalog-7)"),
+    "events/across_first": ("index", _EVENT_ROWS, "lowest position across strike that slipped (0..M-1 on a "
+                                                  "lattice; 0 on a chain, and in catalogs before bk-catalog-8)"),
+    "events/across_last": ("index", _EVENT_ROWS, "highest position across strike that slipped (as across_first)"),
     "tasks/point": ("index", _TASK_ROWS, "parameter point (position in the product of the [sweep] lists)"),
     "tasks/seed_index": ("index", _TASK_ROWS, "realisation of its point; task = point * run.seeds + seed_index"),
-    "tasks/N": ("count", _TASK_ROWS, "number of blocks of the chain"),
+    "tasks/N": ("count", _TASK_ROWS, "number of blocks of the chain (of a lattice: along strike)"),
+    "tasks/M": ("count", _TASK_ROWS, "blocks across strike (model.M: the lattice's rows; 1 for a chain, and in "
+                                     "catalogs before bk-catalog-8)"),
+    "tasks/l_across": ("1", _TASK_ROWS, "spring stiffness across strike (model.l_across; NaN for a chain)"),
+    "tasks/geometry": ("text", _TASK_ROWS, "how the blocks are joined (model.geometry); absent before "
+                                           "bk-catalog-8: chain"),
     "tasks/l": ("1", _TASK_ROWS, "inter-block spring stiffness l (l^2 relative to the driver spring)"),
     "tasks/nu": ("model length / model time", _TASK_ROWS, "loading velocity of the driver plate"),
     "tasks/law": ("text", _TASK_ROWS, "friction law (model.law); absent in catalogs written before there was a "

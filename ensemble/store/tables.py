@@ -62,6 +62,9 @@ def expected_parameters(tasks, spinups, law_keys):
            "l": np.array([t.model.l for t in tasks], dtype=np.float64),
            "nu": np.array([t.model.nu for t in tasks], dtype=np.float64),
            "law": np.array([t.model.law.encode() for t in tasks]),
+           "geometry": np.array([t.model.geometry.encode() for t in tasks]),
+           "M": np.array([t.model.M for t in tasks], dtype=np.int64),
+           "l_across": np.array([np.nan if t.model.l_across is None else t.model.l_across for t in tasks]),
            "branch_of": np.array([t.point if spinups else -1 for t in tasks], dtype=np.int64)}
     for name in law_keys:
         out[name] = np.array([np.nan if getattr(t.model, name, None) is None else getattr(t.model, name)
@@ -76,7 +79,7 @@ def config_problems(stored, expected):
         if name not in stored:
             continue      # (a column older catalogs lack: the reader fills it in)
         have = stored[name]
-        if name == "law":
+        if name in ("law", "geometry"):
             have = np.array([bytes(x).rstrip(b"\0") for x in have])
         if np.shape(have) != np.shape(values):
             wrong.append(f"/tasks/{name} ({len(have)} rows, the config has {len(values)} tasks)")

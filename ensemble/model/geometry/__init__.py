@@ -46,6 +46,7 @@ class Geometry:
     stiffness: object     # (g, i, n) -> K_ii: the loader's spring 1 and the springs to i's neighbours
     coupling: object      # (g, i, j) -> the spring between neighbours i and j (-K_ij)
     along: object         # (g, i) -> block i's position along strike (an event's first and last block)
+    across: object        # (g, i) -> its position across strike (0 on a chain)
     drop_stiffness: object    # (g, W, i, n) -> 1 and the springs from block i to neighbours that did not slip
                               # (W[j, Y] not > 0): the force an event's slip of i takes off i alone
     spring_energy: object     # (g, W, flag, i, n, stored, y) -> stored plus the energy of block i's springs,
@@ -123,6 +124,7 @@ around = _dispatch("around", "g, i, n")
 stiffness = _dispatch("stiffness", "g, i, n")
 coupling = _dispatch("coupling", "g, i, j")
 along = _dispatch("along", "g, i")
+across = _dispatch("across", "g, i")
 drop_stiffness = _dispatch("drop_stiffness", "g, W, i, n")
 spring_energy = _dispatch("spring_energy", "g, W, flag, i, n, stored, y")
 max_stiffness = _dispatch("max_stiffness", "g, n")

@@ -81,6 +81,11 @@ def along(g, i):
 
 
 @nb.njit(cache=True)
+def across(g, i):
+    return 0
+
+
+@nb.njit(cache=True)
 def drop_stiffness(g, W, i, n):
     outside = (1 if i > 0 and not W[i - 1, Y] > 0.0 else 0) + (1 if i < n - 1 and not W[i + 1, Y] > 0.0 else 0)
     return 1.0 + g.l2 * outside
@@ -212,5 +217,5 @@ def _record(model):
 
 
 GEOMETRY = Geometry("chain", ChainParams, _record, spring_force, spring_force_at, neighbours, around, stiffness,
-                    coupling, along, drop_stiffness, spring_energy, max_stiffness, cluster, stable, fastest_creep,
-                    creep_force, creep_load, creep_solve)
+                    coupling, along, across, drop_stiffness, spring_energy, max_stiffness, cluster, stable,
+                    fastest_creep, creep_force, creep_load, creep_solve)

@@ -322,11 +322,9 @@ def creep_solve(g, C, lst, m, n):
 
 
 def _record(model):
-    l_across = model.l if getattr(model, "l_across", None) is None else model.l_across
-    return LatticeParams(nx=int(model.N), ny=int(getattr(model, "M", 1)), l2=float(model.l) ** 2,
-                         l2y=float(l_across) ** 2)
+    return LatticeParams(nx=int(model.N), ny=int(model.M), l2=float(model.l) ** 2, l2y=float(model.l_across) ** 2)
 
 
 GEOMETRY = Geometry("lattice", LatticeParams, _record, spring_force, spring_force_at, neighbours, around, stiffness,
-                    coupling, along, drop_stiffness, spring_energy, max_stiffness, cluster, stable, fastest_creep,
-                    creep_force, creep_load, creep_solve)
+                    coupling, along, across, drop_stiffness, spring_energy, max_stiffness, cluster, stable,
+                    fastest_creep, creep_force, creep_load, creep_solve)
