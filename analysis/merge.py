@@ -31,6 +31,18 @@ from . import region as regions
 from .reduce import LAYOUT, PARAMS, reduce_tasks
 
 
+def _chains_only(path, tasks):
+    """The statistics measure distances along a chain: a catalog of another geometry is refused (a lattice's
+    statistics take their distances from the geometry: docs/design/geometry.md, step 9), and the geometry's
+    columns, a chain's defaults, are left out of the summary."""
+    other = sorted({str(name) for name in tasks["geometry"]} - {"chain"})
+    if other:
+        raise MergeError(f"{path}: a catalog of model.geometry = {other[0]!r}; the analysis reads chains only so far "
+                         f"(its statistics measure distances along a chain)")
+    for name in schema.GEOMETRY_TASKS:
+        tasks.pop(name, None)
+
+
 class MergeError(ValueError):
     """Catalogs that cannot be reduced together (the same trajectory twice); exit 2 like bad options."""
 
@@ -106,6 +118,7 @@ def read(paths, allow_partial=False, region=False, span=None, skip=0.0):
     for path in paths:
         with filekind.reading(path, "the event catalog", CatalogError):
             per_task, tasks, attrs = reader.read_tasks(path)
+        _chains_only(path, tasks)
         tasks["seed_entropy"], tasks["spawn_key"] = _streams(tasks, attrs["config"])
         tables.append(tasks)
         configs.append(str(attrs["config"]))

@@ -117,7 +117,8 @@ def _table_entry(name):
 DATASETS = {
     **{f"bins/{name}": (unit, f"({name} bins + 1,)", f"edges of the {what}, half-open [lo, hi), the last one too")
        for name, (unit, what) in _BINS.items()},
-    **{name: entry for name, entry in catalog_schema.DATASETS.items() if name.startswith("tasks/")},
+    **{name: entry for name, entry in catalog_schema.DATASETS.items()
+       if name.startswith("tasks/") and name[len("tasks/"):] not in catalog_schema.GEOMETRY_TASKS},
     **{f"tasks/{name}": entry for name, entry in catalog_schema.READER_TASKS.items()},
     # the columns a summary of one or more catalogs (analysis/merge.py) sets or adds
     "tasks/point": ("index", "(tasks,)", "parameter point the task pools into (row of /points)"),

@@ -172,17 +172,19 @@ def _run(args):
 
 def _compile(args):
     from . import compiled
-    from .model import laws
+    from .model import geometry, laws
     unknown = [name for name in args.law if name not in laws.LAWS]
     if unknown:
         raise ConfigError(f"--law {unknown[0]!r}: not a friction law (one of {', '.join(sorted(laws.LAWS))})")
     if args.jobs is not None and args.jobs < 1:
         raise ConfigError(f"--jobs {args.jobs}: must be at least 1")
     names = args.law or sorted(laws.LAWS)
-    jobs = min(args.jobs or compiled.default_jobs(), len(names))
-    print(f"compiling the kernels of {', '.join(names)} ({len(names)} law(s), {jobs} at once; about "
-          f"{compiled.SECONDS_PER_LAW} s a law where not yet compiled) into {compiled.cache_directory()}", flush=True)
-    return compiled.compile_laws(names, jobs, say=lambda line: print(line, flush=True))
+    shapes = sorted(geometry.GEOMETRIES, key=lambda name: name != geometry.DEFAULT)
+    jobs = min(args.jobs or compiled.default_jobs(), len(names) * len(shapes))
+    print(f"compiling the kernels of {', '.join(names)} on {', '.join(shapes)} ({len(names)} law(s) x "
+          f"{len(shapes)} geometries, {jobs} at once; about {compiled.SECONDS_PER_LAW} s a pair where not yet "
+          f"compiled) into {compiled.cache_directory()}", flush=True)
+    return compiled.compile_laws(names, jobs, say=lambda line: print(line, flush=True), geometries=shapes)
 
 
 def _slurm(args):

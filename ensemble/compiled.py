@@ -1,13 +1,14 @@
-"""The compiled kernels: compiling them ahead for every friction law, and saying so when a run must compile.
+"""The compiled kernels: compiling them ahead for every friction law and geometry, and saying so when a run must
+compile.
 
-The kernels are compiled once per friction law (the integration method is chosen inside them at run time,
-model/methods.py) into the package's numba cache (kernel_cache.py), in a minute or two per law. `make setup`
-runs `python -m ensemble compile`, which compiles every law of the registry, each in a process of its own
-(as many at once as there are cores), so that the first run of any law, method and regime loads them
-instead; a law already in the cache takes about 2 s to check.
+The kernels are compiled once per friction law and geometry (the integration method is chosen inside them at run
+time, model/methods.py) into the package's numba cache (kernel_cache.py), in a minute or two per pair. `make setup`
+runs `python -m ensemble compile`, which compiles every pair of the registries, each in a process of its own
+(as many at once as there are cores), so that the first run of any law, geometry, method and regime loads them
+instead; a pair already in the cache takes about 2 s to check.
 
-`warm(law)` calls every kernel entry point that a run, a checkpoint and the single-event API
-(ensemble.events) reach from Python, on a chain of a few blocks, with the types a run gives them.
+`warm(law, geometry)` calls every kernel entry point that a run, a checkpoint and the single-event API
+(ensemble.events) reach from Python, on a few blocks, with the types a run gives them.
 `announced(say, law)` is the run's guard: if numba starts compiling inside it, `say` gets one line saying
 so and how long it takes, and another when the kernels are ready.
 """
@@ -25,8 +26,9 @@ from numba.core import event as numba_event
 SECONDS_PER_LAW = 90
 
 
-def warm(law):
-    """Compile (or load from the cache) every kernel entry point for the friction law `law` (its name)."""
+def warm(law, geometry="chain"):
+    """Compile (or load from the cache) every kernel entry point for the friction law `law` and the geometry
+    `geometry` (their names)."""
     import numpy as np
 
     from . import events
@@ -35,7 +37,8 @@ def warm(law):
     from .sweep import task_list
 
     # the law's own method; one compilation serves every method (model/methods.py)
-    cfg = from_dict({"model": {"N": 4, "law": law}, "run": {"events": 2, "transient": 0, "seeds": 1}})
+    shape = {"N": 4} if geometry == "chain" else {"N": 4, "M": 2, "geometry": geometry}
+    cfg = from_dict({"model": {**shape, "law": law}, "run": {"events": 2, "transient": 0, "seeds": 1}})
     task = task_list(cfg)[0]
     trajectory = Trajectory(cfg, task)
     trajectory.advance(2)
@@ -77,16 +80,16 @@ def announced(say, law):
         say(f"kernels ready in {time.perf_counter() - listener.start:.0f} s")
 
 
-def compile_laws(names, jobs, say=print):
-    """Compile the kernels of the laws `names`, each in a process of its own, `jobs` at once; returns 0, or
-    1 if any failed (its output said)."""
-    pending = list(names)
+def compile_laws(names, jobs, say=print, geometries=("chain",)):
+    """Compile the kernels of the laws `names` on each of `geometries`, each pair in a process of its own, `jobs`
+    at once; returns 0, or 1 if any failed (its output said)."""
+    pending = [(name, geometry) for name in names for geometry in geometries]
     running = {}
     failed = []
     while pending or running:
         while pending and len(running) < jobs:
             name = pending.pop(0)
-            proc = subprocess.Popen([sys.executable, "-m", "ensemble.compiled", name], stdout=subprocess.PIPE,
+            proc = subprocess.Popen([sys.executable, "-m", "ensemble.compiled", *name], stdout=subprocess.PIPE,
                                     stderr=subprocess.STDOUT, text=True)
             running[proc] = (name, time.perf_counter())
         proc = _wait_any(running)
@@ -94,11 +97,12 @@ def compile_laws(names, jobs, say=print):
         out = proc.stdout.read()
         proc.stdout.close()
         seconds = time.perf_counter() - start
+        which = f"model.law = {name[0]!r}" + ("" if name[1] == "chain" else f", model.geometry = {name[1]!r}")
         if proc.returncode:
             failed.append(name)
-            say(f"model.law = {name!r}: compiling failed (exit {proc.returncode}):\n{out.rstrip()}")
+            say(f"{which}: compiling failed (exit {proc.returncode}):\n{out.rstrip()}")
         else:
-            say(f"model.law = {name!r}: {out.strip() or 'kernels compiled'} ({seconds:.0f} s)")
+            say(f"{which}: {out.strip() or 'kernels compiled'} ({seconds:.0f} s)")
     return 1 if failed else 0
 
 
@@ -122,13 +126,14 @@ def default_jobs():
     return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1))
 
 
-def _one(law):
-    """A child of compile_laws: compile one law, print what happened (compiled, or already in the cache)."""
+def _one(law, geometry):
+    """A child of compile_laws: compile one law on one geometry, print what happened (compiled, or already in the
+    cache)."""
     listener = _Compiles()
     numba_event.register("numba:compile", listener)
-    warm(law)
+    warm(law, geometry)
     print("kernels compiled" if listener.start is not None else "kernels already compiled (loaded from the cache)")
 
 
 if __name__ == "__main__":
-    _one(sys.argv[1])
+    _one(*sys.argv[1:3])

@@ -123,6 +123,7 @@ SEIS = {"seis_time_edges": np.linspace(-1000, 1000, 41), "seis_distance_edges": 
         "seis_near": 2.0, "seis_ring": 10.0, "seis_short": 50.0, "seis_long": 500.0}
 # the chain's parameters and every friction law's keys (NaN where a key is not the task's law's)
 PARAMS = ("N", "l", "nu", "a", "b", "c", "alpha", "sigma")
+GEOMETRY_TASKS = ("geometry", "M", "l_across")    # a catalog's columns of model.geometry (bk-catalog-8)
 MIN_SEEDS = 10
 
 # -- the documented peak rule, in one place (replace this block when the finder changes) -----
@@ -768,7 +769,8 @@ def expected_tasks(catalogs):
     for c, (path, _, tasks) in enumerate(catalogs):
         seed, _ = _catalog_facts(path)
         n = len(tasks["point"])
-        part = {name: np.asarray(values).copy() for name, values in tasks.items()}
+        # (a chain's geometry columns are not the summary's: the analysis reads chains only so far)
+        part = {name: np.asarray(values).copy() for name, values in tasks.items() if name not in GEOMETRY_TASKS}
         for k in range(n):
             if part["seed_entropy"][k] < 0 or part["spawn_key"][k] < 0:
                 part["seed_entropy"][k], part["spawn_key"][k] = seed, k

@@ -1,4 +1,4 @@
-"""The catalog of a chain that creeps (bk-catalog-7): inertial events and creep episodes as rows of
+"""The catalog of a chain that creeps (bk-catalog-8): inertial events and creep episodes as rows of
 /events (`kind`, `ending`), each record's creep state in its checkpoint slots where its chain can creep
 (/checkpoint/creep), statistics of the inertial events alone, and a run interrupted with creep in flight,
 or run on two ranks, that writes the uninterrupted serial catalog.
@@ -67,7 +67,7 @@ def tasks_of(tasks, b):
 def test_a_creeping_chain_writes_both_kinds_and_keeps_its_creep_state(creeping):
     d, _ = creeping
     events, tasks, attrs = reader.read(d / "full.h5")
-    assert attrs["format"] == schema.FORMAT == "bk-catalog-7"
+    assert attrs["format"] == schema.FORMAT == "bk-catalog-8"
     kind, ending = events["kind"], events["ending"]
     assert kind.dtype == ending.dtype == np.int8
     for k in tasks_of(tasks, CREEPING):

@@ -14,6 +14,7 @@ import numba
 import pytest
 
 from ensemble import compiled
+from ensemble.model import geometry, laws
 
 from .processes import ROOT, child_env, run_bounded
 
@@ -24,7 +25,8 @@ def test_a_run_after_compile_compiles_nothing(tmp_path):
     env = child_env(NUMBA_CACHE_DIR=str(tmp_path / "cache"))
     res = run_bounded([sys.executable, "-m", "ensemble", "compile"], 1200, cwd=ROOT, env=env)
     assert res.returncode == 0, res.stdout + res.stderr
-    assert res.stdout.count("kernels compiled (") == 3, res.stdout     # every law, into the empty cache
+    # every law on every geometry, into the empty cache
+    assert res.stdout.count("kernels compiled (") == len(laws.LAWS) * len(geometry.GEOMETRIES), res.stdout
     res = run_bounded([sys.executable, "-m", "benchmarks.first_run", "--in-process", "--N", "8", "--events", "3",
                        "--out", str(tmp_path)], 600, cwd=ROOT, env=env)
     assert res.returncode == 0, res.stdout + res.stderr
@@ -69,8 +71,9 @@ def test_compile_of_a_cached_law_says_so():
                       env=child_env())
     assert res.returncode == 0, res.stdout + res.stderr
     lines = res.stdout.strip().splitlines()
-    assert lines[0].startswith("compiling the kernels of carlson-langer (1 law(s)"), lines
-    assert lines[-1].startswith("model.law = 'carlson-langer': kernels "), lines
+    assert lines[0].startswith("compiling the kernels of carlson-langer on chain, lattice (1 law(s) x 2 "), lines
+    assert sorted(line.split(":")[0] for line in lines[1:]) == [
+        "model.law = 'carlson-langer'", "model.law = 'carlson-langer', model.geometry = 'lattice'"], lines
 
 
 def test_a_cache_built_in_one_checkout_serves_a_copy_elsewhere(tmp_path):

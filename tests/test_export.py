@@ -414,7 +414,9 @@ def test_every_dataset_of_a_catalog_and_a_summary_is_described(files):
     # no line for a dataset gone (/spinup exists with run.branch only: tests/test_branch.py)
     assert set(descriptions(files / "cat.h5")) == set(UNBRANCHED)
     assert_described(files / "cat.summary.h5", summary.DATASETS)
-    assert {name.split("/", 1)[1] for name in schema.DATASETS if name.startswith("tasks/")} <= set(
+    # every task column of the catalog is the summary's, but the geometry's (the analysis reads chains only so far)
+    assert {name.split("/", 1)[1] for name in schema.DATASETS if name.startswith("tasks/")} - set(
+        schema.GEOMETRY_TASKS) <= set(
         name.split("/", 1)[1] for name in descriptions(files / "cat.summary.h5") if name.startswith("tasks/"))
 
 

@@ -8,6 +8,8 @@ missing or swapped across strike changes every event; at b = 20 no block is stif
 stiffest, 1 + 2 l^2 + 2 l_y^2 = 13.5), so nothing creeps and the reference's inertial equations are the model's.
 nu = 1e-2 makes the loading periods short enough to integrate.
 """
+import sys
+
 import numpy as np
 import pytest
 
@@ -15,10 +17,15 @@ from ensemble.config import Integrator, Model
 from ensemble.integrators import kernel_params
 from ensemble.model.chain import simulate
 from ensemble.model.geometry.lattice import LatticeParams
+from ensemble.store import reader
 from ensemble.model.workspace import (D_DURATION, D_FIRST, D_KIND, D_LAST, D_NSLIP, D_SLIP, KIND_CREEP, NDIAG, OK,
                                      UNLIMITED, Workspace)
 
+from .conftest import run_cli, write_config
+from .processes import ROOT, child_env, run_bounded
 from .reference import displacements_for, reference_sequence
+from .same_catalogs import assert_same_events
+from .test_mpi import mpirun, start_and_interrupt
 
 NX, NY = 6, 5
 PLANE = {"l": 2.0, "nu": 1e-2, "a": 1.0, "b": 20.0, "c": 1000.0}
@@ -101,3 +108,74 @@ def test_plane_sequence_agrees_with_the_plain_integration(reference, method):
     assert np.all(np.abs(diag[:, D_DURATION] - reference["duration"][:n]) <= dur_atol)
     # the sequence has events of every kind: one block, the whole plane, between
     assert slipped.sum(axis=1).min() == 1 and slipped.sum(axis=1).max() == NX * NY
+
+
+# -- the run: model.geometry = "lattice" through config, ranks, catalog and resume -------------------------------
+
+@pytest.fixture(scope="module")
+def plane_run(tmp_path_factory):
+    """A plane of 10 x 8 blocks at b = 30 (its interior blocks, 1 + 4 l^2 = 37, creep; its edges, 28, do not) and
+    b = 45 (nothing creeps), two seeds each; the serial run's catalog."""
+    d = tmp_path_factory.mktemp("plane")
+    cfg = write_config(d / "plane.toml", model={"geometry": "lattice", "N": 10, "M": 8}, sweep={"b": [30.0, 45.0]},
+                       run={"seeds": 2, "events": 150, "transient": 30},
+                       output={"batch": 20, "flush_seconds": 0.25, "progress_seconds": 0.5})
+    res = run_cli("run", cfg, "-o", d / "serial.h5", timeout=900)
+    assert res.returncode == 0, res.stderr
+    return d, cfg
+
+
+def test_a_plane_runs_on_two_ranks_and_resumes_after_a_kill_to_the_same_catalog(plane_run):
+    """mpiexec -n 2 writes the serial run's catalog (real parallel HDF5 on the parallel stack), and so does a run
+    killed (-9) after its first committed batch and resumed; the catalog holds the plane: its tasks' geometry,
+    extents across strike, creep episodes where blocks are stiffer than their weakening."""
+    d, cfg = plane_run
+    res = mpirun(2, "run", cfg, "-o", d / "two.h5")
+    assert res.returncode == 0, res.stderr
+    assert_same_events(d / "serial.h5", d / "two.h5")
+    out = d / "killed.h5"
+    code, log = start_and_interrupt(cfg, out, "kill")
+    assert code != 0 and not out.exists(), log
+    res = mpirun(2, "run", cfg, "-o", out, "--resume")
+    assert res.returncode == 0, res.stderr
+    assert_same_events(d / "serial.h5", out)
+    events, tasks, attrs = reader.read(out)
+    assert attrs["format"] == "bk-catalog-8"
+    assert list(tasks["geometry"]) == ["lattice"] * 4 and list(tasks["M"]) == [8] * 4
+    assert list(tasks["l_across"]) == list(tasks["l"]) == [3.0] * 4
+    creep = events["kind"] == 1
+    soft = np.isin(events["task"], np.flatnonzero(tasks["b"] == 30.0))
+    assert creep[soft].sum() > 20 and not creep[~soft].any()
+    inertial = ~creep
+    assert np.all((0 <= events["across_first"]) & (events["across_first"] <= events["across_last"])
+                  & (events["across_last"] < 8) & (events["first"] <= events["last"]) & (events["last"] < 10))
+    width = events["across_last"] - events["across_first"] + 1
+    assert width[inertial].min() == 1 and width[inertial].max() == 8
+    # an event reaching no edge is interior; one reaching an edge across strike is not
+    edge = ((events["first"] == 0) | (events["last"] == 9) | (events["across_first"] == 0)
+            | (events["across_last"] == 7))
+    np.testing.assert_array_equal(events["boundary"], edge)
+
+
+def test_the_analysis_refuses_a_plane_in_one_line(plane_run, tmp_path):
+    """Its statistics measure distances along a chain: a lattice's catalog is refused, naming it, not reduced."""
+    d, _ = plane_run
+    res = run_bounded([sys.executable, "-m", "analysis", "reduce", str(d / "serial.h5"), "-o",
+                       str(tmp_path / "s.h5")], 120, cwd=ROOT, env=child_env())
+    assert res.returncode != 0 and not (tmp_path / "s.h5").exists()
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and "model.geometry = 'lattice'" in lines[0] and "serial.h5" in lines[0], lines
+
+
+@pytest.mark.parametrize("model, message", [
+    ({"M": 4}, "model.M belongs to model.geometry = 'lattice'"),
+    ({"l_across": 2.0}, "model.l_across belongs to model.geometry = 'lattice'"),
+    ({"geometry": "plane"}, "model.geometry must be one of chain, lattice, got 'plane'"),
+    ({"geometry": "lattice", "N": 1000, "M": 2000}, "model.N * model.M must be at most 1000000 blocks"),
+    ({"geometry": "lattice", "M": 0}, "model.M must be an integer in [1, 1000000], got 0")])
+def test_a_bad_geometry_is_one_line_naming_the_key(model, message, tmp_path):
+    cfg = write_config(tmp_path / "bad.toml", model=model)
+    res = run_cli("validate", cfg, timeout=60)
+    assert res.returncode == 2
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0], lines

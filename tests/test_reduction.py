@@ -146,7 +146,8 @@ def synthetic_events(rng, task, n, gridded):
             "n_slipped": (last - first + 1).astype(np.int64), "boundary": (first == 0) | (last == N_CHAIN - 1),
             "duration": rng.random(n) + 0.1, "kind": np.zeros(n, np.int8), "ending": np.zeros(n, np.int8),
             "stress_drop": drop, "n_onset": n_onset.astype(np.int64), "t_spread": t_spread, "t_widest": t_widest,
-            "n_widest": n_widest.astype(np.int64)}
+            "n_widest": n_widest.astype(np.int64), "across_first": np.zeros(n, np.int64),
+            "across_last": np.zeros(n, np.int64)}
 
 
 def write_catalog(path, config_text, written, seed):

@@ -80,6 +80,7 @@ TASK_FIELDS = {
     **{name: np.float64 for name in LAW_KEYS},
 }
 LAW_BYTES = 64        # /tasks/law and /tasks/geometry: fixed-length text
+GEOMETRY_TASKS = ("geometry", "M", "l_across")    # the task columns of model.geometry (bk-catalog-8)
 PROVENANCE_FIELDS = {
     "rank": np.int64, "wall_time": np.float64, "events_per_second": np.float64,
     "seed_entropy": np.int64, "spawn_key": np.int64,
