@@ -95,7 +95,7 @@ install_project() {
 
 compile_kernels() {   # every friction law's kernels into the package's numba cache (ensemble/compiled.py)
   local out rc=0
-  stage "compiling the kernels of every friction law (about a minute a law where not yet compiled, as many at once as there are cores; seconds when cached)"
+  stage "compiling the kernels of every friction law on every geometry (about a minute a pair where not yet compiled, as many at once as there are cores; seconds when cached)"
   out=$(mktemp)
   STEP_LOG=$out step "compiling the kernels" $VPY -m ensemble compile || rc=$?
   grep '^model.law' "$out" | sed 's/^/  /' || true
