@@ -33,11 +33,12 @@ def warm(law, geometry="chain"):
 
     from . import events
     from .config import from_dict
+    from .model import geometry as geometries
     from .run.trajectory import Trajectory
     from .sweep import task_list
 
     # the law's own method; one compilation serves every method (model/methods.py)
-    shape = {"N": 4} if geometry == "chain" else {"N": 4, "M": 2, "geometry": geometry}
+    shape = {"N": 4, "geometry": geometry, **({"M": 2} if "M" in geometries.get(geometry).keys else {})}
     cfg = from_dict({"model": {**shape, "law": law}, "run": {"events": 2, "transient": 0, "seeds": 1}})
     task = task_list(cfg)[0]
     trajectory = Trajectory(cfg, task)

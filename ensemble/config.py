@@ -42,10 +42,12 @@ class _Chain:
         if self.geometry not in geometry.GEOMETRIES:
             raise ConfigError(f"model.geometry must be one of {', '.join(sorted(geometry.GEOMETRIES))}, "
                               f"got {self.geometry!r}")
-        if self.geometry == "chain" and (self.M != 1 or self.l_across is not None):
-            key = "M" if self.M != 1 else "l_across"
-            raise ConfigError(f"model.{key} belongs to model.geometry = 'lattice' (a chain has one row)")
-        if self.geometry == "lattice" and self.l_across is None:
+        own = geometry.get(self.geometry).keys
+        for key, unset in geometry.KEYS.items():
+            if key not in own and getattr(self, key) != unset:
+                takers = ", ".join(repr(g.name) for g in geometry.GEOMETRIES.values() if key in g.keys)
+                raise ConfigError(f"model.{key} belongs to model.geometry = {takers} (not {self.geometry!r})")
+        if "l_across" in own and self.l_across is None:
             object.__setattr__(self, "l_across", self.l)
         if self.N * self.M > MAX_BLOCKS:
             raise ConfigError(f"model.N * model.M must be at most {MAX_BLOCKS} blocks, got {self.N} x {self.M}")

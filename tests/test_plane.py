@@ -168,8 +168,8 @@ def test_the_analysis_refuses_a_plane_in_one_line(plane_run, tmp_path):
 
 
 @pytest.mark.parametrize("model, message", [
-    ({"M": 4}, "model.M belongs to model.geometry = 'lattice'"),
-    ({"l_across": 2.0}, "model.l_across belongs to model.geometry = 'lattice'"),
+    ({"M": 4}, "model.M belongs to model.geometry = 'lattice' (not 'chain')"),
+    ({"l_across": 2.0}, "model.l_across belongs to model.geometry = 'lattice' (not 'chain')"),
     ({"geometry": "plane"}, "model.geometry must be one of chain, lattice, got 'plane'"),
     ({"geometry": "lattice", "N": 1000, "M": 2000}, "model.N * model.M must be at most 1000000 blocks"),
     ({"geometry": "lattice", "M": 0}, "model.M must be an integer in [1, 1000000], got 0")])

@@ -64,11 +64,15 @@ class Geometry:
     creep_solve: object   # (g, C, lst, m, n) -> -1 or the block of the first non-negative pivot: the creep's Newton
                           # update of the creeping blocks lst[:m] into CR_UPPER (Jacobian diagonal CR_DIAG, residual
                           # CR_RES, J[i, j] = K_ij h_j; pivots into CR_DIAG)
+    keys: tuple = ()      # the [model] keys of the geometry's shape it takes (of KEYS: "M", "l_across")
 
     def kernel_params(self, model):
         """The geometry's record for the kernels from a config's model section."""
         return self.record(model)
 
+
+# [model] keys a geometry may take (Geometry.keys) and their values when it does not: config.py refuses another
+KEYS = {"M": 1, "l_across": None}
 
 # what a cluster is made of (Geometry.cluster): creeping blocks (creep arrays C), or sliding ones (an event's flag)
 CREEPING = 0
@@ -83,24 +87,7 @@ def member(C, flag, kind, i):
     return flag[i] == SLIDING
 
 
-def _discover():
-    found = {}
-    for info in pkgutil.iter_modules(__path__):
-        geometry = getattr(importlib.import_module(f"{__name__}.{info.name}"), "GEOMETRY", None)
-        if isinstance(geometry, Geometry):
-            if geometry.name in found:
-                raise RuntimeError(f"two geometries named {geometry.name!r}")
-            found[geometry.name] = geometry
-    return found
-
-
-GEOMETRIES = _discover()        # name -> Geometry
-DEFAULT = "chain"
-_BY_PARAMS = {geometry.params: geometry for geometry in GEOMETRIES.values()}
-
-
-def get(name):
-    return GEOMETRIES[name]
+_BY_PARAMS = {}     # a geometry's record class -> the geometry (filled by the discovery below the calls)
 
 
 def _dispatch(name, args):
@@ -134,3 +121,23 @@ fastest_creep = _dispatch("fastest_creep", "g, C, n, nu, lst, m")
 creep_force = _dispatch("creep_force", "g, C, W, i, n, nu, h")
 creep_load = _dispatch("creep_load", "g, C, j, n, x")
 creep_solve = _dispatch("creep_solve", "g, C, lst, m, n")
+
+
+def _discover():
+    found = {}
+    for info in pkgutil.iter_modules(__path__):
+        geometry = getattr(importlib.import_module(f"{__name__}.{info.name}"), "GEOMETRY", None)
+        if isinstance(geometry, Geometry):
+            if geometry.name in found:
+                raise RuntimeError(f"two geometries named {geometry.name!r}")
+            found[geometry.name] = geometry
+    return found
+
+
+GEOMETRIES = _discover()        # name -> Geometry
+DEFAULT = "chain"
+_BY_PARAMS.update({geometry.params: geometry for geometry in GEOMETRIES.values()})
+
+
+def get(name):
+    return GEOMETRIES[name]

@@ -8,18 +8,16 @@ Block i sits at x = i % nx along strike, y = i // nx across it. The force on it 
 
 With ny = 1 every across-strike term is exactly +0.0 (a missing neighbour's slip is the block's own), so the lattice
 of one row computes the chain's numbers bit for bit; its creep clusters are then runs, solved by the chain's own
-tridiagonal algorithms (the same operations), and a plane's clusters by banded elimination in index order
-(`_band_*`, the band as wide as the cluster is along strike).
+tridiagonal algorithms (the same operations), and a plane's clusters by geometry/graph.py's banded elimination in
+index order (the band as wide as the cluster is along strike).
 """
 from collections import namedtuple
 
 import numba as nb
-import numpy as np
 
-from ..workspace import CR_DIAG, CR_DU, CR_EP, CR_H, CR_RES, CR_UPPER, CR_W, F0, UNTOUCHED, Y
+from ..workspace import CR_DU, CR_EP, F0, UNTOUCHED, Y
 from ..interpolant import slip_at
-from . import Geometry, member
-from . import chain
+from . import chain, graph
 
 
 class LatticeParams(namedtuple("LatticeParams", "nx ny l2 l2y")):
@@ -149,27 +147,8 @@ def max_stiffness(g, n):
     return stiffness(g, y * g.nx + x, n)
 
 
-# -- clusters: connected sets of blocks, found by a walk; a plane's solved by banded elimination in index order
-
-@nb.njit(cache=True)
-def cluster(g, C, flag, kind, n, j, out, seen):
-    """The connected blocks around j that are members of kind (j counted) into out[:m] in increasing order, each
-    marked in seen (the caller clears it); returns m. A walk over out as its queue."""
-    out[0] = j
-    seen[j] = 1
-    m = 1
-    k = 0
-    while k < m:
-        i = out[k]
-        k += 1
-        for q in neighbours(g, i, n):
-            if seen[q] == 0 and member(C, flag, kind, q):
-                seen[q] = 1
-                out[m] = q
-                m += 1
-    out[:m].sort()
-    return m
-
+# -- the creep phase's clusters: a plane's by the graph's banded elimination, one row's by the chain's own algorithms
+# (the same operations: one row is the chain bit for bit)
 
 @nb.njit(cache=True)
 def _as_chain(g):
@@ -177,86 +156,18 @@ def _as_chain(g):
 
 
 @nb.njit(cache=True)
-def _band_of(g, lst, m, n):
-    """(pos, bw): each block's position in the cluster lst[:m] (pos[i], -1 outside it) and the band's half
-    width in positions (the farthest neighbour in the list: at most nx)."""
-    pos = np.full(n, -1, dtype=np.int64)
-    for k in range(m):
-        pos[lst[k]] = k
-    bw = 1
-    for k in range(m):
-        i = lst[k]
-        for q in neighbours(g, i, n):
-            if q != i and pos[q] >= 0:
-                bw = max(bw, abs(pos[q] - k))
-    return pos, bw
-
-
-@nb.njit(cache=True)
-def _band_solve(B, rhs, m, bw, sign):
-    """Gaussian elimination without pivoting of the band matrix B (row k: columns k - bw .. k + bw at B[k, 0 ..
-    2 bw]) and the right-hand side rhs in place, rows in order; returns -1, or the first row whose pivot does not
-    have the sign `sign` (then nothing is solved). The pivots stay on B's diagonal B[k, bw]."""
-    for k in range(m):
-        for q in range(max(0, k - bw), k):
-            a = B[k, q - k + bw]
-            if a != 0.0:
-                mult = a / B[q, bw]
-                for c in range(q + 1, min(q + bw, m - 1) + 1):
-                    B[k, c - k + bw] -= mult * B[q, c - q + bw]
-                rhs[k] -= mult * rhs[q]
-                B[k, q - k + bw] = 0.0
-        if not sign * B[k, bw] > 0.0:
-            return k
-    for k in range(m - 1, -1, -1):
-        r = rhs[k]
-        for c in range(k + 1, min(k + bw, m - 1) + 1):
-            r -= B[k, c - k + bw] * rhs[c]
-        rhs[k] = r / B[k, bw]
-    return -1
-
-
-@nb.njit(cache=True)
-def _stiffness_band(g, C, lst, m, n, diag_less, scale_by_h):
-    """The cluster's K_C - diag(diag_less) as a band (scale_by_h: each column j times C[j, CR_H], the creep's
-    Jacobian J = -(K_C + ...) H, whose diagonal the caller sets), its positions and half width."""
-    pos, bw = _band_of(g, lst, m, n)
-    B = np.zeros((m, 2 * bw + 1))
-    for k in range(m):
-        i = lst[k]
-        B[k, bw] = stiffness(g, i, n) - diag_less[k]
-        for q in neighbours(g, i, n):
-            if q != i and pos[q] >= 0:
-                B[k, pos[q] - k + bw] = -coupling(g, i, q) * (C[q, CR_H] if scale_by_h else 1.0)
-    return B, bw
-
-
-@nb.njit(cache=True)
 def stable(g, C, n, lst, m):
-    """K_C - diag(C[lst, CR_W]) is positive definite: every pivot of its elimination positive."""
     if g.ny == 1:
         return chain.stable(_as_chain(g), C, n, lst, m)
-    less = np.empty(m)
-    for k in range(m):
-        less[k] = C[lst[k], CR_W]
-    B, bw = _stiffness_band(g, C, lst, m, n, less, False)
-    return _band_solve(B, np.zeros(m), m, bw, 1.0) < 0
+    return graph.stable(g, C, n, lst, m)
 
 
 @nb.njit(cache=True)
 def fastest_creep(g, C, n, nu, lst, m):
-    """C[lst, CR_RES] = (K_C - diag(max(CR_W, 0)))^-1 nu 1 for the stable cluster lst[:m]."""
     if g.ny == 1:
         chain.fastest_creep(_as_chain(g), C, n, nu, lst, m)
-        return
-    less = np.empty(m)
-    for k in range(m):
-        less[k] = max(C[lst[k], CR_W], 0.0)
-    B, bw = _stiffness_band(g, C, lst, m, n, less, False)
-    rhs = np.full(m, nu)
-    _band_solve(B, rhs, m, bw, 1.0)
-    for k in range(m):
-        C[lst[k], CR_RES] = rhs[k]
+    else:
+        graph.fastest_creep(g, C, n, nu, lst, m)
 
 
 @nb.njit(cache=True, inline="always")
@@ -296,35 +207,18 @@ def creep_load(g, C, j, n, x):
 
 @nb.njit(cache=True)
 def creep_solve(g, C, lst, m, n):
-    """The creep's Newton update of every creeping block lst[:m] (geometry/__init__.py): J = CR_DIAG on the
-    diagonal, K_ij h_j off it, over each cluster (the creeping blocks' band: clusters apart are not coupled)."""
     if g.ny == 1:
         return chain.creep_solve(_as_chain(g), C, lst, m, n)
-    less = np.zeros(m)
-    B, bw = _stiffness_band(g, C, lst, m, n, less, True)
-    rhs = np.empty(m)
-    for k in range(m):
-        i = lst[k]
-        B[k, bw] = C[i, CR_DIAG]
-        rhs[k] = C[i, CR_RES]
-    for k in range(m):
-        for c in range(2 * bw + 1):
-            if c != bw:
-                B[k, c] = -B[k, c]      # J[i, j] = +K_ij h_j (the band holds -K_ij h_j)
-    bad = _band_solve(B, rhs, m, bw, -1.0)
-    if bad >= 0:
-        return lst[bad]
-    for k in range(m):
-        i = lst[k]
-        C[i, CR_DIAG] = B[k, bw]
-        C[i, CR_UPPER] = rhs[k]
-    return -1
+    return graph.creep_solve(g, C, lst, m, n)
 
 
 def _record(model):
     return LatticeParams(nx=int(model.N), ny=int(model.M), l2=float(model.l) ** 2, l2y=float(model.l_across) ** 2)
 
 
-GEOMETRY = Geometry("lattice", LatticeParams, _record, spring_force, spring_force_at, neighbours, around, stiffness,
-                    coupling, along, across, drop_stiffness, spring_energy, max_stiffness, cluster, stable,
-                    fastest_creep, creep_force, creep_load, creep_solve)
+GEOMETRY = graph.geometry("lattice", LatticeParams, _record, neighbours=neighbours, around=around, stiffness=stiffness,
+                          coupling=coupling, along=along, across=across, max_stiffness=max_stiffness,
+                          spring_force=spring_force, spring_force_at=spring_force_at, drop_stiffness=drop_stiffness,
+                          spring_energy=spring_energy, stable=stable, fastest_creep=fastest_creep,
+                          creep_force=creep_force, creep_load=creep_load, creep_solve=creep_solve,
+                          keys=("M", "l_across"))
