@@ -126,7 +126,9 @@ NOT_QUICK = {   # test files with no test in the quick tier, and why
     "test_attacks.py": "every attack starts from a catalog of its own (7 s and more); the quick tier's flipped byte "
                        "is test_faults.py's",
     "test_histories.py": "every test reads catalogs of real runs with and without histories (about 20 s to make)",
-    "test_plane.py": "compiles the lattice's kernels of three methods (about a minute each on an empty cache)",
+    "test_plane.py": "every test runs a plane: a plain full-lattice integration, runs on two ranks and a killed one "
+                     "(about 30 s in all)",
+    "test_third_geometry.py": "compiles a copy of the package with a third geometry (about a minute)",
 }
 
 
