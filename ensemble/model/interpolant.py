@@ -14,7 +14,7 @@ def hermite(x, y0, y1, d0, d1):
             + (3 * x2 - 2 * x3) * y1 + (x3 - x2) * d1)
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def slip_at(W, flag, j, x):
     """Slip of block j at fraction x of the current step (Hermite if it slides)."""
     if flag[j] != SLIDING:

@@ -47,7 +47,7 @@ def spring_force(g, W, col, i, n, F0, tau, nu):
     return spring_force_of(F0, tau, nu, g.l2, W[left(i), col], W[i, col], W[right(i, n), col])
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def spring_force_at(g, W, flag, x, i, n, F0, tau, nu):
     yl = slip_at(W, flag, left(i), x)
     yr = slip_at(W, flag, right(i, n), x)
