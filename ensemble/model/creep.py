@@ -33,7 +33,7 @@ import numba as nb
 import numpy as np
 
 from .geometry import (CREEPING, SLIDING_NOW, across, along, around, cluster, coupling, creep_force, creep_load,
-                       creep_solve, fastest_creep, max_stiffness, neighbours, stable, stiffness)
+                       creep_solve, creeping, fastest_creep, max_stiffness, neighbours, stable, stiffness)
 from .laws import (creep_state, creep_weakening, creeps, friction, friction_slopes, onset_delay, rest_state, state_rate,
                    threshold)
 from .schedule import advance_clock, materialize, onset_key, tree_min, tree_set
@@ -84,11 +84,6 @@ def loaded_past_threshold(p, n, psi):
     kernels treat it as they always have: an event, in which it stays pressed without slipping."""
     dt = 2.0 * math.pi / math.sqrt(max_stiffness(p.geom, n))
     return p.nu * dt > threshold(p.law, rest_state(p.law, psi, dt)) - threshold(p.law, psi)
-
-
-@nb.njit(cache=True, inline="always")
-def creeping(C, i):
-    return C[i, CR_EP] != 0.0
 
 
 @nb.njit(cache=True)

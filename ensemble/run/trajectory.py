@@ -125,6 +125,14 @@ class Trajectory:
                 "dropped": int(hctl[HC_DROPPED])}
 
 
+def _boundary(model, first, last, across_first, across_last):
+    """The rupture reached an end of the chain, or on a lattice an edge along or across strike."""
+    edge = (first == 0) | (last == model.N - 1)
+    if model.M > 1:
+        edge |= (across_first == 0) | (across_last == model.M - 1)
+    return edge
+
+
 def event_rows(task, t, epicenter, diag):
     """Kernel output -> catalog columns (EVENT_FIELDS, ensemble/store/schema.py)."""
     first = diag[:, D_FIRST].astype(np.int64)
@@ -135,8 +143,7 @@ def event_rows(task, t, epicenter, diag):
         "task": np.full(len(t), task.index, dtype=np.int64), "t": t, "epicenter": epicenter,
         "mu": np.log10(diag[:, D_SLIP]), "slip": diag[:, D_SLIP], "first": first, "last": last,
         "n_slipped": diag[:, D_NSLIP].astype(np.int64),
-        "boundary": ((first == 0) | (last == task.model.N - 1) | (across_first == 0 if task.model.M > 1 else False)
-                     | (across_last == task.model.M - 1 if task.model.M > 1 else False)),
+        "boundary": _boundary(task.model, first, last, across_first, across_last),
         "duration": diag[:, D_DURATION],
         "kind": diag[:, D_KIND].astype(np.int8), "ending": diag[:, D_ENDING].astype(np.int8),
         "stress_drop": diag[:, D_STRESS_DROP], "n_onset": diag[:, D_N_ONSET].astype(np.int64),

@@ -80,10 +80,16 @@ SLIDING_NOW = 1
 
 
 @nb.njit(cache=True, inline="always")
+def creeping(C, i):
+    """Block i creeps (the creep arrays C: it belongs to an episode)."""
+    return C[i, CR_EP] != 0.0
+
+
+@nb.njit(cache=True, inline="always")
 def member(C, flag, kind, i):
     """Block i belongs to a cluster of this kind."""
     if kind == CREEPING:
-        return C[i, CR_EP] != 0.0
+        return creeping(C, i)
     return flag[i] == SLIDING
 
 

@@ -8,9 +8,9 @@ from collections import namedtuple
 
 import numba as nb
 
-from ..workspace import CR_DIAG, CR_DU, CR_EP, CR_H, CR_RES, CR_UPPER, CR_W, F0, UNTOUCHED, Y
+from ..workspace import CR_DIAG, CR_DU, CR_H, CR_RES, CR_UPPER, CR_W, F0, UNTOUCHED, Y
 from ..interpolant import slip_at
-from . import Geometry, member
+from . import Geometry, creeping, member
 
 
 class ChainParams(namedtuple("ChainParams", "l2")):
@@ -111,11 +111,6 @@ def max_stiffness(g, n):
 # -- clusters: a cluster of the chain is a run of neighbouring blocks lo..hi, its stiffness matrix tridiagonal
 
 @nb.njit(cache=True)
-def _creeping(C, i):
-    return C[i, CR_EP] != 0.0
-
-
-@nb.njit(cache=True)
 def cluster(g, C, flag, kind, n, j, out, seen):
     """The run of blocks around j that are members of kind (j counted) into out[:m] in increasing order, each
     marked in seen (the caller clears it); returns m."""
@@ -173,8 +168,8 @@ def fastest_creep(g, C, n, nu, lst, m):
 @nb.njit(cache=True)
 def creep_force(g, C, W, i, n, nu, h):
     """The force on creeping block i at the end of its creep step h, its creeping neighbours' slips CR_DU in."""
-    du_l = C[i - 1, CR_DU] if i > 0 and _creeping(C, i - 1) else 0.0
-    du_r = C[i + 1, CR_DU] if i < n - 1 and _creeping(C, i + 1) else 0.0
+    du_l = C[i - 1, CR_DU] if i > 0 and creeping(C, i - 1) else 0.0
+    du_r = C[i + 1, CR_DU] if i < n - 1 and creeping(C, i + 1) else 0.0
     return W[i, F0] + nu * h - stiffness(g, i, n) * C[i, CR_DU] + g.l2 * (du_l + du_r)
 
 
@@ -183,7 +178,7 @@ def creep_load(g, C, j, n, x):
     """The force on resting block j from x of its creeping neighbours' slips CR_DU."""
     slip = 0.0
     for k in (left(j), right(j, n)):
-        if k != j and _creeping(C, k):
+        if k != j and creeping(C, k):
             slip += C[k, CR_DU]
     return g.l2 * x * slip
 
@@ -197,7 +192,7 @@ def creep_solve(g, C, lst, m, n):
     l2 = g.l2
     for k in range(m):
         i = lst[k]
-        if i > 0 and _creeping(C, i - 1):
+        if i > 0 and creeping(C, i - 1):
             mult = l2 * C[i - 1, CR_H] / C[i - 1, CR_DIAG]     # J[i, i-1] / pivot[i-1]
             C[i, CR_DIAG] -= mult * l2 * C[i, CR_H]             # J[i-1, i] = l2 h_i
             C[i, CR_RES] -= mult * C[i - 1, CR_RES]
@@ -206,7 +201,7 @@ def creep_solve(g, C, lst, m, n):
     for k in range(m - 1, -1, -1):
         i = lst[k]
         r = C[i, CR_RES]
-        if i < n - 1 and _creeping(C, i + 1):
+        if i < n - 1 and creeping(C, i + 1):
             r -= l2 * C[i + 1, CR_H] * C[i + 1, CR_UPPER]
         C[i, CR_UPPER] = r / C[i, CR_DIAG]
     return -1

@@ -13,8 +13,8 @@ import numba as nb
 import numpy as np
 
 from ..interpolant import slip_at
-from ..workspace import CR_DIAG, CR_DU, CR_EP, CR_H, CR_RES, CR_UPPER, CR_W, F0, UNTOUCHED, Y
-from . import Geometry, coupling, member, neighbours, stiffness
+from ..workspace import CR_DIAG, CR_DU, CR_H, CR_RES, CR_UPPER, CR_W, F0, UNTOUCHED, Y
+from . import Geometry, coupling, creeping, member, neighbours, stiffness
 
 
 @nb.njit(cache=True)
@@ -177,17 +177,12 @@ def creep_solve(g, C, lst, m, n):
     return -1
 
 
-@nb.njit(cache=True, inline="always")
-def _creeping(C, i):
-    return C[i, CR_EP] != 0.0
-
-
 @nb.njit(cache=True)
 def creep_force(g, C, W, i, n, nu, h):
     """The force on creeping block i after its creep step h, its creeping neighbours' slips CR_DU in."""
     force = W[i, F0] + nu * h - stiffness(g, i, n) * C[i, CR_DU]
     for j in neighbours(g, i, n):
-        if j != i and _creeping(C, j):
+        if j != i and creeping(C, j):
             force += coupling(g, i, j) * C[j, CR_DU]
     return force
 
@@ -197,7 +192,7 @@ def creep_load(g, C, j, n, x):
     """The force on resting block j from x of its creeping neighbours' slips CR_DU."""
     load = 0.0
     for k in neighbours(g, j, n):
-        if k != j and _creeping(C, k):
+        if k != j and creeping(C, k):
             load += coupling(g, j, k) * C[k, CR_DU]
     return x * load
 

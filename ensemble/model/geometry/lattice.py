@@ -15,9 +15,9 @@ from collections import namedtuple
 
 import numba as nb
 
-from ..workspace import CR_DU, CR_EP, F0, UNTOUCHED, Y
+from ..workspace import CR_DU, F0, UNTOUCHED, Y
 from ..interpolant import slip_at
-from . import chain, graph
+from . import chain, creeping, graph
 
 
 class LatticeParams(namedtuple("LatticeParams", "nx ny l2 l2y")):
@@ -171,14 +171,9 @@ def fastest_creep(g, C, n, nu, lst, m):
 
 
 @nb.njit(cache=True, inline="always")
-def _creeping(C, i):
-    return C[i, CR_EP] != 0.0
-
-
-@nb.njit(cache=True, inline="always")
 def _creep_slip(C, i, j):
     """A creep step's slip CR_DU of neighbour j of block i if it creeps (0 if it does not or is missing)."""
-    return C[j, CR_DU] if j != i and _creeping(C, j) else 0.0
+    return C[j, CR_DU] if j != i and creeping(C, j) else 0.0
 
 
 @nb.njit(cache=True)
@@ -196,11 +191,11 @@ def creep_load(g, C, j, n, x):
     """The force on resting block j from x of its creeping neighbours' slips CR_DU."""
     slip_x = 0.0
     for k in (left(g, j), right(g, j)):
-        if k != j and _creeping(C, k):
+        if k != j and creeping(C, k):
             slip_x += C[k, CR_DU]
     slip_y = 0.0
     for k in (down(g, j), up(g, j, n)):
-        if k != j and _creeping(C, k):
+        if k != j and creeping(C, k):
             slip_y += C[k, CR_DU]
     return g.l2 * x * slip_x + g.l2y * x * slip_y
 
