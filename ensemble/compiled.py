@@ -29,7 +29,10 @@ SECONDS_PER_LAW = 90
 def warm(law, geometry="chain"):
     """Compile (or load from the cache) every kernel entry point for the friction law `law` and the geometry
     `geometry` (their names)."""
+    import warnings
+
     import numpy as np
+    from numba.core.errors import NumbaIRAssumptionWarning
 
     from . import events
     from .config import from_dict
@@ -41,12 +44,16 @@ def warm(law, geometry="chain"):
     shape = {"N": 4, "geometry": geometry, **({"M": 2} if "M" in geometries.get(geometry).keys else {})}
     cfg = from_dict({"model": {**shape, "law": law}, "run": {"events": 2, "transient": 0, "seeds": 1}})
     task = task_list(cfg)[0]
-    trajectory = Trajectory(cfg, task)
-    trajectory.advance(2)
-    trajectory.checkpoint()
-    force, psi = trajectory.state()
-    epicenter, _, force, psi = events.advance_to_onset(force, psi, task.model)
-    events.run_event(force, psi, epicenter, task.model, cfg.integrator, trace=np.zeros((4, events.NTRACE)))
+    # numba's own inlining (inline="always") into a loop has put variables out of scope and dropped a loop's
+    # stores in these kernels (docs/design/geometry.md): compiled code numba itself doubts is an error here
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", NumbaIRAssumptionWarning)
+        trajectory = Trajectory(cfg, task)
+        trajectory.advance(2)
+        trajectory.checkpoint()
+        force, psi = trajectory.state()
+        epicenter, _, force, psi = events.advance_to_onset(force, psi, task.model)
+        events.run_event(force, psi, epicenter, task.model, cfg.integrator, trace=np.zeros((4, events.NTRACE)))
 
 
 class _Compiles(numba_event.Listener):

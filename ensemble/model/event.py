@@ -349,7 +349,9 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
         for k in range(na):
             i = act[k]
             for j in neighbours(p.geom, i, n):
-                if j != i and above_threshold(W, flag, n, j, tau + h, p):
+                # the flag first, here: a call per sliding neighbour (its arrays' reference counts) took a
+                # quarter of a 32 x 32 plane's events (docs/plane.md, cost)
+                if j != i and flag[j] != SLIDING and above_threshold(W, flag, n, j, tau + h, p):
                     x = locate(ONSET_NEIGHBOUR, W, flag, n, j, tau, h, 0.0, 0.0, 0.0, 0.0, p)
                     if x < x_cut:
                         x_cut, who, kind = x, j, ONSET_NEIGHBOUR
@@ -414,7 +416,7 @@ def continue_event(arrays, t0, n, p, profile, trace, budget):
         for k in range(m + nstuck):
             i = act[k] if k < m else stuck[k - m]
             for j in neighbours(p.geom, i, n):
-                if j != i and above_threshold(W, flag, n, j, tau, p):
+                if j != i and flag[j] != SLIDING and above_threshold(W, flag, n, j, tau, p):
                     na, nt, yrest = _start(arrays, na, nt, t0, p, j, tau, yrest)
         # -- the hand-back: sliding blocks slow enough to creep stop here and creep from here on
         # (creep.slow_enough, creep.after_event)

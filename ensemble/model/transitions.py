@@ -35,19 +35,19 @@ def rest_psi(W, j, tau, p):
     return rest_state(p.law, W[j, P], tau - W[j, TR])
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def force_now(W, n, j, tau, p):
     """Force on block j at local time tau, with the slips of the blocks as they are now."""
     return spring_force(p.geom, W, Y, j, n, W[j, F0], tau, event_nu(p))
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def _excess_now(W, n, j, tau, p):
     """Force above the static threshold of resting block j at the current time."""
     return force_now(W, n, j, tau, p) - threshold(p.law, rest_psi(W, j, tau, p))
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def above_threshold(W, flag, n, j, tau, p):
     """Block j is at rest and its force exceeds the static threshold at local time tau."""
     # Cheap filter first: the threshold of a resting block never falls (laws/__init__.py), so a
@@ -109,6 +109,9 @@ def locate(kind, W, flag, n, j, tau, h, v0, v1, d0, d1, p):
     return hi
 
 
+# Not inlined by numba: inside `locate`'s bisection loop numba's inlining puts spring_force_at's variables out of
+# scope (a NumbaIRAssumptionWarning, an error in `python -m ensemble compile`); the reference counts of a call
+# cost a plane's events about 8 %.
 @nb.njit(cache=True)
 def _excess(W, flag, n, j, tau, h, x, p):
     """Force above the static threshold of resting block j at fraction x of the step."""

@@ -57,7 +57,7 @@ def spring_force(g, W, col, i, n, F0_, tau, nu):
                   W[down(g, i), col], W[up(g, i, n), col])
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def spring_force_at(g, W, flag, x, i, n, F0_, tau, nu):
     yl = slip_at(W, flag, left(g, i), x)
     yr = slip_at(W, flag, right(g, i), x)
