@@ -20,14 +20,15 @@ from .creep_reference import inertial, on_the_manifold, stiffness
 L = 3.0
 
 
-def creep_path(n, b, nu, state, t_end, tol=1e-6, creeping=(1, 2, 3), budget=3, a=0.0):
+def creep_path(n, b, nu, state, t_end, tol=1e-6, creeping=(1, 2, 3), budget=3, a=0.0, K=None, params=None):
     """Run the kernel from `state` (force, psi) in calls of a small work budget (about one creep step
     each) until the time t_end; returns the creep's time at each call's end and, there, the slips of the creeping blocks
-    (from their forces: nothing else moves), their psi and creep velocities. No event may happen."""
-    K = stiffness(n, L)
+    (from their forces: nothing else moves), their psi and creep velocities. No event may happen. The chain of n
+    blocks at l = L, or the geometry of the kernels' record `params` with the stiffness matrix K."""
+    K = stiffness(n, L) if K is None else K
     C = list(creeping)
     force0, psi0 = state
-    p = kernel_params(Model(N=n, l=L, b=b, a=a, nu=nu), Integrator(creep_tol=tol))
+    p = kernel_params(Model(N=n, l=L, b=b, a=a, nu=nu), Integrator(creep_tol=tol)) if params is None else params
     ws = Workspace(n)
     ws.load(force0, psi0)
     clock = np.zeros(2)

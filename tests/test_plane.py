@@ -110,6 +110,42 @@ def test_plane_sequence_agrees_with_the_plain_integration(reference, method):
     assert slipped.sum(axis=1).min() == 1 and slipped.sum(axis=1).max() == NX * NY
 
 
+# A creeping cluster on a plane of 5 x 4 (l = 2, l_y = 1.5, b = 5.5): an edge block and a T of four interior ones, so
+# the cluster is no interval, its springs run along and across strike, and the Newton's banded elimination meets
+# fill-in; its K_C - b I has lambda_min 1.6 (stable), its resting neighbours stay far below their thresholds.
+CREEP_NX, CREEP_NY, CREEP_B, CREEP_NU = 5, 4, 5.5, 1e-3
+CREEP_CLUSTER = [1, 6, 7, 8, 12]
+
+
+def test_a_creeping_cluster_on_a_plane_follows_the_full_equations():
+    """The kernel's creep of a cluster across strike against scipy's solution of the cluster's full inertial
+    equations (tests/creep_reference.py with the plane's stiffness matrix from tests/reference.py: no package
+    code) over 1 / nu, the time its state takes to relax (psi by 0.16 to 0.48, velocities by 14-18 %): slips,
+    velocities and psi to the chain's bounds (tests/test_creep.py; measured 1.7e-4, 2.4e-4, 1.1e-4). A wrong
+    Jacobian in the Newton's elimination only slows its convergence; a wrong residual fails here
+    (tests/mutations.py lattice-creep-across-spring)."""
+    from .creep_reference import inertial, on_the_manifold
+    from .reference import stiffness_matrix
+    from .test_creep import creep_path
+    n, C = CREEP_NX * CREEP_NY, CREEP_CLUSTER
+    K = stiffness_matrix(n, PLANE["l"], CREEP_NX, L_Y)
+    R = np.setdiff1d(np.arange(n), C)
+    psi_c = np.log(CREEP_B / CREEP_NU) + np.array([0.8, 1.0, 1.5, 1.2, 1.1])
+    u, v, psi = on_the_manifold(K, C, CREEP_B, CREEP_NU, psi_c, np.zeros(len(R)))
+    model = Model(N=CREEP_NX, l=PLANE["l"], a=0.0, b=CREEP_B, nu=CREEP_NU)
+    params = lattice_params(model, {"creep_tol": 1e-6}, CREEP_NX, CREEP_NY, L_Y)
+    times, slips, psis, vs = creep_path(n, CREEP_B, CREEP_NU, (-(K @ u), psi), 1.0 / CREEP_NU, 1e-6, creeping=C,
+                                        K=K, params=params)
+    t_ref, ur, vr, pr, rest = inertial(K, C, 0.0, CREEP_B, CREEP_NU, u, v, psi, times[-1], times)
+    assert np.all(rest < CREEP_B * psi[R]), "a neighbour would have started"
+    slip_err = np.max(np.abs(slips - (ur - u[C]))) / np.max(np.abs(ur - u[C]))
+    late = slice(len(times) // 10, None)        # the kernel starts from rest, the reference on the manifold
+    v_err = np.max(np.abs(vs[late] / vr[late] - 1))
+    psi_err = np.max(np.abs(psis - pr))
+    assert abs(pr[-1, 2] - pr[0, 2]) > 0.4 and abs(vr[-1, 2] / vr[0, 2] - 1) > 0.15, "the comparison is not trivial"
+    assert slip_err < 5e-4 and v_err < 1e-3 and psi_err < 1.5e-4, (slip_err, v_err, psi_err)
+
+
 # -- the run: model.geometry = "lattice" through config, ranks, catalog and resume -------------------------------
 
 @pytest.fixture(scope="module")
