@@ -71,12 +71,14 @@ def parse_setting(text, baselines=()):
     return setting
 
 
-def trajectory(N, b, setting, seed_index, seeds, root_seed=0):
-    """A fresh chain (task `seed_index` of `seeds`) integrated with a kernel setting.
+def trajectory(N, b, setting, seed_index, seeds, root_seed=0, M=None):
+    """A fresh chain (task `seed_index` of `seeds`) integrated with a kernel setting; with M, a plane of N x M
+    blocks (model.geometry = "lattice").
 
     The initial state depends only on (root_seed, seed_index), not on the setting.
     """
-    cfg = Config(model=Model(N=N, b=b), run=Run(seeds=seeds, seed=root_seed),
+    shape = {} if M is None else {"geometry": "lattice", "M": M}
+    cfg = Config(model=Model(N=N, b=b, **shape), run=Run(seeds=seeds, seed=root_seed),
                  integrator=setting.integrator())
     return Trajectory(cfg, task_list(cfg)[seed_index])
 

@@ -67,7 +67,7 @@ def main():
         t, _, diag = traj.advance(args.events)
     elapsed, cpu = time.perf_counter() - start, time.process_time() - cpu
     balance = energy.balance(before, (traj.state()[0], traj.clock.sum(), traj.ws.episodes_in_flight()), t, diag,
-                             args.nu, cfg.model.l)
+                             cfg.model)
     kind = diag[:, D_KIND]
     block_steps = diag[:, D_BLOCK_STEPS].sum()      # (creep steps count their creeping blocks alike)
     creep = diag[diag[:, D_KIND] == KIND_CREEP]

@@ -5,6 +5,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .config import Integrator
+from .energy import stiffness_product
 from .integrators import kernel_params
 from .model import laws
 from .model.event import integrate_event
@@ -54,9 +55,13 @@ def relative_energy_residual(residual, scale):
 def physical_state(u, theta, t, model):
     """Displacements u_i, states theta_i at time t -> (force, psi) in the c-free frame.
 
-    force_i = (nu t - u_i) + l^2 (u_{i+1} - 2 u_i + u_{i-1}) - c with free ends.
+    force_i = (nu t - u_i) + l^2 (u_{i+1} - 2 u_i + u_{i-1}) - c with free ends on the chain, nu t - (K u)_i - c
+    with the springs of another geometry (energy.stiffness_product).
     """
     u = np.asarray(u, dtype=float)
+    if model.geometry != "chain":
+        return (model.nu * t - stiffness_product(u, model) - (model.c if model.c is not None else 0.0),
+                np.log(np.asarray(theta, dtype=float)))
     lap = np.zeros_like(u)
     lap[:-1] += u[1:] - u[:-1]
     lap[1:] += u[:-1] - u[1:]

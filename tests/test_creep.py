@@ -159,14 +159,15 @@ def test_a_run_of_creep_and_events_keeps_the_energy_balance(method):
     at creep_tol = 1e-6, falling as sqrt(creep_tol)). The creep rows carry their work: at the friction b psi of a
     creeping block per unit slip, and the driver's work on a slip made within the episode."""
     n, b, nu, count = 40, 15.0, 1e-3, 300
-    p = kernel_params(Model(N=n, l=L, b=b, nu=nu), Integrator(method=method))
+    model = Model(N=n, l=L, b=b, nu=nu)
+    p = kernel_params(model, Integrator(method=method))
     ws = Workspace(n)
     ws.load(np.random.default_rng(1).uniform(0, 1, n) * b * 20, np.full(n, 20.0))
     clock = np.zeros(2)
     start = (ws.state(clock, p)[0], 0.0, ws.episodes_in_flight())
     t, e, d = np.empty(count), np.empty(count, dtype=np.int64), np.empty((count, NDIAG))
     assert simulate(ws.arrays, clock, p, count, UNLIMITED, t, e, d) == (OK, count)
-    balance = energy.balance(start, (ws.state(clock, p)[0], clock.sum(), ws.episodes_in_flight()), t, d, nu, L)
+    balance = energy.balance(start, (ws.state(clock, p)[0], clock.sum(), ws.episodes_in_flight()), t, d, model)
     creeps, events = d[d[:, D_KIND] == KIND_CREEP], d[d[:, D_KIND] == KIND_EVENT]
     assert len(creeps) > 150 and len(events) > 50
     assert abs(balance.residual) < 2e-6 * abs(balance.load_work), balance   # measured 5.0e-7 (ark4), 3.4e-7 (exp4)

@@ -146,6 +146,39 @@ def test_a_creeping_cluster_on_a_plane_follows_the_full_equations():
     assert slip_err < 5e-4 and v_err < 1e-3 and psi_err < 1.5e-4, (slip_err, v_err, psi_err)
 
 
+def test_a_plane_run_of_creep_and_events_keeps_the_energy_balance():
+    """Over 300 rows of an 8 x 6 plane at b = 30 (its interior, stiffness 37, creeps; its edges, 28, do not), the
+    driver's work equals the change of the elastic energy F K^-1 F / 2 (ensemble/energy.py: conjugate gradients on
+    the plane's K from its springs, here also against a dense solve with tests/reference.py's K) plus the friction
+    work of every row, events and creep episodes (measured 1.4e-7 of the driver's work); events.physical_state
+    gives the forces of displacements from tests/reference.py back."""
+    from ensemble import energy
+    from .reference import stiffness_matrix
+    model = Model(N=8, M=6, geometry="lattice", l=3.0, l_across=2.5, b=30.0, nu=1e-3)
+    n, count = 48, 300
+    p = kernel_params(model, Integrator(method="exp4"))
+    ws = Workspace(n)
+    ws.load(np.random.default_rng(1).uniform(0, 1, n) * model.b * 20, np.full(n, 20.0))
+    clock = np.zeros(2)
+    force0 = ws.state(clock, p)[0]
+    K = stiffness_matrix(n, model.l, 8, model.l_across)
+    assert energy.elastic_energy(force0, model) == pytest.approx(0.5 * force0 @ np.linalg.solve(K, force0),
+                                                                 rel=1e-12)
+    # the physical state of the same forces (events.physical_state) gives them back
+    from ensemble.events import physical_state
+    from .reference import displacements_for
+    u = displacements_for(force0, 2.5e3, model, nx=8, l_y=model.l_across)
+    np.testing.assert_allclose(physical_state(u, np.ones(n), 2.5e3, model)[0], force0, rtol=1e-9, atol=1e-9)
+    start = (force0, 0.0, ws.episodes_in_flight())
+    t, e, d = np.empty(count), np.empty(count, dtype=np.int64), np.empty((count, NDIAG))
+    assert simulate(ws.arrays, clock, p, count, UNLIMITED, t, e, d) == (OK, count)
+    balance = energy.balance(start, (ws.state(clock, p)[0], clock.sum(), ws.episodes_in_flight()), t, d, model)
+    kinds = d[:, D_KIND]
+    assert np.sum(kinds == KIND_CREEP) > 50 and np.sum(kinds != KIND_CREEP) > 50, np.bincount(kinds.astype(int))
+    print(f"relative residual {abs(balance.residual) / abs(balance.load_work):.1e}")
+    assert abs(balance.residual) < 2e-6 * abs(balance.load_work), balance
+
+
 # -- the run: model.geometry = "lattice" through config, ranks, catalog and resume -------------------------------
 
 @pytest.fixture(scope="module")

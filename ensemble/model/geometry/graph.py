@@ -38,6 +38,19 @@ def spring_force_at(g, W, flag, x, i, n, F0, tau, nu):
 
 
 @nb.njit(cache=True)
+def stiffness_times(g, x, out):
+    """out = K x: the loader's spring and every spring of the geometry (the Python side's energy and physical
+    state, ensemble/energy.py; any geometry, through its neighbours and springs)."""
+    n = x.shape[0]
+    for i in range(n):
+        f = stiffness(g, i, n) * x[i]
+        for j in neighbours(g, i, n):
+            if j != i:
+                f -= coupling(g, i, j) * x[j]
+        out[i] = f
+
+
+@nb.njit(cache=True)
 def drop_stiffness(g, W, i, n):
     """1 and the springs from block i to neighbours that did not slip."""
     k = 1.0
