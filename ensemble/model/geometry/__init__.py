@@ -8,9 +8,10 @@ function (numba.extending.overload, inlined), as the friction laws' calls do (la
 the geometry at run time, and a geometry's kernels are its own (the chain's arithmetic is not a special case of
 another's: docs/design/geometry.md measures what that would cost).
 
-Today the chain is the one geometry; the kernels' steps and the event's loops call it through here, the creep
-phase's neighbour loops still import the chain's left and right from geometry/chain.py until they go through the
-geometry too (docs/design/geometry.md, the order of work).
+The built-ins are the chain (geometry/chain.py) and the lattice (geometry/lattice.py, N x M blocks); every kernel
+loop (the steps, the event's, the creep phase's) goes through here. A new geometry declares its neighbours and
+springs and takes the rest from geometry/graph.py (forces, energy, clusters and their creep, and K x for the
+Python side: ensemble/energy.py).
 
 A geometry's blocks are numbered 0..n-1; a missing neighbour (a free edge) is the block itself, so loops over
 `neighbours` skip j == i and a spring to a missing neighbour is never stretched (the ghost u_{-1} = u_0).
