@@ -1,0 +1,252 @@
+"""The plane's events against the claims of the two-dimensional model's paper (docs/plane.md):
+
+    python -m examples.plane.study CATALOG [CATALOG ...] [--histories CATALOG] [-o docs/plane/study]
+
+Each CATALOG is one task of a chain or a plane (its *.partial file while its run goes on: the numbers then say how
+many events they rest on). For each, of its inertial events (not its creep episodes):
+
+- R(mu): the magnitudes in bins of 0.01; the fraction of events that slip every block (a plane's characteristic
+  event); Gutenberg-Richter over the best two decades of mu and over the top two decades (KS distance and b,
+  examples/populations/answer.py's fits, at least 1000 events in a stretch);
+- the fraction of events that slip every block, and of those whose extent spans the fault both ways;
+- the large events (LARGE_BLOCKS blocks or more): of those that do not run from one end of the fault to the other,
+  how often their epicenter lies at an end of the rupture's extent along strike (within a tenth of its length:
+  UNILATERAL; a uniformly placed epicenter is there 1 time in 5); of those that span neither the fault's length
+  nor its width, the median of their extent along over across strike (anisotropy);
+- intervals: 95 %, over the catalog cut into CHUNKS stretches of consecutive events resampled (a block bootstrap:
+  events close in time are not independent).
+
+With --histories (a plane's catalog run with output.history): each kept event's rupture zone (the blocks that
+slipped), whether its epicenter lies on the zone's rim (a slipped block beside one that did not slip or beside
+the plane's edge; against the fraction of the zone's blocks on its rim, what a uniformly placed epicenter gives),
+and two figures of the largest kept event that does not slip the whole plane: its slip on the plane and the time
+each block started to slip (the rupture's growth).
+
+Writes OUT.json (every number), OUT.md (the table) and OUT_{mu,zone,growth}.png.
+"""
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from analysis.drawing import FONT, palette, save
+from ensemble.model.workspace import KIND_EVENT
+from ensemble.store import reader
+
+from examples.populations.answer import best_decades, top_decades
+
+EDGES = np.round(np.arange(0.0, 9.0 + 1e-9, 0.01), 2)
+LARGE_BLOCKS = 100      # a large event slips at least this many blocks (and not every block)
+UNILATERAL = 0.1        # an epicenter within this fraction of the extent's length from one of its ends
+CHUNKS = 20             # stretches of consecutive events the bootstrap resamples
+RESAMPLES = 400
+LEVEL = 0.95
+
+
+def shape(tasks):
+    """(geometry, N, M) of a catalog's single task."""
+    geometry = tasks["geometry"][0]
+    geometry = geometry.decode() if isinstance(geometry, bytes) else str(geometry)
+    return geometry, int(tasks["N"][0]), int(tasks["M"][0])
+
+
+def numbers(ev, n_blocks):
+    """The catalog's numbers from its events (dict of columns)."""
+    mu, slipped, N = ev["mu"], ev["n_slipped"], ev["N"]
+    M = n_blocks // N
+    counts = np.histogram(mu, EDGES)[0]
+    best, top = best_decades(counts, EDGES), top_decades(counts, EDGES)
+    length = ev["last"] - ev["first"] + 1
+    width = ev["across_last"] - ev["across_first"] + 1
+    large = slipped >= LARGE_BLOCKS
+    # the ends along strike are the rupture's own where it does not run from one end of the fault to the other;
+    # its shape is its own where it spans neither the fault's length nor (on a plane) its width
+    own_ends = large & (length < N)
+    own_shape = own_ends & ((width < M) | (M == 1))
+    x = ev["epicenter"] % N
+    at_end = np.minimum(x - ev["first"], ev["last"] - x) <= UNILATERAL * np.maximum(length - 1, 1)
+    return {"events": int(len(mu)), "whole": float(np.mean(slipped == n_blocks)),
+            "spanning": float(np.mean((length == N) & (width == M))),
+            "best_two_decades": dict(zip(("ks", "from_mu", "b"), best)),
+            "top_two_decades": dict(zip(("ks", "from_mu", "b"), top)),
+            "large": int(large.sum()), "large_own_ends": int(own_ends.sum()), "large_own_shape": int(own_shape.sum()),
+            "unilateral": float(np.mean(at_end[own_ends])) if own_ends.any() else math.nan,
+            "anisotropy_median": (float(np.median(length[own_shape] / width[own_shape])) if own_shape.any()
+                                  else math.nan)}
+
+
+def with_intervals(ev, n_blocks, rng):
+    """numbers() of all the events, each number with its block-bootstrap interval."""
+    whole = numbers(ev, n_blocks)
+    cuts = np.array_split(np.arange(len(ev["mu"])), CHUNKS)
+    draws = []
+    for _ in range(RESAMPLES):
+        pick = np.concatenate([cuts[k] for k in rng.integers(0, CHUNKS, CHUNKS)])
+        draws.append(numbers({k: v[pick] if np.ndim(v) else v for k, v in ev.items()}, n_blocks))
+    q = [(1 - LEVEL) / 2 * 100, (1 + LEVEL) / 2 * 100]
+
+    def interval(get):
+        values = np.array([get(d) for d in draws], dtype=float)
+        return [float(v) for v in np.nanpercentile(values, q)] if np.isfinite(values).any() else [math.nan] * 2
+
+    for key in ("whole", "spanning", "unilateral", "anisotropy_median"):
+        whole[f"{key}_interval"] = interval(lambda d, key=key: d[key])
+    for key in ("best_two_decades", "top_two_decades"):
+        whole[key]["ks_interval"] = interval(lambda d, key=key: d[key]["ks"])
+        whole[key]["b_interval"] = interval(lambda d, key=key: d[key]["b"])
+    return whole, np.histogram(ev["mu"], EDGES)[0]
+
+
+def zones(path):
+    """Per kept history of the catalog at `path`: (row, slip at the end, first-slip time per block, epicenter)."""
+    with reader.Reader(path) as cat:
+        geometry, N, M = shape(cat.tasks)
+        ev = cat.events()
+        out = []
+        for h in cat.histories(0):
+            slip = h["slip"]
+            moved = slip > 0.0
+            started = np.where(moved.any(axis=0), h["time"][np.argmax(moved, axis=0)], np.nan)
+            out.append({"row": int(h["row"]), "slip": slip[-1], "start": started,
+                        "epicenter": int(ev["epicenter"][h["row"]]), "mu": float(ev["mu"][h["row"]])})
+    return N, M, out
+
+
+def rim(zone, N, M):
+    """Blocks of the zone (bool, N x M as rows of N) with a neighbour outside it or beside the plane's edge."""
+    z = zone.reshape(M, N)
+    padded = np.pad(z, 1, constant_values=False)
+    inside = padded[:-2, 1:-1] & padded[2:, 1:-1] & padded[1:-1, :-2] & padded[1:-1, 2:]
+    return (z & ~inside).ravel()
+
+
+def rim_numbers(N, M, kept):
+    rows = []
+    for k in kept:
+        zone = k["slip"] > 0.0
+        if zone.sum() < LARGE_BLOCKS or zone.all():
+            continue
+        edge = rim(zone, N, M)
+        rows.append((bool(edge[k["epicenter"]]), edge.sum() / zone.sum()))
+    if not rows:
+        return {"kept": 0}
+    at, share = np.array(rows).T
+    return {"kept": len(rows), "epicenter_on_rim": float(at.mean()), "rim_share_of_zone": float(share.mean())}
+
+
+def figure_mu(results, hists, path):
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(5.2, 3.4))
+    centres = (EDGES[:-1] + EDGES[1:]) / 2
+    for (name, r), counts, color in zip(results.items(), hists, palette(len(results))):
+        width = 10          # bins of 0.1
+        c = counts[:len(counts) // width * width].reshape(-1, width).sum(axis=1)
+        x = centres[:len(c) * width].reshape(-1, width).mean(axis=1)
+        keep = c > 0
+        ax.plot(x[keep], c[keep] / c.sum() / 0.1, "-", color=color, lw=1,
+                label=f"{name} ({r['events']} events)")
+    ax.set_yscale("log")
+    ax.set_xlabel("mu = log10(sum of slips)", fontsize=FONT)
+    ax.set_ylabel("R(mu), per unit mu", fontsize=FONT)
+    ax.tick_params(labelsize=FONT)
+    ax.legend(fontsize=FONT - 1, frameon=False)
+    ax.set_title("magnitude distribution: planes and the chain at b = 40", fontsize=FONT + 1)
+    fig.tight_layout()
+    save(fig, path)
+
+
+def figure_zone(N, M, k, path, what):
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(5.0, 4.4))
+    zone = k["slip"] > 0.0
+    if what == "slip":
+        data, label = np.where(zone, k["slip"], np.nan), "slip"
+        title = f"rupture zone of an event (mu = {k['mu']:.2f}, {zone.sum()} of {N * M} blocks)"
+    else:
+        data, label = k["start"], "time since the onset when the block starts to slip"
+        title = "its growth: when each block started to slip"
+    image = ax.imshow(data.reshape(M, N), origin="lower", cmap="viridis", interpolation="nearest")
+    x, y = k["epicenter"] % N, k["epicenter"] // N
+    ax.plot([x], [y], "r*", ms=10, label="epicenter")
+    ax.set_xlabel("along strike (block)", fontsize=FONT)
+    ax.set_ylabel("across strike (block)", fontsize=FONT)
+    ax.tick_params(labelsize=FONT)
+    ax.legend(fontsize=FONT, loc="upper right", framealpha=0.8)
+    bar = fig.colorbar(image, ax=ax, shrink=0.85)
+    bar.set_label(label, fontsize=FONT)
+    bar.ax.tick_params(labelsize=FONT)
+    ax.set_title(title, fontsize=FONT + 1)
+    fig.tight_layout()
+    save(fig, path)
+
+
+def table(results, rims):
+    def iv(v, i, d=3):
+        return f"{v:.{d}f} [{i[0]:.{d}f}, {i[1]:.{d}f}]"
+    lines = ["| catalog | events | slip every block | span the fault both ways | best two decades: KS, from mu, b | "
+             "top two decades: KS, from mu, b | large: all, own ends, own shape | epicenter at an end along strike | "
+             "extent along / across (median) |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    def decades(d):
+        return f"{iv(d['ks'], d['ks_interval'])}, {d['from_mu']:.2f}, {iv(d['b'], d['b_interval'], 2)}"
+
+    for name, r in results.items():
+        best, top = r["best_two_decades"], r["top_two_decades"]
+        lines.append(f"| {name} | {r['events']} | {iv(r['whole'], r['whole_interval'])} | "
+                     f"{iv(r['spanning'], r['spanning_interval'])} | "
+                     f"{decades(best)} | {decades(top)} | "
+                     f"{r['large']}, {r['large_own_ends']}, {r['large_own_shape']} | "
+                     f"{iv(r['unilateral'], r['unilateral_interval'])} | "
+                     f"{iv(r['anisotropy_median'], r['anisotropy_median_interval'], 2)} |")
+    for name, r in rims.items():
+        if r["kept"]:
+            lines += ["", f"{name}: {r['kept']} kept large events: epicenter on the rupture zone's rim in "
+                          f"{r['epicenter_on_rim']:.2f} of them; the rim holds {r['rim_share_of_zone']:.2f} of a "
+                          f"zone's blocks (a uniformly placed epicenter's chance)"]
+    return lines
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("catalogs", nargs="+")
+    p.add_argument("--histories", help="a plane's catalog with output.history")
+    p.add_argument("-o", "--out", default="docs/plane/study")
+    p.add_argument("--seed", type=int, default=0)
+    args = p.parse_args(argv)
+    rng = np.random.default_rng(args.seed)
+    results, hists = {}, []
+    for path in args.catalogs:
+        with reader.Reader(path) as cat:
+            geometry, N, M = shape(cat.tasks)
+            b = float(cat.tasks["b"][0])
+            ev = cat.events()
+        inertial = ev["kind"] == KIND_EVENT         # not the creep episodes
+        ev = {**{k: v[inertial] for k, v in ev.items()}, "N": N}
+        name = f"chain N = {N}, b = {b:g}" if geometry == "chain" else f"plane {N} x {M}, b = {b:g}"
+        results[name], counts = with_intervals(ev, N * M, rng)
+        hists.append(counts)
+        print(f"{path}: {name}, {results[name]['events']} events", flush=True)
+    rims = {}
+    out = Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    if args.histories:
+        N, M, kept = zones(args.histories)
+        rims[f"plane {N} x {M}"] = rim_numbers(N, M, kept)
+        partial = [k for k in kept if LARGE_BLOCKS <= (k["slip"] > 0).sum() < N * M]
+        if partial:
+            k = max(partial, key=lambda k: k["mu"])
+            figure_zone(N, M, k, f"{out}_zone.png", "slip")
+            figure_zone(N, M, k, f"{out}_growth.png", "start")
+    figure_mu(results, hists, f"{out}_mu.png")
+    Path(f"{out}.json").write_text(json.dumps({"catalogs": args.catalogs, "results": results, "rims": rims},
+                                              indent=1, default=float))
+    text = "\n".join(table(results, rims)) + "\n"
+    Path(f"{out}.md").write_text(text)
+    sys.stdout.write(text)
+
+
+if __name__ == "__main__":
+    main()
