@@ -36,6 +36,7 @@ os.environ["PATH"] = os.path.dirname(sys.executable) + os.pathsep + os.environ.g
 # rather than marked in each file, so that the tier is one list to read. tests/test_quick_tier.py checks
 # that every name exists and that every test file is here or in NOT_QUICK, with the reason.
 QUICK = {
+    "test_plane_study.py": ["test_an_epicenter_on_the_rim_against_its_share_of_the_zone"],
     "test_creep.py": ["test_a_cluster_too_soft_to_creep_hands_over_to_an_event",
                       "test_above_the_block_stiffness_nothing_creeps"],
     "test_intervals.py": ["test_every_statistic_is_the_same_whatever_the_chunks"],

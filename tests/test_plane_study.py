@@ -1,0 +1,48 @@
+"""examples/plane/study.py's measures of a plane's events (docs/plane.md) on hand-built events with known answers."""
+import numpy as np
+
+from examples.plane.study import numbers, rim, rim_numbers
+
+
+def test_the_rim_of_a_rupture_zone_is_its_blocks_beside_another_or_beside_the_edge():
+    """A 3 x 3 zone inside a 6 x 5 plane: its 8 outer blocks; a zone against the plane's edge: the edge's blocks
+    are rim too; a lone block is its own rim."""
+    N, M = 6, 5
+    zone = np.zeros((M, N), bool)
+    zone[1:4, 1:4] = True
+    assert rim(zone.ravel(), N, M).reshape(M, N).sum() == 8
+    assert not rim(zone.ravel(), N, M).reshape(M, N)[2, 2]
+    zone = np.zeros((M, N), bool)
+    zone[0:3, 0:3] = True           # in the corner: (0, 0) and the edges' blocks are rim, (1, 1) is not
+    r = rim(zone.ravel(), N, M).reshape(M, N)
+    assert r[0, 0] and r[0, 1] and r[2, 2] and not r[1, 1]
+    assert rim(np.eye(1, N * M, 7, dtype=bool)[0], N, M).sum() == 1
+
+
+def test_an_epicenter_on_the_rim_against_its_share_of_the_zone():
+    """Two zones of 10 x 10 on a 20 x 20 plane (rim 36 of 100 blocks), one with its epicenter on the rim, one in
+    the middle: half of the epicenters on the rim, and the rim's share 0.36; a zone below LARGE_BLOCKS is left out."""
+    N = M = 20
+    zone = np.zeros((M, N), bool)
+    zone[5:15, 5:15] = True
+    kept = [{"slip": zone.ravel() * 1.0, "epicenter": 5 * N + 9},      # (x 9, y 5): the zone's lower rim
+            {"slip": zone.ravel() * 1.0, "epicenter": 10 * N + 10},    # its middle
+            {"slip": np.eye(1, N * M, 3)[0], "epicenter": 3}]          # one block: too small
+    r = rim_numbers(N, M, kept)
+    assert r == {"kept": 2, "epicenter_on_rim": 0.5, "rim_share_of_zone": 0.36}
+
+
+def test_unilateral_ruptures_and_shapes_count_only_ruptures_bounded_by_their_own_ends():
+    """On a 100 x 10 plane: a rupture over x 10..59 from x = 12 (within a tenth of its length of an end), one over
+    20..69 from x = 45 (in the middle), one over the whole length (not counted: its ends are the fault's), and a
+    small one (below LARGE_BLOCKS); the shape's extent along over across strike of the first alone, 50 / 5 (the
+    second spans the plane's width)."""
+    N, M = 100, 10
+    ev = {"mu": np.array([4.0, 4.0, 5.0, 1.0]), "n_slipped": np.array([250, 500, 1000, 1]), "N": N,
+          "first": np.array([10, 20, 0, 3]), "last": np.array([59, 69, 99, 3]),
+          "across_first": np.array([0, 0, 0, 0]), "across_last": np.array([4, 9, 9, 0]),
+          "epicenter": np.array([12 + N * 2, 45 + N * 5, 50, 3])}
+    r = numbers(ev, N * M)
+    assert (r["large"], r["large_own_ends"], r["large_own_shape"]) == (3, 2, 1)
+    assert r["unilateral"] == 0.5 and r["anisotropy_median"] == 10.0
+    assert r["whole"] == 0.25 and r["spanning"] == 0.25
