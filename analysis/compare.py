@@ -3,7 +3,7 @@
 
 The magnitude mu = log10(total slip) has each law's own scale (the aging law's large events slip
 ~10^5, Carlson-Langer's ~10^2), so "more characteristic" is decided on the number of blocks an
-event slips, n = 1..N, and on recurrence times divided by their mean:
+event slips, n = 1..N (N M on a plane: an area), and on recurrence times divided by their mean:
 
 - fraction_large: share of events with n >= n_large (default 50, N / 16 at N = 800: about the 1st
   percentile of the rupture length of the aging law's mu >= 4 events at b = 20).
@@ -59,9 +59,9 @@ LAYOUT = Layout(of("compare"))                            # the comparison's sta
 
 def compare_point(per_task, params, rows, opt):
     """A point's numbers (NUMBERS order, with lo and hi), R(log10 n), R(mu), recurrence times, from the engine."""
-    n_blocks = int(params["N"])
+    n_blocks = _blocks(params)
     result = point_statistics(per_task, rows, opt, merge.bootstrap_rng(opt.seed, params),
-                              LAYOUT, n_blocks)
+                              LAYOUT, n_blocks, geometry_name=params.get("geometry", "chain"))
     names = [n.name for n in LAYOUT.numbers]
     x = result["numbers"][[names.index(name) for name in ENGINE_NUMBERS]]
     sizes, size, mu = result["sums"]["n_slipped"], result["curve"]["size"], result["curve"]["mu"]
@@ -72,9 +72,16 @@ def compare_point(per_task, params, rows, opt):
             "fit_share": sizes[opt.n_min:opt.n_large].sum() / max(sizes.sum(), 1), "n_blocks": n_blocks}
 
 
+def _blocks(params):
+    """A point's number of blocks: N, or N M on a plane (the sizes n reach it)."""
+    return int(params["N"]) * int(params.get("M", 1))
+
+
 def label(law, params):
     keys = [k for k in PARAMS[3:] if params[k] == params[k]]   # (the law's keys: others are NaN)
-    return f"{law}: " + ", ".join(f"{k} = {params[k]:g}" for k in keys)
+    shape = (f"{params['geometry']} {int(params['N'])} x {int(params['M'])}, l_across = {params['l_across']:g}: "
+             if "geometry" in params else "")
+    return f"{law}: " + shape + ", ".join(f"{k} = {params[k]:g}" for k in keys)
 
 
 def _check_memory(opt, n_tasks, n_blocks):
@@ -95,9 +102,10 @@ def compare(paths, opt):
         raise checks.UsageError("--level must be in (0, 1); --bootstrap, --blocks >= 1; --window >= 0")
     inputs = merge.read(paths)
     for params, rows in inputs.points:
-        _check_memory(opt, len(rows), int(params["N"]))
-        if opt.n_large > int(params["N"]):
-            raise ValueError(f"--n-large {opt.n_large} exceeds the chain of {int(params['N'])} blocks")
+        _check_memory(opt, len(rows), _blocks(params))
+        if opt.n_large > _blocks(params):
+            raise ValueError(f"--n-large {opt.n_large} exceeds the {params.get('geometry', 'chain')} of "
+                             f"{_blocks(params)} blocks")
     out = []
     for params, rows in inputs.points:   # a point's tasks reduced together, then dropped
         per_task = merge.reduce_share(inputs, rows, opt, LAYOUT)

@@ -29,9 +29,10 @@ def _legend(ax):
 
 
 def _chains(points):
-    """' at N = 800' (the points' chain length), or ' at N = 400-1600'."""
+    """' at N = 800' (the points' chain length), or ' at N = 400-1600'; with a plane among them, ' of 48 blocks'."""
     sizes = sorted({int(p["n_blocks"]) for p in points})
-    return f" at N = {sizes[0]}" if len(sizes) == 1 else f" at N = {sizes[0]}-{sizes[-1]}"
+    span = f"{sizes[0]}" if len(sizes) == 1 else f"{sizes[0]}-{sizes[-1]}"
+    return f" of {span} blocks" if any("geometry" in p.get("params", {}) for p in points) else f" at N = {span}"
 
 
 def figures(points, opt, out_dir, mu_edges):

@@ -9,6 +9,10 @@ of each snapshot in turn (their spacing is the kernel's: one per change of the l
 output.history_dlogv, or per output.history_dt); the labels give the snapshots' times. Right: against time, the
 largest velocity and the epicenter's (log scale) and the number of blocks sliding: the initial phase (one or a
 few blocks accelerating slowly), the acceleration and the rupture's spread.
+
+On a plane (model.geometry = "lattice") the left panel is the epicenter's row along strike (block i at
+x = i % N, y = i // N): the rupture's extent along it and MARGIN blocks beside it; the right panel is the
+whole plane's.
 """
 import numpy as np
 
@@ -34,8 +38,10 @@ def pick(path, task=None, index=0):
                 h = kept[index]
                 row = k * cat.per_task + h["row"]
                 event = {name: ds[row] for name, ds in cat.layout.events.items()}
-                event["run"] = ", ".join(f"{name} = {cat.tasks[name][k]:g}" for name in ("N", "l", "a", "b")
-                                         if np.isfinite(cat.tasks[name][k]))
+                event["run"] = ", ".join(f"{name} = {cat.tasks[name][k]:g}" for name in ("N", "M", "l", "a", "b")
+                                         if np.isfinite(cat.tasks[name][k]) and (name != "M" or cat.tasks[name][k] > 1))
+                # blocks along strike (a row of the plane, or the chain) and rows across
+                event["along"], event["rows"] = int(cat.tasks["N"][k]), int(cat.tasks["M"][k])
                 return k, index, h, event
     where = "any task" if task is None else f"task {task}"
     raise CatalogError(f"{path}: {where} has no event history {index} (output.history: the events whose "
@@ -47,23 +53,26 @@ def draw(path, output, task=None, index=0):
     k, j, h, ev = pick(path, task, index)
     time, v = h["time"], np.maximum(h["velocity"], V_FLOOR)
     logv = np.log10(v)
-    n = v.shape[1]
-    # the rupture zone and a margin: the blocks that moved
+    n = ev["along"]
+    epicenter = int(ev["epicenter"])
+    row = epicenter // n    # (0 on a chain) the epicenter's row along strike, blocks row * n .. row * n + n - 1
+    plane = ev["rows"] > 1
+    # the rupture zone and a margin: the blocks that moved (first and last are positions along strike)
     lo, hi = max(int(ev["first"]) - MARGIN, 0), min(int(ev["last"]) + MARGIN, n - 1)
     fig, (left, right) = plt.subplots(1, 2, figsize=(9.0, 4.2))
-    image = left.imshow(logv[:, lo:hi + 1], origin="lower", aspect="auto", cmap="viridis", interpolation="nearest",
-                        extent=(lo - 0.5, hi + 0.5, -0.5, len(time) - 0.5), vmin=np.log10(V_FLOOR))
+    image = left.imshow(logv[:, row * n + lo:row * n + hi + 1], origin="lower", aspect="auto", cmap="viridis",
+                        interpolation="nearest", extent=(lo - 0.5, hi + 0.5, -0.5, len(time) - 0.5),
+                        vmin=np.log10(V_FLOOR))
     ticks = np.unique(np.linspace(0, len(time) - 1, 7).round().astype(int))
     left.set_yticks(ticks)
     left.set_yticklabels([f"{time[t]:.3g}" for t in ticks], fontsize=FONT)
-    left.set_xlabel("block", fontsize=FONT + 1)
+    left.set_xlabel(f"block along strike, the epicenter's row {row} across" if plane else "block", fontsize=FONT + 1)
     left.set_ylabel("time since the onset (one row per snapshot)", fontsize=FONT + 1)
     left.tick_params(labelsize=FONT)
     bar = fig.colorbar(image, ax=left)
     bar.set_label("log10 velocity", fontsize=FONT + 1)
     bar.ax.tick_params(labelsize=FONT)
     # the phases in time: the largest velocity and the epicenter's, and how many blocks slide
-    epicenter = int(ev["epicenter"])
     right.semilogy(time, v.max(axis=1), color="C0", lw=1.2, label="largest velocity")
     right.semilogy(time, v[:, epicenter], color="C1", lw=1.0, ls="--", label=f"epicenter (block {epicenter})")
     right.set_ylim(V_FLOOR, v.max() * 3)
@@ -77,9 +86,10 @@ def draw(path, output, task=None, index=0):
     lines = right.get_lines() + count.get_lines()
     right.legend(lines, [line.get_label() for line in lines], fontsize=FONT, loc="upper center", ncol=3,
                  bbox_to_anchor=(0.5, -0.14), frameon=False)
+    across = f" along, {int(ev['across_first'])}..{int(ev['across_last'])} across" if plane else ""
     what = (f"task {k} ({ev['run']}), row {h['row']}: mu = {float(ev['mu']):.2f}, epicenter {int(ev['epicenter'])}, "
-            f"blocks "
-            f"{int(ev['first'])}..{int(ev['last'])}, duration {float(ev['duration']):.4g}, {len(time)} snapshots"
+            f"blocks {int(ev['first'])}..{int(ev['last'])}{across}, duration {float(ev['duration']):.4g}, "
+            f"{len(time)} snapshots"
             + (f" ({h['dropped']} dropped)" if h["dropped"] else ""))
     layout(fig, f"event history {j} of {what}", 0.15)
     save(fig, output)

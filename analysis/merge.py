@@ -7,8 +7,9 @@ that has not finished it is the stream the runner uses, SeedSequence(run.seed of
 config, spawn_key=(task index,)) (ensemble/run/tasks.py), and the summary stores it so.
 
 - Points. Tasks with exactly equal parameters pool into one parameter point, whichever catalog
-  they come from; points are numbered in the order of first appearance (catalogs in the order
-  given, tasks in catalog order).
+  they come from (on a plane, model.geometry with its M and l_across are parameters too, so two
+  planes of other shapes, or a plane and a chain, never pool: analysis/geometry.py); points are
+  numbered in the order of first appearance (catalogs in the order given, tasks in catalog order).
 - Order inside a point. The tasks of a point are ordered by their stream, (seed_entropy,
   spawn_key); these are the resampling units in that order. With `bootstrap_rng`, which depends
   on the --seed and the point's parameters only, a point's numbers and intervals do not depend on
@@ -27,20 +28,26 @@ from ensemble.store import reader, schema
 from ensemble.store.errors import CatalogError
 from ensemble.config import loads
 
+from . import geometry
 from . import region as regions
 from .reduce import LAYOUT, PARAMS, reduce_tasks
 
 
-def _chains_only(path, tasks):
-    """The statistics measure distances along a chain: a catalog of another geometry is refused (a lattice's
-    statistics take their distances from the geometry: docs/design/geometry.md, step 9), and the geometry's
-    columns, a chain's defaults, are left out of the summary."""
-    other = sorted({str(name) for name in tasks["geometry"]} - {"chain"})
+def _known_geometry(path, tasks):
+    """A catalog of a geometry the analysis does not know (analysis/geometry.py) is refused in one line."""
+    other = sorted({str(name) for name in tasks["geometry"]} - set(geometry.GEOMETRIES))
     if other:
-        raise MergeError(f"{path}: a catalog of model.geometry = {other[0]!r}; the analysis reads chains only so far "
-                         f"(its statistics measure distances along a chain)")
-    for name in schema.GEOMETRY_TASKS:
-        tasks.pop(name, None)
+        raise MergeError(f"{path}: a catalog of model.geometry = {other[0]!r}; the analysis reads "
+                         f"{', '.join(geometry.GEOMETRIES)} (analysis/geometry.py: where its blocks lie)")
+
+
+def _chains_without_geometry(tables):
+    """Where every task is a chain, the geometry's columns (a chain's defaults) are left out of the task table,
+    so that a summary of chains is the one of before; with a plane among them, every task keeps them."""
+    if all(set(map(str, t["geometry"])) <= {geometry.CHAIN} for t in tables):
+        for tasks in tables:
+            for name in schema.GEOMETRY_TASKS:
+                tasks.pop(name, None)
 
 
 class MergeError(ValueError):
@@ -78,12 +85,13 @@ def bootstrap_rng(seed, params):
     """The bootstrap generator of the point with these parameters:
     SeedSequence(seed, spawn_key=(N, bits(l), bits(nu), bits(x) for each of its law's keys x in
     PARAMS order)), where bits(x) is the IEEE-754 binary64 pattern of x as an unsigned integer (for
-    the aging law: bits(a), bits(b), bits(c)). Keys of other laws (NaN) are left out. A region's:
+    the aging law: bits(a), bits(b), bits(c)). Keys of other laws (NaN) are left out. A point of another
+    geometry than the chain appends geometry.spawn_key (CRC-32 of its name, bits(M), bits(l_across)). A region's:
     SeedSequence(seed, spawn_key=region.bootstrap_key(its text))."""
     if "region" in params:
         return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=regions.bootstrap_key(params["region"])))
     key = [int(params["N"])] + [int(np.float64(params[name]).view(np.uint64)) for name in PARAMS[1:]
-                                if not np.isnan(params[name])]
+                                if not np.isnan(params[name])] + geometry.spawn_key(params)
     return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=tuple(key)))
 
 
@@ -118,13 +126,14 @@ def read(paths, allow_partial=False, region=False, span=None, skip=0.0):
     for path in paths:
         with filekind.reading(path, "the event catalog", CatalogError):
             per_task, tasks, attrs = reader.read_tasks(path)
-        _chains_only(path, tasks)
+        _known_geometry(path, tasks)
         tasks["seed_entropy"], tasks["spawn_key"] = _streams(tasks, attrs["config"])
         tables.append(tasks)
         configs.append(str(attrs["config"]))
         per_tasks.append(int(per_task))
         discarded.append(int(attrs.get("transient", 0)))
         unfinished.append(_unfinished(path, tasks, per_task))
+    _chains_without_geometry(tables)
     partial = _partial_statement(paths, tables, per_tasks, unfinished)
     if partial and not allow_partial:
         path, tasks, (n_open, named) = next((p, t, u) for p, t, u in zip(paths, tables, unfinished)
@@ -151,16 +160,19 @@ def _concatenate(tables):
 
 
 def _points(paths, tasks):
-    """Pool the rows of `tasks` by friction law and exact parameters; set tasks["point"]; refuse repeated
-    streams. Two laws may share keys (aging and slip: a, b, c), so the law is part of a point."""
+    """Pool the rows of `tasks` by friction law, geometry and exact parameters; set tasks["point"]; refuse
+    repeated streams. Two laws may share keys (aging and slip: a, b, c), so the law is part of a point; so is a
+    plane's shape (geometry.point_key: nothing on a chain)."""
     where = {}
     for g in range(len(tasks["point"])):
         # by bit pattern: keys of another law are NaN, which equals nothing, itself included
         law = law_name(tasks["law"][g])
-        bits = (law, *(np.float64(tasks[name][g]).view(np.uint64).item() for name in PARAMS))
-        where.setdefault(bits, (tuple(tasks[name][g].item() for name in PARAMS), law, []))[2].append(g)
+        bits = (law, *(np.float64(tasks[name][g]).view(np.uint64).item() for name in PARAMS),
+                *geometry.point_key(tasks, g))
+        where.setdefault(bits, (tuple(tasks[name][g].item() for name in PARAMS), law, geometry.point_params(tasks, g),
+                                []))[3].append(g)
     points = []
-    for i, (key, law, rows) in enumerate(where.values()):
+    for i, (key, law, shape, rows) in enumerate(where.values()):
         rows.sort(key=lambda g: (int(tasks["seed_entropy"][g]), int(tasks["spawn_key"][g])))
         for a, b in zip(rows, rows[1:]):
             stream = (int(tasks["seed_entropy"][a]), int(tasks["spawn_key"][a]))
@@ -172,7 +184,7 @@ def _points(paths, tasks):
                     f"spawn_key {stream[1]}, " + ", ".join(f"{n} = {v:g}" for n, v in zip(PARAMS, key) if v == v)
                     + "): give each trajectory once")
         tasks["point"][rows] = i
-        points.append(({**dict(zip(PARAMS, key)), "law": law}, rows))
+        points.append(({**dict(zip(PARAMS, key)), "law": law, **shape}, rows))
     return points
 
 

@@ -27,6 +27,7 @@ import numpy as np
 from ensemble.config import MEASURED_TRANSIENT_PER_BLOCK, TRANSIENT_PER_BLOCK
 
 from . import stats, summary
+from .geometry import CHAIN
 from .reduce import PARAMS
 from .report import LABELS, count_text, events_per_point, level_text, partial_text, point_label, size_text
 
@@ -207,9 +208,12 @@ CLAIMS = (
 
 
 def _matching(s, claim):
-    laws = summary.point_laws(s)
+    """The points of `s` that test `claim` (the paper's law, on a chain: a plane's points never do) and how many
+    values of claim.vary they hold."""
+    laws, chains = summary.point_laws(s), summary.point_geometries(s) == CHAIN
     rows = [i for i in range(len(s["points/N"]))
-            if laws[i] == PAPER_LAW and all(s[f"points/{k}"][i] in values for k, values in claim.where.items())]
+            if laws[i] == PAPER_LAW and chains[i]
+            and all(s[f"points/{k}"][i] in values for k, values in claim.where.items())]
     vary = (claim.vary,) if isinstance(claim.vary, str) else claim.vary
     return rows, len({tuple(float(s[f"points/{k}"][i]) for k in vary) for i in rows})
 
@@ -264,14 +268,16 @@ def transients(s, name):
             lines.append(f"note: {path}: its stored config does not say how many events it discarded")
             continue
         transient = int(transient)
-        n_blocks = int(s["tasks/N"][tasks].max())
+        blocks = s["tasks/N"][tasks] * (s["tasks/M"][tasks] if "tasks/M" in s else 1)    # N M on a plane
+        n_blocks = int(blocks.max())
+        at = f"N = {n_blocks}" if "tasks/M" not in s else f"{n_blocks} blocks"
         measured = MEASURED_TRANSIENT_PER_BLOCK * n_blocks
         if transient < measured:
-            lines.append(f"warning: {path}: run.transient = {transient} events at N = {n_blocks}, shorter than "
+            lines.append(f"warning: {path}: run.transient = {transient} events at {at}, shorter than "
                          f"the longest transient measured ({measured:g} events, {MEASURED_TRANSIENT_PER_BLOCK:g} per "
                          "block: docs/benchmarks.md): its statistics include the random start")
         elif transient < TRANSIENT_PER_BLOCK * n_blocks:
-            lines.append(f"note: {path}: run.transient = {transient} events at N = {n_blocks}, no shorter than the "
+            lines.append(f"note: {path}: run.transient = {transient} events at {at}, no shorter than the "
                          f"longest transient measured ({measured:g}) but without the default's margin "
                          f"({TRANSIENT_PER_BLOCK} N = {TRANSIENT_PER_BLOCK * n_blocks} events, "
                          f"{TRANSIENT_PER_BLOCK / MEASURED_TRANSIENT_PER_BLOCK:g}x the measured)")

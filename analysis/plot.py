@@ -18,9 +18,12 @@ import matplotlib.pyplot as plt
 from .drawing import DPI, save
 from .figure_labels import legend_labels, summary_name, title_text
 from .reduce import LAYOUT
+from .statistics import refusal
+from .summary import SummaryError, point_geometries
 
-# every statistic's figures, by name (`analysis plot --figure NAME`)
+# every statistic's figures, by name (`analysis plot --figure NAME`), and the statistic each is of
 FIGURES = {f.name: f for st in LAYOUT.statistics for f in st.figures}
+OWNER = {f.name: st for st in LAYOUT.statistics for f in st.figures}
 
 
 def figure(summaries, kind, title=None, names=None):
@@ -31,6 +34,10 @@ def figure(summaries, kind, title=None, names=None):
         summaries = [summaries]
     names = ([summary_name(n) for n in names] if names is not None
              else [f"summary {j + 1}" for j in range(len(summaries))])
+    for s, name in zip(summaries, names):    # a statistic that refuses a point's geometry has nothing to draw of it
+        why = [refusal(OWNER[kind], g) for g in dict.fromkeys(point_geometries(s)) if refusal(OWNER[kind], g)]
+        if why:
+            raise SummaryError(f"{name}: no figure {kind!r}: {why[0]}; plot the chains' summaries apart")
     keys, labels = legend_labels(summaries, names)
     chosen = FIGURES[kind]
     fig = plt.figure(figsize=chosen.size(len(labels)), dpi=DPI)

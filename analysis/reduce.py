@@ -21,13 +21,15 @@ from ensemble.store import reader, schema
 from ensemble.store.errors import CatalogError
 from ensemble.config import LAW_KEYS
 
-from . import stats
+from . import geometry, stats
 from .recurrence import RecurrenceScanner
-from .statistics import CRITERIA, Layout, Rows
+from .statistics import CRITERIA, Layout, Rows, refusal
 
 # the parameters that tell points apart: the chain's, and every friction law's keys (NaN where a
-# key is not of the task's law, so tasks of two laws never pool)
+# key is not of the task's law, so tasks of two laws never pool); a plane's shape besides (GEOMETRY_PARAMS,
+# analysis/geometry.py: a point of another geometry than the chain has them, and a summary holding one says them)
 PARAMS = ("N", "l", "nu", *LAW_KEYS)
+GEOMETRY_PARAMS = schema.GEOMETRY_TASKS
 
 
 # every statistic of analysis/statistics/, laid out: its tables, numbers and curves in the registry's order
@@ -38,7 +40,7 @@ CURVES = {c.name: LAYOUT.tables[c.table].bins for c in LAYOUT.curves}
 
 def bin_edges(opt, n_blocks=None, layout=LAYOUT):
     """{bins name: edges} of the options (the summary's /bins/<name>): option <name>_edges; bins of the
-    chain's own (Table.chain_edges) from its N, `n_blocks`."""
+    chain's own (Table.chain_edges) from its number of blocks, `n_blocks` (N, or N M on a plane)."""
     return {name: layout.chain_bins[name](n_blocks) if name in layout.chain_bins else getattr(opt, f"{name}_edges")
             for name in layout.bins}
 
@@ -70,15 +72,18 @@ def parse_bins(text, name="bins"):
     return edges
 
 
-def reduce_task(chunks, written, nu, n_blocks_chain, opt, rows=None, layout=LAYOUT):
+def reduce_task(chunks, written, nu, blocks, opt, rows=None, layout=LAYOUT):
     """Stream one task's rows (chunks of dicts of columns, `written` inertial events and `rows`
     rows of every kind in all) into its tables (statistics.Tables: {table: (stretches, width)}; the
-    attribute `rows` the rows read). Every statistic is fed each chunk once. The chunks are consumed to
-    their end (the catalog checks a task's checksum there)."""
-    out = layout.empty(opt.blocks, bin_edges(opt, n_blocks_chain, layout))
+    attribute `rows` the rows read). blocks: the task's geometry.Shape (or its number of blocks: a chain).
+    Every statistic is fed each chunk once, but one that refuses the task's geometry (statistics.refusal):
+    its tables stay empty. The chunks are consumed to their end (the catalog checks a task's checksum there)."""
+    shape = geometry.shape(blocks)
+    out = layout.empty(opt.blocks, bin_edges(opt, shape.n_blocks, layout))
     out.rows = 0
-    for seen in task_rows(chunks, written, nu, n_blocks_chain, opt, rows, layout):
-        for statistic in layout.statistics:
+    fed = [statistic for statistic in layout.statistics if not refusal(statistic, shape.geometry)]
+    for seen in task_rows(chunks, written, nu, shape, opt, rows, layout):
+        for statistic in fed:
             statistic.feed(out, seen)
     out.carry.clear()    # the statistics' carry of this task ends with it
     for name in layout.samples:   # a stretch's sample: one array of its values in the order fed
@@ -86,12 +91,13 @@ def reduce_task(chunks, written, nu, n_blocks_chain, opt, rows=None, layout=LAYO
     return out
 
 
-def task_rows(chunks, written, nu, n_blocks_chain, opt, rows=None, layout=LAYOUT):
+def task_rows(chunks, written, nu, blocks, opt, rows=None, layout=LAYOUT):
     """The statistics' view of each chunk of one task's rows (statistics.Rows: the inertial events and creep
     episodes apart, their stretches, the recurrences of each large-event criterion so far), as reduce_task feeds
     them; arguments as there."""
     k = opt.blocks
-    scanners = {c: RecurrenceScanner(n_blocks_chain, float(getattr(opt, c.threshold)), getattr(opt, c.window))
+    shape = geometry.shape(blocks)
+    scanners = {c: RecurrenceScanner(shape, float(getattr(opt, c.threshold)), getattr(opt, c.window))
                 for c in _criteria(layout)} if written else {}
     lo = row = 0
     t_before = np.nan
@@ -111,8 +117,8 @@ def task_rows(chunks, written, nu, n_blocks_chain, opt, rows=None, layout=LAYOUT
                 src, T, interior = scanner.feed(ev["t"], ev["epicenter"], values, ev["boundary"])
                 scans[criterion.name] = ((src * k) // written, T * nu, interior)
             lo = hi
-        yield Rows(part, inertial, ev, block, creep, creep_block, scans.get("mu"), t_before, nu, opt, n_blocks_chain,
-                   ev is not None and lo == written, scans)
+        yield Rows(part, inertial, ev, block, creep, creep_block, scans.get("mu"), t_before, nu, opt, shape.n_blocks,
+                   ev is not None and lo == written, scans, shape)
         if ev is not None:
             t_before = ev["t"][-1]
 
@@ -132,8 +138,8 @@ def reduce_tasks(path, task_indices, opt, layout=LAYOUT, windows=None):
     rows of a task with start <= t < end only (a region's window: analysis/region.py); the attribute `rows` is
     still every committed row read."""
     out = {}
-    # the catalog checks the ranges of the rows as they stream (an epicenter outside the chain
-    # would also overflow RecurrenceScanner's buffers) and each task's checksum after its last chunk
+    # the catalog checks the ranges of the rows as they stream (an epicenter outside the task's blocks would
+    # also break RecurrenceScanner's packing bound; it checks them too) and each task's checksum after its last chunk
     with filekind.reading(path, "the event catalog", CatalogError), reader.Reader(path) as cat:
         tasks = cat.tasks
         for k in task_indices:
@@ -141,7 +147,7 @@ def reduce_tasks(path, task_indices, opt, layout=LAYOUT, windows=None):
             rows = int(tasks["events_written"][k])
             if windows is None:
                 out[k] = reduce_task(cat.task_events(k, opt.chunk), cat.count(k, schema.KIND_EVENT),
-                                     float(tasks["nu"][k]), int(tasks["N"][k]), opt, rows, layout)
+                                     float(tasks["nu"][k]), geometry.task_shape(tasks, k), opt, rows, layout)
             else:
                 start, end = windows[k]
                 t, kind = cat.column(k, "t"), cat.column(k, "kind")
@@ -149,8 +155,8 @@ def reduce_tasks(path, task_indices, opt, layout=LAYOUT, windows=None):
                 out[k] = reduce_task(reader.rows_where(cat.task_events(k, opt.chunk),
                                                        lambda part: _inside(part["t"], start, end)),
                                      int(np.count_nonzero(inside & (kind == schema.KIND_EVENT))),
-                                     float(tasks["nu"][k]), int(tasks["N"][k]), opt, int(np.count_nonzero(inside)),
-                                     layout)
+                                     float(tasks["nu"][k]), geometry.task_shape(tasks, k), opt,
+                                     int(np.count_nonzero(inside)), layout)
             out[k].rows = rows
     return out
 
@@ -199,9 +205,12 @@ def _units(per_task, task_ids, whole="seeds"):
 UNIT_ARRAYS = tuple(LAYOUT.tables)
 
 
-def point_statistics(per_task, task_ids, opt, rng, layout=LAYOUT, n_blocks=None, whole="seeds"):
+def point_statistics(per_task, task_ids, opt, rng, layout=LAYOUT, n_blocks=None, whole="seeds",
+                     geometry_name=geometry.CHAIN):
     """Merged densities and summary numbers of one parameter point, with bootstrap intervals, and each
-    statistic's extras (the recurrence peaks). n_blocks: the chain's N (for bins of the chain's own).
+    statistic's extras (the recurrence peaks). n_blocks: its number of blocks, N M (for bins of the chain's own);
+    geometry_name: its geometry's, whose refused statistics (statistics.refusal) give NaN numbers, curves and
+    extras (the engine fed them nothing).
 
     A resample draws units with replacement, rng.integers(0, units, (bootstrap, units)); its additive tables
     are the sums of the drawn units', its samples the drawn units' values concatenated in the order drawn.
@@ -223,13 +232,19 @@ def point_statistics(per_task, task_ids, opt, rng, layout=LAYOUT, n_blocks=None,
         u.update({name: np.concatenate([units[name][i] for i in picks]) for name in layout.samples})
         return layout.sum_of(u)
 
+    refused = {s.name for s in layout.statistics if refusal(s, geometry_name)}
+    blank = {c.name for s in layout.statistics if s.name in refused for c in s.curves}
+
     def numbers(u):
-        return np.array([x for s in layout.statistics if s.numbers for x in s.estimate(u, opt)], dtype=float)
+        return np.array([x for s in layout.statistics if s.numbers
+                         for x in (s.estimate(u, opt) if s.name not in refused else [np.nan] * len(s.numbers))],
+                        dtype=float)
 
     def curves(u):
-        return [c.values(u, opt, edges) if c.values is not None else
-                stats.density(u[c.table], None, u.column(*c.total), widths[c.table])
-                for c in layout.curves]
+        out = [c.values(u, opt, edges) if c.values is not None else
+               stats.density(u[c.table], None, u.column(*c.total), widths[c.table])
+               for c in layout.curves]
+        return [np.full(len(v), np.nan) if c.name in blank else v for c, v in zip(layout.curves, out)]
 
     def estimate(row, picks):
         u = split(row, picks)
@@ -269,5 +284,7 @@ def point_statistics(per_task, task_ids, opt, rng, layout=LAYOUT, n_blocks=None,
         start += len(values)
     for statistic in layout.statistics:
         if statistic.extra is not None:
-            out.update(statistic.extra(units, opt, rng))
+            extra = statistic.extra(units, opt, rng)
+            out.update({name: np.full(np.shape(v), np.nan) for name, v in extra.items()}
+                       if statistic.name in refused else extra)
     return out

@@ -14,6 +14,7 @@ from ensemble import checks, filekind
 from ensemble.store.errors import CatalogError
 
 from . import merge, options, summary
+from .geometry import CHAIN
 from .reduce import LAYOUT, MIN_UNITS, NUMBERS, bin_edges, point_statistics, unreliable
 
 # errors that reduce's rank 0 finds before the work starts and every rank then raises alike
@@ -135,7 +136,8 @@ def reduce_on(comm, request, say=print, warn=None):
     points = []
     for params, ids in inputs.points:
         result = point_statistics(per_task, ids, opt, merge.bootstrap_rng(opt.seed, params),
-                                  whole="faults" if request.region else "seeds")
+                                  whole="faults" if request.region else "seeds",
+                                  geometry_name=params.get("geometry", CHAIN))
         result["params"] = params
         points.append(result)
     for line in inputs.warnings:
@@ -147,7 +149,8 @@ def reduce_on(comm, request, say=print, warn=None):
         why = unreliable(p["units"], p["method"])
         if why:
             what = (f"region {i} ({p['params']['region']})" if request.region else f"point {i} ({p['params']['law']}: "
-                    f"{', '.join(f'{k} = {v:g}' for k, v in p['params'].items() if k != 'law' and v == v)})")
+                    + ", ".join(f"{k} = {v}" if isinstance(v, str) else f"{k} = {v:g}"
+                                for k, v in p["params"].items() if k != "law" and v == v) + ")")
             warn(f"{what}: {why}")
     methods = sorted({p["method"] for p in points})
     say(f"wrote {out}: {len(points)} {'regions' if request.region else 'parameter points'}, {len(per_task)} tasks"

@@ -17,7 +17,7 @@ events are in the window; a window cuts no event in two (an event is in when its
 The transient. Each fault discarded the catalog's `transient` events before it recorded (run.transient,
 10 events per block of the longest fault by default: more per block for every shorter one). A fault whose
 discard is below what was measured to be needed, MEASURED_TRANSIENT_PER_BLOCK events per block of its own
-N (docs/benchmarks.md), is named in a warning.
+N (docs/benchmarks.md; of a plane, per block of its N M), is named in a warning.
 
 The bootstrap resamples faults (reduce._units: with at least MIN_UNITS faults; with fewer, the stretches
 of every fault's window, as for a point of few seeds), from SeedSequence(--seed, spawn_key from the
@@ -33,6 +33,7 @@ from ensemble.store import reader, schema
 from ensemble.store.errors import CatalogError
 from ensemble.sweep import sweep_points, task_list
 
+from . import geometry
 from .reduce import PARAMS
 
 
@@ -67,7 +68,8 @@ def group(paths, configs, discarded, tasks, span=None, skip=0.0, partial=False):
     first onset (--region-skip: the later part of the record alone, e.g. to see that the transient is gone).
     partial: a reduction of unfinished runs; its faults with fewer than two inertial events are left out of
     `tasks` (said in a warning). params: {"region": text (describe), "region_label": its
-    label, "law": law, and each of PARAMS: the value its faults share, NaN for a key drawn}."""
+    label, "law": law, and each of PARAMS: the value its faults share, NaN for a key drawn; on a plane its
+    geometry, M and l_across (geometry.point_params)}."""
     warnings = []
     start, last = _onsets(paths, tasks)
     if partial and not np.all(last > start):
@@ -109,7 +111,9 @@ def group(paths, configs, discarded, tasks, span=None, skip=0.0, partial=False):
         tasks["window_end"][rows] = tasks["window_start"][rows] + spans[r] / tasks["nu"][rows]
         shared = {p: (float(tasks[p][rows[0]]) if np.all(tasks[p][rows] == tasks[p][rows[0]]) else np.nan)
                   for p in PARAMS}
-        points.append(({**shared, "region": name, "region_label": short, "law": str(tasks["law"][rows[0]])}, rows))
+        # (a population draws N, l and its law's keys only: its faults share their geometry, M and l_across)
+        points.append(({**shared, "region": name, "region_label": short, "law": str(tasks["law"][rows[0]]),
+                        **geometry.point_params(tasks, rows[0])}, rows))
         warnings += _transient_warnings(paths, discarded, tasks, rows, r)
     return points, spans, warnings
 
@@ -131,7 +135,7 @@ def _onsets(paths, tasks):
 def _transient_warnings(paths, discarded, tasks, rows, r):
     out = []
     for g in rows:
-        need, c = MEASURED_TRANSIENT_PER_BLOCK * int(tasks["N"][g]), int(tasks["catalog"][g])
+        need, c = MEASURED_TRANSIENT_PER_BLOCK * geometry.task_shape(tasks, g).n_blocks, int(tasks["catalog"][g])
         if discarded[c] < need:
             out.append(f"region {r}: {paths[c]} task {tasks['catalog_task'][g]} (N = {tasks['N'][g]}) discarded "
                        f"{discarded[c]} events before it recorded, fewer than the {need:g} its transient may last "

@@ -2,8 +2,9 @@
 import numpy as np
 
 from . import reduce, summary
-from .reduce import LAYOUT, PARAMS
-from .statistics import holds, number_lines
+from .geometry import GEOMETRIES
+from .reduce import GEOMETRY_PARAMS, LAYOUT
+from .statistics import holds, number_lines, refusal
 
 # every number's label in the report (the statistics': Number.label, else its name)
 LABELS = {n.name: n.label or n.name for n in LAYOUT.numbers}
@@ -16,14 +17,20 @@ def level_text(level):
 
 def varying(s):
     """Model parameters that differ between points (for labels and legends)."""
-    return [p for p in PARAMS if len(np.unique(s[f"points/{p}"])) > 1] or ["b"]
+    return [p for p in summary.point_keys(s) if len(np.unique(s[f"points/{p}"])) > 1] or ["b"]
 
 
 def point_label(s, i, keys=None, law=False):
-    """"b = 20", or "slip: b = 20" where the summary's points are of more than one law or `law` asks for it."""
+    """"b = 20", or "slip: b = 20" where the summary's points are of more than one law or `law` asks for it; in a
+    summary that holds a plane, the point's geometry after the law, "lattice: N = 8, ..., M = 6, l_across = 3" (a
+    chain's point there without the plane's keys)."""
     keys = keys or varying(s)
+    geometry = summary.point_geometries(s)[i]
+    theirs = set(GEOMETRY_PARAMS) - set(GEOMETRIES[geometry].keys)    # keys of another geometry than the point's
     text = ", ".join(f"{k} = {s[f'points/{k}'][i]:g}" for k in keys
-                     if not np.isnan(s[f'points/{k}'][i]))     # NaN: a key of another law
+                     if k not in theirs and not np.isnan(s[f'points/{k}'][i]))     # NaN: a key of another law
+    if "points/geometry" in s:
+        text = f"{geometry}: {text}"
     laws = summary.point_laws(s)
     return f"{laws[i]}: {text}" if law or len(set(laws)) > 1 else text
 
@@ -74,7 +81,8 @@ def partial_text(s):
 def table(s):
     """The report: the summary's line, each statistic's lines about the whole summary, then per point its line and
     each statistic's lines (Statistic.report; by default its numbers with their intervals), in the statistics'
-    order, of those the summary holds. A partial reduction says so on its first line."""
+    order, of those the summary holds; a statistic that refuses the point's geometry, its one line why
+    (statistics.refusal). A partial reduction says so on its first line."""
     a = s["attrs"]
     held = [st for st in LAYOUT.statistics if holds(s, st)]
     lines = [partial_text(s)] if partial_text(s) else []
@@ -83,17 +91,21 @@ def table(s):
               f"{a['bootstrap']} bootstrap resamples"]
     lines += [line for st in held if st.report_header is not None for line in st.report_header(s)]
     lines.append("")
+    keys, geometries = summary.point_keys(s), summary.point_geometries(s)
     for i in range(len(s["points/N"])):
         if "points/region" in s:    # a regional reduction (analysis/region.py)
-            lines.append(f"region {i}: {s['points/region_label'][i]}; {point_label(s, i, list(PARAMS), law=True)}  "
+            lines.append(f"region {i}: {s['points/region_label'][i]}; {point_label(s, i, keys, law=True)}  "
                          f"(resampling {s['points/method'][i]}, {s['points/units'][i]} units; "
                          f"window {s['points/region_span'][i]:.6g} T*nu per fault)")
         else:
-            lines.append(f"point {i}: " + point_label(s, i, list(PARAMS), law=True) +
+            lines.append(f"point {i}: " + point_label(s, i, keys, law=True) +
                          f"  (resampling {s['points/method'][i]}, {s['points/units'][i]} units)")
         if unreliable(s, i):
             lines.append(f"    WARNING: {unreliable(s, i)}")
         for st in LAYOUT.statistics:
+            if refusal(st, geometries[i]):
+                lines.append(f"    {refusal(st, geometries[i])}")
+                continue
             # (a statistic a summary holds only in part, an older format's, shows the numbers it has)
             lines += st.report(s, i) if st.report is not None and holds(s, st) else number_lines(st, s, i)
         lines.append("")

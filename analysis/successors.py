@@ -21,6 +21,7 @@ from typing import Callable
 import numpy as np
 
 from . import stats, summary
+from .geometry import CHAIN
 from .paper import PAPER_LAW, RESAMPLES, WORDS, fmt, number, points_for, transients, with_interval
 from .reduce import PARAMS
 from .report import level_text, partial_text, point_label, size_text
@@ -39,8 +40,11 @@ def committed(directory=COMMITTED):
 
 def stiffness(s, i):
     """A block's stiffness on the chain, 1 + 2 l^2: a block whose weakening b is below it creeps before it
-    ruptures (the weak regime)."""
-    return 1.0 + 2.0 * s["points/l"][i] ** 2
+    ruptures (the weak regime). On a plane of M rows the stiffest (interior) block's, 1 + 2 l^2 plus l_across^2 for
+    each neighbour across strike (two where M >= 3; its edge rows have one)."""
+    chain = 1.0 + 2.0 * s["points/l"][i] ** 2
+    M = int(s["points/M"][i]) if "points/M" in s else 1
+    return chain + min(M - 1, 2) * s["points/l_across"][i] ** 2 if M > 1 else chain
 
 
 def _units(s, i, tables):
@@ -409,8 +413,10 @@ def _needs(claim):
 
 
 def pool(paper, summaries, names):
-    """[(summary, its points of the paper's law, name)] of the summaries holding the paper's numbers."""
-    return [(s, [i for i, law in enumerate(summary.point_laws(s)) if law == PAPER_LAW],
+    """[(summary, its points of the paper's law on a chain, name)] of the summaries holding the paper's numbers (the
+    papers' models are chains: a plane's points are none of theirs)."""
+    return [(s, [i for i, (law, shape) in enumerate(zip(summary.point_laws(s), summary.point_geometries(s)))
+                 if law == PAPER_LAW and shape == CHAIN],
              Path(str(name)).name.removesuffix(".h5").removesuffix(".summary"))
             for s, name in zip(summaries, names) if holds(s, paper.needs)]
 

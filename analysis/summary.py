@@ -17,6 +17,9 @@
     /points/{N, l, nu, <law keys>}              parameters of each point (first appearance order;
                                                 the keys of every friction law, NaN if not its law's)
     /points/law                                 its friction law (two laws may share keys: aging, slip)
+    /points/{geometry, M, l_across}             its geometry and the plane's shape (only where a task is not a
+                                                chain: then /tasks/{geometry, M, l_across} too; a summary of
+                                                chains is as before the plane)
     /points/method, /points/units               resampling used ("seeds", "faults" or "blocks") and unit count
     /points/{mu, tnu, tnu_interior}_density     (points, bins): estimate; *_lo, *_hi: interval
     /points/{creep_mu, creep_duration}_density  the same for the creep episodes (format 3)
@@ -68,7 +71,8 @@ from ensemble import checks, filekind, space
 from ensemble.store import schema as catalog_schema
 
 from . import options, reduce
-from .reduce import MIN_UNITS, NUMBERS, PARAMS
+from .geometry import CHAIN
+from .reduce import GEOMETRY_PARAMS, MIN_UNITS, NUMBERS, PARAMS
 from .statistics import bin_names
 
 FORMAT = filekind.SUMMARY_FORMAT_PREFIX + "6"   # 6: checksums (a `crc32` on every dataset, `attrs_crc32` over
@@ -117,8 +121,7 @@ def _table_entry(name):
 DATASETS = {
     **{f"bins/{name}": (unit, f"({name} bins + 1,)", f"edges of the {what}, half-open [lo, hi), the last one too")
        for name, (unit, what) in _BINS.items()},
-    **{name: entry for name, entry in catalog_schema.DATASETS.items()
-       if name.startswith("tasks/") and name[len("tasks/"):] not in catalog_schema.GEOMETRY_TASKS},
+    **{name: entry for name, entry in catalog_schema.DATASETS.items() if name.startswith("tasks/")},
     **{f"tasks/{name}": entry for name, entry in catalog_schema.READER_TASKS.items()},
     # the columns a summary of one or more catalogs (analysis/merge.py) sets or adds
     "tasks/point": ("index", "(tasks,)", "parameter point the task pools into (row of /points)"),
@@ -134,6 +137,13 @@ DATASETS = {
     **{f"points/{name}": (unit, _POINTS, f"{meaning}, of the point's tasks")
        for name, (unit, _, meaning) in ((n, catalog_schema.DATASETS[f"tasks/{n}"]) for n in PARAMS)},
     "points/law": ("text", _POINTS, "friction law of the point's tasks (a point is a law and its parameters)"),
+    # where a task is of another geometry than the chain (analysis/geometry.py); a summary of chains holds none
+    "points/geometry": ("text", _POINTS, "model.geometry of the point's tasks (a summary of chains alone holds none "
+                                         "of these three)"),
+    "points/M": ("count", _POINTS, "blocks across strike of the point's tasks (model.M; 1 on a chain); its blocks "
+                                   "are N M"),
+    "points/l_across": ("1", _POINTS, "spring stiffness across strike of the point's tasks (model.l_across; NaN on a "
+                                      "chain)"),
     "points/method": ("text", _POINTS, "resampling units of the intervals: 'seeds' (the point's tasks, "
                                        f"when it has at least {MIN_UNITS}; 'faults' those of a region) or 'blocks' "
                                        "(the stretches of all its tasks)"),
@@ -245,6 +255,10 @@ def write(path, inputs, per_task, points, opt, force=False):
         for name in PARAMS:
             h5[f"points/{name}"] = np.array([p["params"][name] for p in points])
         h5["points/law"] = np.array([p["params"]["law"] for p in points], dtype="S")
+        if "geometry" in inputs.tasks:   # a plane among the tasks (merge.read): every point says its shape
+            h5["points/geometry"] = np.array([p["params"].get("geometry", CHAIN) for p in points], dtype="S")
+            h5["points/M"] = np.array([p["params"].get("M", 1) for p in points], dtype=np.int64)
+            h5["points/l_across"] = np.array([p["params"].get("l_across", np.nan) for p in points], dtype=np.float64)
         if inputs.spans:    # a regional reduction (analysis/region.py)
             h5["points/region"] = np.array([p["params"]["region"].encode() for p in points], dtype="S")
             h5["points/region_label"] = np.array([p["params"]["region_label"].encode() for p in points], dtype="S")
@@ -325,7 +339,7 @@ def read(path):
             raise SummaryError(f"{path}: summary format {out['attrs'].get('format', '(none)')}, this version "
                                f"reads {' and '.join(READS)}; reduce the catalog again")
         out["points/method"] = np.array([m.decode() for m in out["points/method"]])
-        for name in ("points/region", "points/region_label"):
+        for name in ("points/region", "points/region_label", "points/geometry"):
             if name in out:
                 out[name] = np.array([x.decode() for x in out[name]])
     for name in PARAMS:   # a summary from before the friction-law registry: aging points, no other keys
@@ -334,6 +348,23 @@ def read(path):
         out["points/law"] = np.array([law.decode() for law in out["points/law"]])
     out["points/law"] = point_laws(out)
     return out
+
+
+def point_geometries(s):
+    """(points,) the geometry of each point of summary `s` (read): chains where it holds none."""
+    return np.asarray(s["points/geometry"]) if "points/geometry" in s else np.full(len(s["points/N"]), CHAIN)
+
+
+def point_blocks(s):
+    """(points,) the number of blocks of each point of summary `s` (read): N, or N M on a plane."""
+    M = s["points/M"] if "points/M" in s else 1
+    return (np.asarray(s["points/N"]) * M).astype(np.int64)
+
+
+def point_keys(s):
+    """The parameters that tell the points of summary `s` apart: reduce.PARAMS, and the plane's M and l_across
+    where it holds a plane (the geometry's name is said as the law is: report.point_label)."""
+    return list(PARAMS) + [k for k in GEOMETRY_PARAMS if k != "geometry" and f"points/{k}" in s]
 
 
 def point_laws(s):

@@ -115,6 +115,8 @@ QUICK = {
                                    "test_a_hand_built_sequence_gives_its_classes"],
     "test_slow_slip.py": ["test_the_table_is_the_rows_whatever_the_chunks"],
     "test_successors.py": ["test_the_regimes_name_a_point_that_breaks_them"],
+    "test_plane_analysis.py": ["test_the_scanner_on_a_plane_is_a_plain_scan_whatever_the_chunks",
+                               "test_the_seismicity_of_a_plane_counts_euclidean_distances_block_by_block"],
 }
 NOT_QUICK = {   # test files with no test in the quick tier, and why
     "test_sequences.py": "every test needs a serial catalog and a full-chain reference (10 s and more)",

@@ -13,6 +13,7 @@ import sys
 import numpy as np
 import pytest
 
+from analysis import summary
 from ensemble.config import Integrator, Model
 from ensemble.integrators import kernel_params
 from ensemble.model.chain import simulate
@@ -226,14 +227,22 @@ def test_a_plane_runs_on_two_ranks_and_resumes_after_a_kill_to_the_same_catalog(
     np.testing.assert_array_equal(events["boundary"], edge)
 
 
-def test_the_analysis_refuses_a_plane_in_one_line(plane_run, tmp_path):
-    """Its statistics measure distances along a chain: a lattice's catalog is refused, naming it, not reduced."""
+def test_the_analysis_reads_a_plane(plane_run, tmp_path):
+    """The analysis takes its distances from the geometry (analysis/geometry.py): a lattice's catalog reduces into
+    points that say their shape, and the statistics of chains only say so in one line each."""
     d, _ = plane_run
     res = run_bounded([sys.executable, "-m", "analysis", "reduce", str(d / "serial.h5"), "-o",
                        str(tmp_path / "s.h5")], 120, cwd=ROOT, env=child_env())
-    assert res.returncode != 0 and not (tmp_path / "s.h5").exists()
-    lines = res.stderr.strip().splitlines()
-    assert len(lines) == 1 and "model.geometry = 'lattice'" in lines[0] and "serial.h5" in lines[0], lines
+    assert res.returncode == 0, res.stderr
+    s = summary.read(tmp_path / "s.h5")
+    assert list(s["points/geometry"]) == ["lattice"] * 2 and list(s["points/M"]) == [8] * 2
+    assert list(s["points/b"]) == [30.0, 45.0] and s["points/numbers/n_creep"][:, 0].tolist()[1] == 0
+    res = run_bounded([sys.executable, "-m", "analysis", "report", str(tmp_path / "s.h5")], 120, cwd=ROOT,
+                      env=child_env())
+    assert res.returncode == 0, res.stderr
+    lines = res.stdout.splitlines()
+    assert [line.split(":")[0].strip() for line in lines if "not on a lattice" in line] == \
+        ["rupture_classes", "slow_slip"] * 2, lines
 
 
 @pytest.mark.parametrize("model, message", [

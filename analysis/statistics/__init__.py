@@ -36,6 +36,12 @@ A statistic (a module of this package that defines STATISTIC) declares
   comparison, analysis/compare.py); `Layout(of("compare"))` lays out a set.
 - optionally `extra(units, opt, rng)`: {name: array} per point beyond numbers and curves, computed after
   the bootstrap of the numbers and curves (the recurrence peaks).
+- the geometries it holds on (`geometries`, analysis/geometry.py; empty: every one), and why not on the others
+  (`why_not`): a statistic whose meaning is a chain's (an interval of blocks, the ends of the chain) refuses a
+  plane. The engine feeds it no task of another geometry; that point's numbers, curves and extras are NaN, the
+  report says `refusal` in one line instead, and its figures refuse such a point in one line. Distances between
+  blocks come from the geometry (Rows.shape: Euclidean in block units, |i - j| on the chain), and block counts
+  from Rows.n_blocks (N M on a plane).
 
 The engine (analysis/reduce.py) streams each task once, hands every statistic the same rows, stacks the
 tables of a point's units, bootstraps them all alike, and the summary stores and describes what the
@@ -66,6 +72,8 @@ import numba as nb
 import numpy as np
 
 import ensemble.model  # noqa: F401  (first: numba caches the kernels in the package's cache, ensemble/kernel_cache.py)
+
+from ..geometry import GEOMETRIES
 
 
 @dataclass(frozen=True)
@@ -200,6 +208,15 @@ class Statistic:
     report_header: Optional[Callable] = None
     exports: tuple = ()             # its ExportTables (`analysis export` of a summary)
     figures: tuple = ()             # its Figures (`analysis plot --figure NAME`)
+    geometries: tuple = ()          # the geometries it holds on (analysis/geometry.py); empty: every one
+    why_not: str = ""               # why it refuses the others (a few words: the report's and the figures' line)
+
+
+def refusal(statistic, geometry):
+    """Why `statistic` has no numbers on a point of `geometry` (a geometry's name), in one line; '' where it has."""
+    if not statistic.geometries or geometry in statistic.geometries:
+        return ""
+    return f"{statistic.name}: not on a {geometry} ({statistic.why_not})"
 
 
 def holds(s, statistic):
@@ -270,6 +287,12 @@ def _check(found):
             options[o.name] = st
     criteria = {c.name: c for st in found for c in st.criteria}
     for st in found:
+        unknown = sorted(set(st.geometries) - set(GEOMETRIES))
+        if unknown:
+            fail(st, f"geometry {unknown[0]!r} is none of the analysis' ({', '.join(GEOMETRIES)}: "
+                     "analysis/geometry.py)")
+        if st.geometries and not st.why_not:
+            fail(st, "holds on some geometries only: say why not on the others (why_not)")
         for name in st.uses_options:
             if name not in options:
                 fail(st, f"uses option {name!r}, which no statistic declares")
@@ -434,9 +457,10 @@ class Rows:
     events' columns; block: the stretch of each inertial event; creep: mask of its creep episodes and
     creep_block their stretches; recurrences: (stretch of the starting event, T nu, interior) of the
     recurrences closed in this chunk, or None when no statistic asks for them; t_before: the time of the
-    task's last inertial event before this chunk (NaN before its first); nu, opt; n_blocks: N, the blocks of
-    the chain; last: whether this chunk holds the task's last inertial event (none come after it); scans: the
-    recurrences by criterion of a large event (Criterion), those the statistics need.
+    task's last inertial event before this chunk (NaN before its first); nu, opt; n_blocks: the task's blocks, N on
+    a chain, N M on a plane (what block counts such as n_slipped reach); last: whether this chunk holds the task's
+    last inertial event (none come after it); scans: the recurrences by criterion of a large event (Criterion),
+    those the statistics need; shape: the task's geometry.Shape (where its blocks lie: Shape.position).
     """
     part: dict
     inertial: np.ndarray
@@ -451,3 +475,4 @@ class Rows:
     n_blocks: int = 0
     last: bool = False
     scans: dict = field(default_factory=dict)   # criterion -> recurrences as `recurrences` ("mu": the same)
+    shape: object = None

@@ -132,7 +132,8 @@ def draw(summaries, fig, keys, labels, names, title):
         band(ax, x, s["points/tnu_density"][i], s["points/tnu_lo"][i], s["points/tnu_hi"][i],
              "all large events", "C0")
         band(ax, x, s["points/tnu_interior_density"][i], s["points/tnu_interior_lo"][i],
-             s["points/tnu_interior_hi"][i], "interior events (the rupture reaches neither end)", "C3", style="--")
+             s["points/tnu_interior_hi"][i], "interior events (the rupture reaches "
+             + ("no edge)" if "points/geometry" in s else "neither end)"), "C3", style="--")
         if "points/numbers/cv_tnu" in s:       # (summaries before format 4 have no intervals statistic)
             label += "\nCV of $T\\nu$ " + number_text(*s["points/numbers/cv_tnu"][i], digits=".2f", missing="n/a")
         ax.set_title(label, fontsize=FONT + 1)

@@ -1,7 +1,8 @@
 """Rupture lengths: the number of blocks an event slips, n = 0..N, a size axis that means the same under
 every friction law (the comparison's, analysis/compare.py; its module docstring defines the numbers).
 
-Its table counts the inertial events per n on bins of the chain's own (0..N: each point has its N), so that
+Its table counts the inertial events per n on bins of the chain's own (0..N: each point has its N; a plane's
+0..N M, Rows.n_blocks, n an area there), so that
 every number is a function of summed counts. The numbers: the share of events with n >= n_large, the dip of
 R(log10 n), the exponent tau of a discrete power law fitted to n_min <= n < n_large and the KS distance of
 all n >= n_min from that law continued to N; the curve: R(log10 n) averaged over bins of LOG_BIN in log10 n.

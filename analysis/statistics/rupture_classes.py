@@ -11,6 +11,9 @@ The classes, as this code defines them (the paper's text was not at hand; docs/s
 - at the rim: its epicenter within `window` blocks (the recurrences' window) of an end of the rupture zone of the
   task's last large event (mu >= mu_c) before it, min(|e - first'|, |e - last'|) <= window; counted among the
   events of each class that have such a predecessor.
+
+A chain's statistic: on a plane the rupture zone is an area, not an interval, and the catalog keeps only its
+extents, not its rim; a plane's points have no numbers here (statistics.refusal).
 """
 import numpy as np
 
@@ -114,4 +117,6 @@ STATISTIC = Statistic(
              Option("uni_edge", "number", 0.1, "1", "unilateral: epicenter within this share of the rupture "
                                                     "zone's length from one of its ends", 0.0, 0.5)),
     figures=(Figure("rupture_classes", "R(mu) of the unilateral and of the bilateral events of every point",
-                    figure_size, draw),))
+                    figure_size, draw),),
+    # on a plane a rupture zone is an area whose rim the catalog does not keep (only its extents along and across)
+    geometries=("chain",), why_not="its classes and rims are the ends of an interval of blocks along a chain")

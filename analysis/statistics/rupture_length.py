@@ -12,6 +12,9 @@ off over the range) gives NaN, as fewer than two events do. The definition of L_
 code's choice: the paper's text was not at hand (docs/successors.md). lr_min's default, 200 blocks, lies past
 the hump of P(L_r) at the seed paper's b = 20 (its peak near 130 blocks): from 50 the fit would take the hump's
 rise for the tail. The tail is not quite exponential: L_0 falls as lr_min grows (docs/successors.md).
+
+On a plane L_r is still the blocks an event slips, there an area (Rows.n_blocks = N M: the fit's top is
+min(lr_max, N M - 1), ruptures of the whole plane out), and L_0 the scale of its tail in blocks, an area.
 """
 import math
 
@@ -50,7 +53,7 @@ def correlation_length(n, excess, span):
 
 
 def fit_range(lr_min, lr_max, n_blocks):
-    """(lr_min, top): the L_0 fit's range of a chain of n_blocks, whole-chain ruptures out."""
+    """(lr_min, top): the L_0 fit's range of a chain (or plane) of n_blocks, whole-chain (-plane) ruptures out."""
     return lr_min, min(lr_max, n_blocks - 1)
 
 
@@ -76,7 +79,8 @@ def fitted_density(s, i, lengths):
     """The fitted law of point i of summary `s` as a density over all its inertial events, at integer `lengths`
     (NaN outside the fit's range and without an L_0)."""
     l0, n_fit = s["points/numbers/L0"][i, 0], s["points/numbers/n_L0"][i, 0]
-    lo, top = fit_range(int(s["attrs"]["lr_min"]), int(s["attrs"]["lr_max"]), int(s["points/N"][i]))
+    from ..summary import point_blocks
+    lo, top = fit_range(int(s["attrs"]["lr_min"]), int(s["attrs"]["lr_max"]), int(point_blocks(s)[i]))
     out = np.full(len(lengths), np.nan)
     inside = (lengths >= lo) & (lengths <= top)
     if np.isfinite(l0) and n_fit > 0 and inside.any():
@@ -97,6 +101,7 @@ def draw(summaries, fig, keys, labels, names, title):
     from ..drawing import FONT, band, layout, legend_columns, palette
     from ..figure_labels import points_of
     from ..stats import centers
+    from ..summary import point_blocks
     from . import number_text
     ax = fig.add_subplot()
     points = points_of(summaries)
@@ -105,7 +110,7 @@ def draw(summaries, fig, keys, labels, names, title):
         band(ax, x, s["points/lr_density"][i], s["points/lr_lo"][i], s["points/lr_hi"][i],
              f"{label}: $L_0$ = {number_text(*s['points/numbers/L0'][i], digits='.3g')}", color, log=True,
              open_ends=True)
-        lengths = np.arange(int(s["points/N"][i]) + 1)
+        lengths = np.arange(int(point_blocks(s)[i]) + 1)
         ax.plot(lengths, fitted_density(s, i, lengths), "--", color=color, lw=1.0)
     ax.set_yscale("log")
     density = np.concatenate([s["points/lr_density"].ravel() for s in summaries])

@@ -3,7 +3,8 @@ mu >= mu_c), stacked by their time from its onset and their distance from its ep
 
 Every pair (mainshock m, inertial event i != m of the same task, of any size, a mainshock too) with
 dt = T_i - T_m in the time bins (T = t nu, the loader's displacement; negative dt: before the mainshock)
-and d = |epicenter_i - epicenter_m| in the distance bins (blocks) is counted in the 2-d histogram
+and d = |epicenter_i - epicenter_m| in the distance bins (blocks; on a plane the Euclidean distance in block
+units between the epicenters, sqrt(dx^2 + dy^2) with dx along strike and dy across) is counted in the 2-d histogram
 `seis_pairs` (time bins x distance bins), in the stretch of the mainshock. Pairs are found across the
 chunks in which a task streams: the events of the last max(|lo|, |hi|) of T nu are carried to the next
 chunk, and a pair is counted in the chunk of its later event.
@@ -12,10 +13,13 @@ The rates are honest about what was observed: a mainshock's exposure in a cell (
 bin k) is the time of bin j that lies within the task's observed span [T of its first inertial event,
 T of its last] (a window cut by the start or the end of the task's rows counts only what it covers),
 times the number of blocks of the chain (0 .. N-1) at a distance in bin k of the epicenter (fewer near
-the chain's ends). A mainshock's exposure is added when its window has been seen to its end, or with
+the chain's ends; on a plane the blocks of the N x M plane at a Euclidean distance in bin k, fewer near its
+edges). A mainshock's exposure is added when its window has been seen to its end, or with
 the task's last inertial event; so it is added once, the same way whatever the chunks. The map is the
 counts over the summed exposures: events per mainshock per block per unit T nu, like the background
-rate: every inertial event after the task's first, over the blocks of the chain times the task's span.
+rate: every inertial event after the task's first, over the blocks of the chain (N M of a plane) times the
+task's span. The chain keeps its own kernels (count_pairs, expose), the plane has its own (count_pairs_plane,
+expose_plane): KERNELS, by geometry.
 
 The numbers take the cells whose bins lie wholly within a region (options seis_near, seis_ring,
 seis_short, seis_long: put them on the bins' edges): near = distance < seis_near, ring = seis_near <=
@@ -29,6 +33,7 @@ import numpy as np
 
 import ensemble.model  # noqa: F401  (first: numba caches the kernel in the package's cache, ensemble/kernel_cache.py)
 
+from .. import geometry
 from . import ExportTable, Figure, Number, Option, Statistic, Table, holds
 
 NAME = "seismicity"
@@ -85,7 +90,7 @@ def expose(T, x, s, start, end, n_blocks, time_edges, distance_edges, out):
     stretch s), one after the other: the T nu of each time bin of its window within [start, end] times the
     blocks 0 .. n_blocks - 1 at a distance in each distance bin of x (|j - x| < D counts the integers j in
     (x - D, x + D), clipped to the chain)."""
-    n_time, n_distance = time_edges.shape[0] - 1, distance_edges.shape[0] - 1
+    n_distance = distance_edges.shape[0] - 1
     space = np.empty(n_distance)
     for m in range(T.shape[0]):
         below = 0.0
@@ -99,19 +104,96 @@ def expose(T, x, s, start, end, n_blocks, time_edges, distance_edges, out):
             if k > 0:
                 space[k - 1] = within - below
             below = within
-        for j in range(n_time):
-            a, b = T[m] + time_edges[j], T[m] + time_edges[j + 1]
-            cover = max(min(b, end) - max(a, start), 0.0)
-            for k in range(n_distance):
-                out[s[m], j * n_distance + k] += cover * space[k]
+        _spread(T[m], s[m], start, end, time_edges, space, out)
+
+
+@nb.njit(cache=True)
+def _spread(T, s, start, end, time_edges, space, out):
+    """Add one mainshock's exposure (onset T, stretch s) to out: the T nu of each time bin of its window within
+    [start, end] times its blocks in each distance bin (space)."""
+    n_time, n_distance = time_edges.shape[0] - 1, space.shape[0]
+    for j in range(n_time):
+        a, b = T + time_edges[j], T + time_edges[j + 1]
+        cover = max(min(b, end) - max(a, start), 0.0)
+        for k in range(n_distance):
+            out[s, j * n_distance + k] += cover * space[k]
+
+
+@nb.njit(cache=True)
+def _plane_bin(dx, dy, distance_edges):
+    """The distance bin of a block dx along and dy across strike from the epicenter (-1: in none)."""
+    k = np.searchsorted(distance_edges, np.sqrt(float(dx * dx + dy * dy)), side="right") - 1
+    return k if k < distance_edges.shape[0] - 1 else -1
+
+
+@nb.njit(cache=True)
+def count_pairs_plane(T, x, y, main, stretch, n_old, time_edges, distance_edges, out):
+    """count_pairs on a plane: the epicenters at (x along, y across strike), a pair's distance Euclidean in block
+    units, binned by its own search of the distance edges."""
+    lo, hi = time_edges[0], time_edges[-1]
+    n = T.shape[0]
+    for m in range(n):
+        if not main[m]:
+            continue
+        if m >= n_old:
+            i = m - 1
+            while i >= 0 and T[i] - T[m] >= lo:
+                _add(T[i] - T[m], _plane_bin(x[i] - x[m], y[i] - y[m], distance_edges), stretch[m], time_edges, out)
+                i -= 1
+        i = max(m + 1, n_old)
+        while i < n and T[i] - T[m] < hi:
+            _add(T[i] - T[m], _plane_bin(x[i] - x[m], y[i] - y[m], distance_edges), stretch[m], time_edges, out)
+            i += 1
+
+
+@nb.njit(cache=True)
+def expose_plane(T, x, y, s, start, end, n_along, n_across, time_edges, distance_edges, out):
+    """expose on a plane of n_along x n_across blocks: each mainshock's blocks in each distance bin counted one by
+    one (those within the last edge: a square of its side around the epicenter, cut by the plane's edges), binned
+    as the pairs are (_plane_bin)."""
+    n_distance = distance_edges.shape[0] - 1
+    space = np.empty(n_distance)
+    reach = int(np.ceil(min(distance_edges[n_distance], float(n_along + n_across))))
+    for m in range(T.shape[0]):
+        space[:] = 0.0
+        for i in range(max(y[m] - reach, 0), min(y[m] + reach, n_across - 1) + 1):
+            for j in range(max(x[m] - reach, 0), min(x[m] + reach, n_along - 1) + 1):
+                k = _plane_bin(j - x[m], i - y[m], distance_edges)
+                if k >= 0:
+                    space[k] += 1.0
+        _spread(T[m], s[m], start, end, time_edges, space, out)
+
+
+def _chain_pairs(T, epicenter, main, stretch, n_old, opt, shape, out):
+    count_pairs(T, epicenter, main, stretch, n_old, opt.seis_time_edges,
+                distance_bins(max(shape.n_blocks, int(epicenter.max()) + 1), opt.seis_distance_edges), out)
+
+
+def _plane_pairs(T, epicenter, main, stretch, n_old, opt, shape, out):
+    x, y = shape.position(epicenter)
+    count_pairs_plane(T, x, y, main, stretch, n_old, opt.seis_time_edges, opt.seis_distance_edges, out)
+
+
+def _chain_expose(T, epicenter, s, start, end, opt, shape, out):
+    expose(T, epicenter, s, start, end, shape.n_blocks, opt.seis_time_edges, opt.seis_distance_edges, out)
+
+
+def _plane_expose(T, epicenter, s, start, end, opt, shape, out):
+    x, y = shape.position(epicenter)
+    expose_plane(T, x, y, s, start, end, shape.N, shape.M, opt.seis_time_edges, opt.seis_distance_edges, out)
+
+
+# the kernels of each geometry (analysis/geometry.py): (count the pairs, add the exposures), each taking the
+# epicenters' block indices and the task's Shape
+KERNELS = {"chain": (_chain_pairs, _chain_expose), "lattice": (_plane_pairs, _plane_expose)}
 
 
 def _expose(acc, carry, take, end, opt):
     """Add the exposures of the pending mainshocks `take` (a mask, in time order) with the span ending at `end`,
     one after the other (the sums are the same whatever the chunks)."""
-    expose(carry["pending_T"][take], carry["pending_x"][take], carry["pending_s"][take].astype(np.int64),
-           carry["start"], end, carry["n_blocks"], opt.seis_time_edges, opt.seis_distance_edges,
-           acc["seis_exposure"])
+    KERNELS[carry["shape"].geometry][1](carry["pending_T"][take], carry["pending_x"][take],
+                                        carry["pending_s"][take].astype(np.int64), carry["start"], end, opt,
+                                        carry["shape"], acc["seis_exposure"])
 
 
 def feed(acc, rows):
@@ -125,9 +207,10 @@ def feed(acc, rows):
     carry = acc.carry.get(NAME)
     if carry is None:   # the task's first inertial event opens its span
         carry = acc.carry[NAME] = {
-            "start": T[0], "n_blocks": rows.n_blocks, "T": T[:0], "x": x[:0], "main": main[:0], "s": rows.block[:0],
+            "start": T[0], "shape": rows.shape or geometry.shape(rows.n_blocks), "T": T[:0], "x": x[:0],
+            "main": main[:0], "s": rows.block[:0],
             "pending_T": T[:0], "pending_x": x[:0], "pending_s": rows.block[:0]}
-    # the background: every event after the task's first closes a gap of the whole chain
+    # the background: every event after the task's first closes a gap of the whole chain (or plane)
     t = np.concatenate([[rows.t_before], rows.ev["t"]])
     gap = np.diff(t) * rows.nu
     first = 0 if np.isfinite(rows.t_before) else 1
@@ -140,8 +223,8 @@ def feed(acc, rows):
     allx = np.concatenate([carry["x"], x])
     allm = np.concatenate([carry["main"], main])
     alls = np.concatenate([carry["s"], rows.block])
-    count_pairs(allT, allx, allm, alls.astype(np.int64), n_old, edges,
-                distance_bins(max(rows.n_blocks, int(allx.max()) + 1), opt.seis_distance_edges), acc["seis_pairs"])
+    KERNELS[carry["shape"].geometry][0](allT, allx, allm, alls.astype(np.int64), n_old, opt, carry["shape"],
+                                        acc["seis_pairs"])
     keep = allT >= allT[-1] - max(abs(edges[0]), abs(edges[-1]))
     carry.update(T=allT[keep], x=allx[keep], main=allm[keep], s=alls[keep])
     # the exposures: of every mainshock whose window has been seen to its end, in time order

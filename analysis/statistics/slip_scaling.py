@@ -5,7 +5,8 @@ An event's mean slip is its total slip over the blocks it slipped, slip / L_r (L
 stress drop the mean drop of those blocks' forces by its slip (/events/stress_drop, ensemble/model/workspace.py:
 D_STRESS_DROP; NaN in catalogs before bk-catalog-7, whose events are left out of the stress drop's sums alone).
 The curves: the mean of each per bin of L_r (the lr bins of rupture_length.py). The numbers, over the events of
-the L_0 fit's range lr_min <= L_r <= top = min(lr_max, N - 1) (rupture_length.py; "large" here): the mean of
+the L_0 fit's range lr_min <= L_r <= top = min(lr_max, N - 1) (N M - 1 on a plane, where L_r is an area:
+rupture_length.py; "large" here): the mean of
 each, and the ratio of its mean over the upper half of the range (L_r >= (lr_min + top) / 2) to its mean over
 the lower half, 1 where it does not depend on L_r.
 """

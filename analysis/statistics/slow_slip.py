@@ -22,6 +22,11 @@ slips (silent earthquakes over silent earthquakes and mainshocks).
 An episode's row comes when it ends, after the rows of the events during it, so the task's mainshocks are kept
 from chunk to chunk (their onset, end, zone, slip, stretch and what has been counted of them: `acc.carry`); each
 count is added once, when the episode that makes it is read, whatever the chunks.
+
+A chain's statistic: a creep episode's and an event's blocks are intervals there (first..last), so "its blocks
+hold the epicenter" and "meets the zone or its two neighbours" are exact. On a plane they are areas of which the
+catalog keeps the extents along and across only, whose box also holds blocks of neither: a plane's points have no
+numbers here (statistics.refusal).
 """
 import numpy as np
 
@@ -197,4 +202,7 @@ STATISTIC = Statistic(
                                  "varying parameters", map_size, draw_map, describe=describe_map),),
     options=(Option("afterslip_window", "number", 0.01, "model length",
                     "afterslip: a creep episode beginning at most this long (T nu) after a mainshock's end", 0.0,
-                    1e9),))
+                    1e9),),
+    # on a plane a creeping cluster and a rupture zone are areas; the catalog keeps their extents only, whose box
+    # holds blocks of neither, so "next to" could not be told
+    geometries=("chain",), why_not="its precursors and afterslip are intervals of blocks next to each other on a chain")
