@@ -46,3 +46,5 @@ def test_unilateral_ruptures_and_shapes_count_only_ruptures_bounded_by_their_own
     assert (r["large"], r["large_own_ends"], r["large_own_shape"]) == (3, 2, 1)
     assert r["unilateral"] == 0.5 and r["anisotropy_median"] == 10.0
     assert r["whole"] == 0.25 and r["spanning"] == 0.25
+    # near the fault's edges (a tenth of 100 along, of 10 across): the third alone (y = 0); uniform chance 0.36
+    assert r["near_edge"] == 1 / 3 and r["edge_chance"] == 1 - 0.8 ** 2

@@ -12,15 +12,17 @@ many events they rest on). For each, of its inertial events (not its creep episo
 - the large events (LARGE_BLOCKS blocks or more): of those that do not run from one end of the fault to the other,
   how often their epicenter lies at an end of the rupture's extent along strike (within a tenth of its length:
   UNILATERAL; a uniformly placed epicenter is there 1 time in 5); of those that span neither the fault's length
-  nor its width, the median of their extent along over across strike (anisotropy);
+  nor its width, the median of their extent along over across strike (anisotropy); of all of them, how often the
+  epicenter lies near the fault's own edges (within EDGE_BAND of its length of an end, or of its width of an edge),
+  beside a uniformly placed epicenter's chance;
 - intervals: 95 %, over the catalog cut into CHUNKS stretches of consecutive events resampled (a block bootstrap:
   events close in time are not independent).
 
 With --histories (a plane's catalog run with output.history): each kept event's rupture zone (the blocks that
 slipped), whether its epicenter lies on the zone's rim (a slipped block beside one that did not slip or beside
 the plane's edge; against the fraction of the zone's blocks on its rim, what a uniformly placed epicenter gives),
-and two figures of the largest kept event that does not slip the whole plane: its slip on the plane and the time
-each block started to slip (the rupture's growth).
+and two figures of the largest kept event that slips at most half the plane (else the largest that does not slip
+all of it): its slip on the plane and the time each block started to slip (the rupture's growth).
 
 Writes OUT.json (every number), OUT.md (the table) and OUT_{mu,zone,growth}.png.
 """
@@ -41,6 +43,7 @@ from examples.populations.answer import best_decades, top_decades
 EDGES = np.round(np.arange(0.0, 9.0 + 1e-9, 0.01), 2)
 LARGE_BLOCKS = 100      # a large event slips at least this many blocks (and not every block)
 UNILATERAL = 0.1        # an epicenter within this fraction of the extent's length from one of its ends
+EDGE_BAND = 0.1         # ... within this fraction of the fault's length (width) from its ends (edges)
 CHUNKS = 20             # stretches of consecutive events the bootstrap resamples
 RESAMPLES = 400
 LEVEL = 0.95
@@ -66,14 +69,19 @@ def numbers(ev, n_blocks):
     # its shape is its own where it spans neither the fault's length nor (on a plane) its width
     own_ends = large & (length < N)
     own_shape = own_ends & ((width < M) | (M == 1))
-    x = ev["epicenter"] % N
+    x, y = ev["epicenter"] % N, ev["epicenter"] // N
     at_end = np.minimum(x - ev["first"], ev["last"] - x) <= UNILATERAL * np.maximum(length - 1, 1)
+    # the epicenter near the fault's own edges: within EDGE_BAND of its length of an end, or of its width of an
+    # edge across strike (a plane); a uniformly placed one is there with the chance `edge_chance`
+    near = (np.minimum(x, N - 1 - x) < EDGE_BAND * N) | ((M > 1) & (np.minimum(y, M - 1 - y) < EDGE_BAND * M))
     return {"events": int(len(mu)), "whole": float(np.mean(slipped == n_blocks)),
             "spanning": float(np.mean((length == N) & (width == M))),
             "best_two_decades": dict(zip(("ks", "from_mu", "b"), best)),
             "top_two_decades": dict(zip(("ks", "from_mu", "b"), top)),
             "large": int(large.sum()), "large_own_ends": int(own_ends.sum()), "large_own_shape": int(own_shape.sum()),
             "unilateral": float(np.mean(at_end[own_ends])) if own_ends.any() else math.nan,
+            "near_edge": float(np.mean(near[large])) if large.any() else math.nan,
+            "edge_chance": 1 - (1 - 2 * EDGE_BAND) ** (2 if M > 1 else 1),
             "anisotropy_median": (float(np.median(length[own_shape] / width[own_shape])) if own_shape.any()
                                   else math.nan)}
 
@@ -92,7 +100,7 @@ def with_intervals(ev, n_blocks, rng):
         values = np.array([get(d) for d in draws], dtype=float)
         return [float(v) for v in np.nanpercentile(values, q)] if np.isfinite(values).any() else [math.nan] * 2
 
-    for key in ("whole", "spanning", "unilateral", "anisotropy_median"):
+    for key in ("whole", "spanning", "unilateral", "near_edge", "anisotropy_median"):
         whole[f"{key}_interval"] = interval(lambda d, key=key: d[key])
     for key in ("best_two_decades", "top_two_decades"):
         whole[key]["ks_interval"] = interval(lambda d, key=key: d[key]["ks"])
@@ -188,8 +196,8 @@ def table(results, rims):
         return f"{v:.{d}f} [{i[0]:.{d}f}, {i[1]:.{d}f}]"
     lines = ["| catalog | events | slip every block | span the fault both ways | best two decades: KS, from mu, b | "
              "top two decades: KS, from mu, b | large: all, own ends, own shape | epicenter at an end along strike | "
-             "extent along / across (median) |",
-             "|---|---|---|---|---|---|---|---|---|"]
+             "large events' epicenter near the fault's edge (uniform) | extent along / across (median) |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     def decades(d):
         return f"{iv(d['ks'], d['ks_interval'])}, {d['from_mu']:.2f}, {iv(d['b'], d['b_interval'], 2)}"
 
@@ -200,7 +208,9 @@ def table(results, rims):
                      f"{decades(best)} | {decades(top)} | "
                      f"{r['large']}, {r['large_own_ends']}, {r['large_own_shape']} | "
                      f"{iv(r['unilateral'], r['unilateral_interval'])} | "
-                     f"{iv(r['anisotropy_median'], r['anisotropy_median_interval'], 2)} |")
+                     f"{iv(r['near_edge'], r['near_edge_interval'])} ({r['edge_chance']:.2f}) | "
+                     + (f"{iv(r['anisotropy_median'], r['anisotropy_median_interval'], 2)} |" if "plane" in name
+                        else "- |"))
     for name, r in rims.items():
         if r["kept"]:
             lines += ["", f"{name}: {r['kept']} kept large events: epicenter on the rupture zone's rim in "
@@ -237,7 +247,9 @@ def main(argv=None):
         rims[f"plane {N} x {M}"] = rim_numbers(N, M, kept)
         partial = [k for k in kept if LARGE_BLOCKS <= (k["slip"] > 0).sum() < N * M]
         if partial:
-            k = max(partial, key=lambda k: k["mu"])
+            # the largest that slips at most half the plane, else the largest that does not slip all of it
+            half = [k for k in partial if (k["slip"] > 0).sum() <= N * M // 2]
+            k = max(half or partial, key=lambda k: k["mu"])
             figure_zone(N, M, k, f"{out}_zone.png", "slip")
             figure_zone(N, M, k, f"{out}_growth.png", "start")
     figure_mu(results, hists, f"{out}_mu.png")
