@@ -1,9 +1,9 @@
 """The plane's events against the claims of the two-dimensional model's paper (docs/plane.md):
 
-    python -m examples.plane.study CATALOG [CATALOG ...] [--histories CATALOG] [-o docs/plane/study]
+    python -m examples.plane.study CATALOG [CATALOG ...] [--histories CATALOG] [--events K] [-o docs/plane/study]
 
 Each CATALOG is one task of a chain or a plane (its *.partial file while its run goes on: the numbers then say how
-many events they rest on). For each, of its inertial events (not its creep episodes):
+many events they rest on). For each, of its inertial events (the creep episodes between them are counted):
 
 - R(mu): the magnitudes in bins of 0.01; the fraction of events that slip every block (a plane's characteristic
   event); Gutenberg-Richter over the best two decades of mu and over the top two decades (KS distance and b,
@@ -194,7 +194,8 @@ def figure_zone(N, M, k, path, what):
 def table(results, rims):
     def iv(v, i, d=3):
         return f"{v:.{d}f} [{i[0]:.{d}f}, {i[1]:.{d}f}]"
-    lines = ["| catalog | events | slip every block | span the fault both ways | best two decades: KS, from mu, b | "
+    lines = ["| catalog | events (creep episodes among them) | slip every block | span the fault both ways | "
+             "best two decades: KS, from mu, b | "
              "top two decades: KS, from mu, b | large: all, own ends, own shape | epicenter at an end along strike | "
              "large events' epicenter near the fault's edge (uniform) | extent along / across (median) |",
              "|---|---|---|---|---|---|---|---|---|---|"]
@@ -203,7 +204,7 @@ def table(results, rims):
 
     for name, r in results.items():
         best, top = r["best_two_decades"], r["top_two_decades"]
-        lines.append(f"| {name} | {r['events']} | {iv(r['whole'], r['whole_interval'])} | "
+        lines.append(f"| {name} | {r['events']} ({r['creep_episodes']}) | {iv(r['whole'], r['whole_interval'])} | "
                      f"{iv(r['spanning'], r['spanning_interval'])} | "
                      f"{decades(best)} | {decades(top)} | "
                      f"{r['large']}, {r['large_own_ends']}, {r['large_own_shape']} | "
@@ -225,6 +226,7 @@ def main(argv=None):
     p.add_argument("--histories", help="a plane's catalog with output.history")
     p.add_argument("-o", "--out", default="docs/plane/study")
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--events", type=int, help="the first this many inertial events of each catalog")
     args = p.parse_args(argv)
     rng = np.random.default_rng(args.seed)
     results, hists = {}, []
@@ -233,10 +235,12 @@ def main(argv=None):
             geometry, N, M = shape(cat.tasks)
             b = float(cat.tasks["b"][0])
             ev = cat.events()
-        inertial = ev["kind"] == KIND_EVENT         # not the creep episodes
+        inertial = np.flatnonzero(ev["kind"] == KIND_EVENT)[:args.events]        # not the creep episodes
+        creep = int(np.sum(ev["kind"][:inertial[-1] + 1] != KIND_EVENT)) if len(inertial) else 0
         ev = {**{k: v[inertial] for k, v in ev.items()}, "N": N}
         name = f"chain N = {N}, b = {b:g}" if geometry == "chain" else f"plane {N} x {M}, b = {b:g}"
         results[name], counts = with_intervals(ev, N * M, rng)
+        results[name]["creep_episodes"] = creep
         hists.append(counts)
         print(f"{path}: {name}, {results[name]['events']} events", flush=True)
     rims = {}
