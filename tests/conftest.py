@@ -262,7 +262,7 @@ def committed(out):
 
 
 def write_config(path, **sections):
-    """A small config file: sections given as dicts override the test defaults."""
+    """A small config file: sections given as dicts override the test defaults (a value None drops the key)."""
     # no integrator key: the law's own method (the aging law's exp4 takes about a fifth of the time of rk4 at
     # dt = 1e-3 for these runs); a test that needs rk4's fixed steps, or long events, says so in `integrator`
     base = {"model": {"N": 60, "b": 20.0}, "run": {"events": 40, "transient": 20, "seeds": 2},
@@ -273,6 +273,8 @@ def write_config(path, **sections):
     for name, values in base.items():
         lines.append(f"[{name}]")
         for k, v in values.items():
+            if v is None:
+                continue
             if isinstance(v, bool):
                 lines.append(f"{k} = {'true' if v else 'false'}")
             elif isinstance(v, str):

@@ -227,6 +227,25 @@ def test_a_plane_runs_on_two_ranks_and_resumes_after_a_kill_to_the_same_catalog(
     np.testing.assert_array_equal(events["boundary"], edge)
 
 
+@pytest.mark.slow
+@pytest.mark.parametrize("law, keys", [("slip", {"a": 1.0, "b": 30.0}),
+                                       ("carlson-langer", {"alpha": 2.5, "sigma": 0.01, "nu": 0.01, "b": None})])
+def test_every_law_runs_on_a_plane_on_two_ranks_to_the_serial_catalog(law, keys, tmp_path):
+    """The slip law (its interior blocks creep before they rupture) and Carlson-Langer's on a 10 x 8 plane:
+    mpiexec -n 2 writes the serial run's catalog (the aging law's: the test above)."""
+    cfg = write_config(tmp_path / "p.toml", model={"geometry": "lattice", "N": 10, "M": 8, "law": law, **keys},
+                       run={"seeds": 2, "events": 100, "transient": 20}, output={"batch": 20})
+    res = run_cli("run", cfg, "-o", tmp_path / "serial.h5", timeout=900)
+    assert res.returncode == 0, res.stderr
+    res = mpirun(2, "run", cfg, "-o", tmp_path / "two.h5")
+    assert res.returncode == 0, res.stderr
+    assert_same_events(tmp_path / "serial.h5", tmp_path / "two.h5")
+    events, tasks, _ = reader.read(tmp_path / "two.h5")
+    assert list(tasks["law"]) == [law] * 2 and len(events["t"]) == 200
+    creep = (events["kind"] == 1).sum()
+    assert creep > 20 if law == "slip" else creep == 0, creep
+
+
 def test_the_analysis_reads_a_plane(plane_run, tmp_path):
     """The analysis takes its distances from the geometry (analysis/geometry.py): a lattice's catalog reduces into
     points that say their shape, and the statistics of chains only say so in one line each."""
