@@ -181,7 +181,8 @@ def main(argv=None):
             p = points[-1]
             print(f"  {s.label} N={N} b={b:g}: " + (f"{p['events_per_second']:.1f} events/s"
                   if p["status"] == "ok" else p["status"]) + f" ({minutes(clock.elapsed)} elapsed)", flush=True)
-    sweeps = [("N", f"b = {args.b_at:g}", [p for p in points if p["b"] == args.b_at and p["N"] in args.Ns]),
+    along = f"side of an N x N plane, b = {args.b_at:g}" if args.plane else f"b = {args.b_at:g}"
+    sweeps = [("N", along, [p for p in points if p["b"] == args.b_at and p["N"] in args.Ns]),
               ("b", f"N = {args.N_at}", [p for p in points if p["N"] == args.N_at and p["b"] in args.bs])]
     sweeps = [sw for sw in sweeps if sw[2]]
     data = {"config": vars(args), "points": points, "wall_seconds": clock.elapsed}

@@ -10,5 +10,7 @@ for name in p32 p64 chain p32_b20; do
 done
 $py -m examples.plane.study "$out/p32.h5" "$out/p64.h5" "$out/chain.h5" "$out/p32_b20.h5" --histories "$out/p64.h5" \
     -o docs/plane/study
-$py -m benchmarks.cost_scaling --plane --runs exp4 --Ns 32 64 128 256 --bs --b-at 40 --events 2000 --budget 300 \
+$py -m benchmarks.cost_scaling --plane --runs exp4 --Ns 32 64 128 --bs --b-at 40 --events 2000 --budget 300 \
     --transient-per-block 0 --min-transient 300 --out benchmarks/results --name plane_cost
+$py -m benchmarks.cost_scaling --plane --runs exp4 --Ns 256 --bs --b-at 40 --events 2000 --budget 300 \
+    --transient-per-block 0 --min-transient 300 --out benchmarks/results --name plane_cost_256
