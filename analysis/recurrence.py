@@ -30,7 +30,8 @@ def scan(t, epicenter, mu, boundary, mu_c, n_along, n_blocks, window, offset, pe
     epicenter: each event's block, at x = epicenter % n_along along strike and y = epicenter // n_along across
     (y 0 on a chain, n_along = N); n_blocks: the task's blocks; window: in blocks. On one row (a chain) the test
     is |dx| <= window, else dx^2 + dy^2 <= window^2 in integers (the same test where dy = 0; the row's own loop,
-    which leaves pending_y alone, keeps a chain's scan as fast as before the plane).
+    which leaves pending_y alone, keeps a chain's scan as fast as before the plane: one loop choosing its test
+    inside took 12 % longer at window 2 over 2e6 events of a chain).
     pending_*: arrays of capacity at least the geometry's packing bound (Shape.pending) holding the pending events
     (time, epicenter x and y, interior flag, index in the task); n_pending their number.
     Event j of the chunk has index offset + j in the task. For every closed
