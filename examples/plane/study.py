@@ -112,6 +112,7 @@ def zones(path):
     """Per kept history of the catalog at `path`: (row, slip at the end, first-slip time per block, epicenter)."""
     with reader.Reader(path) as cat:
         geometry, N, M = shape(cat.tasks)
+        b = float(cat.tasks["b"][0])
         ev = cat.events()
         out = []
         for h in cat.histories(0):
@@ -120,7 +121,7 @@ def zones(path):
             started = np.where(moved.any(axis=0), h["time"][np.argmax(moved, axis=0)], np.nan)
             out.append({"row": int(h["row"]), "slip": slip[-1], "start": started,
                         "epicenter": int(ev["epicenter"][h["row"]]), "mu": float(ev["mu"][h["row"]])})
-    return N, M, out
+    return N, M, b, out
 
 
 def rim(zone, N, M):
@@ -147,42 +148,43 @@ def rim_numbers(N, M, kept):
 
 def figure_mu(results, hists, path):
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(5.2, 3.4))
+    fig, ax = plt.subplots(figsize=(5.2, 4.0))
     centres = (EDGES[:-1] + EDGES[1:]) / 2
     for (name, r), counts, color in zip(results.items(), hists, palette(len(results))):
         width = 10          # bins of 0.1
         c = counts[:len(counts) // width * width].reshape(-1, width).sum(axis=1)
         x = centres[:len(c) * width].reshape(-1, width).mean(axis=1)
-        keep = c > 0
-        ax.plot(x[keep], c[keep] / c.sum() / 0.1, "-", color=color, lw=1,
-                label=f"{name} ({r['events']} events)")
+        # empty bins break the line; a catalog of few events is drawn as points
+        style = dict(ls="-", lw=1) if r["events"] >= 1000 else dict(ls="none", marker="o", ms=3)
+        ax.plot(x, np.where(c > 0, c / c.sum() / 0.1, np.nan), color=color, label=f"{name} ({r['events']} events)",
+                **style)
     ax.set_yscale("log")
     ax.set_xlabel("mu = log10(sum of slips)", fontsize=FONT)
     ax.set_ylabel("R(mu), per unit mu", fontsize=FONT)
     ax.tick_params(labelsize=FONT)
-    ax.legend(fontsize=FONT - 1, frameon=False)
-    ax.set_title("magnitude distribution: planes and the chain at b = 40", fontsize=FONT + 1)
+    ax.legend(fontsize=FONT - 1, frameon=False, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2)
+    ax.set_title("R(mu) in bins of 0.1: l = 3, a = 0, c = 1e3, nu = 1e-8", fontsize=FONT + 1)
     fig.tight_layout()
     save(fig, path)
 
 
-def figure_zone(N, M, k, path, what):
+def figure_zone(N, M, b, k, path, what):
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(5.0, 4.4))
+    fig, ax = plt.subplots(figsize=(5.2, 4.8))
     zone = k["slip"] > 0.0
     if what == "slip":
         data, label = np.where(zone, k["slip"], np.nan), "slip"
-        title = f"rupture zone of an event (mu = {k['mu']:.2f}, {zone.sum()} of {N * M} blocks)"
+        title = f"slip of an event on a {N} x {M} plane, b = {b:g} (mu = {k['mu']:.2f}, {zone.sum()} blocks)"
     else:
         data, label = k["start"], "time since the onset when the block starts to slip"
-        title = "its growth: when each block started to slip"
+        title = f"its growth on the {N} x {M} plane: when each block started to slip"
     image = ax.imshow(data.reshape(M, N), origin="lower", cmap="viridis", interpolation="nearest")
     x, y = k["epicenter"] % N, k["epicenter"] // N
     ax.plot([x], [y], "r*", ms=10, label="epicenter")
     ax.set_xlabel("along strike (block)", fontsize=FONT)
     ax.set_ylabel("across strike (block)", fontsize=FONT)
     ax.tick_params(labelsize=FONT)
-    ax.legend(fontsize=FONT, loc="upper right", framealpha=0.8)
+    ax.legend(fontsize=FONT, loc="upper center", bbox_to_anchor=(0.5, -0.13), frameon=False)
     bar = fig.colorbar(image, ax=ax, shrink=0.85)
     bar.set_label(label, fontsize=FONT)
     bar.ax.tick_params(labelsize=FONT)
@@ -247,15 +249,15 @@ def main(argv=None):
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     if args.histories:
-        N, M, kept = zones(args.histories)
+        N, M, b, kept = zones(args.histories)
         rims[f"plane {N} x {M}"] = rim_numbers(N, M, kept)
         partial = [k for k in kept if LARGE_BLOCKS <= (k["slip"] > 0).sum() < N * M]
         if partial:
             # the largest that slips at most half the plane, else the largest that does not slip all of it
             half = [k for k in partial if (k["slip"] > 0).sum() <= N * M // 2]
             k = max(half or partial, key=lambda k: k["mu"])
-            figure_zone(N, M, k, f"{out}_zone.png", "slip")
-            figure_zone(N, M, k, f"{out}_growth.png", "start")
+            figure_zone(N, M, b, k, f"{out}_zone.png", "slip")
+            figure_zone(N, M, b, k, f"{out}_growth.png", "start")
     figure_mu(results, hists, f"{out}_mu.png")
     Path(f"{out}.json").write_text(json.dumps({"catalogs": args.catalogs, "results": results, "rims": rims},
                                               indent=1, default=float))
