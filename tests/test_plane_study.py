@@ -48,3 +48,21 @@ def test_unilateral_ruptures_and_shapes_count_only_ruptures_bounded_by_their_own
     assert r["whole"] == 0.25 and r["spanning"] == 0.25
     # near the fault's edges (a tenth of 100 along, of 10 across): the third alone (y = 0); uniform chance 0.36
     assert r["near_edge"] == 1 / 3 and r["edge_chance"] == 1 - 0.8 ** 2
+
+
+def test_shapes_by_size_measure_elongation_either_way_and_how_much_of_the_box_slipped():
+    """On a 100 x 100 plane, three bounded ruptures: 20 x 10 blocks full (200 blocks: along / across 2, elongation
+    2, fill 1), 10 x 20 with half its box slipped (100 blocks: 0.5, 2, 0.5) and 40 x 40 with 1000 blocks (1, 1,
+    0.625); their bins of size 100-199, 200-399 and 800-1599; the medians over all three: 1, 2 and 0.625."""
+    N, M = 100, 100
+    ev = {"mu": np.full(3, 4.0), "n_slipped": np.array([200, 100, 1000]), "N": N,
+          "first": np.array([10, 50, 30]), "last": np.array([29, 59, 69]),
+          "across_first": np.array([0, 30, 50]), "across_last": np.array([9, 49, 89]),
+          "epicenter": np.array([10, 50 + 30 * N, 30 + 50 * N])}
+    r = numbers(ev, N * M)
+    assert r["large_own_shape"] == 3
+    assert (r["anisotropy_median"], r["elongation_median"], r["fill_median"]) == (1.0, 2.0, 0.625)
+    s = r["by_size"]
+    assert s["count"] == [1, 1, 0, 1, 0]
+    assert s["along_over_across"][:2] == [0.5, 2.0] and s["elongation"][:2] == [2.0, 2.0]
+    assert s["fill"][0] == 0.5 and s["fill"][3] == 0.625 and np.isnan(s["fill"][2])

@@ -12,9 +12,11 @@ many events they rest on). For each, of its inertial events (the creep episodes 
 - the large events (LARGE_BLOCKS blocks or more): of those that do not run from one end of the fault to the other,
   how often their epicenter lies at an end of the rupture's extent along strike (within a tenth of its length:
   UNILATERAL; a uniformly placed epicenter is there 1 time in 5); of those that span neither the fault's length
-  nor its width, the median of their extent along over across strike (anisotropy); of all of them, how often the
-  epicenter lies near the fault's own edges (within EDGE_BAND of its length of an end, or of its width of an edge),
-  beside a uniformly placed epicenter's chance;
+  nor its width, the median of their extent along over across strike (anisotropy along strike), of the longer
+  extent over the shorter one (elongation, either way) and of the blocks slipped over their bounding box (fill: a
+  disc fills pi / 4 of it, a jagged zone less), overall and in bins of size (blocks slipped, SIZE_BINS); of all
+  of them, how often the epicenter lies near the fault's own edges (within EDGE_BAND of its length of an end, or of
+  its width of an edge), beside a uniformly placed epicenter's chance;
 - intervals: 95 %, over the catalog cut into CHUNKS stretches of consecutive events resampled (a block bootstrap:
   events close in time are not independent).
 
@@ -44,6 +46,7 @@ EDGES = np.round(np.arange(0.0, 9.0 + 1e-9, 0.01), 2)
 LARGE_BLOCKS = 100      # a large event slips at least this many blocks (and not every block)
 UNILATERAL = 0.1        # an epicenter within this fraction of the extent's length from one of its ends
 EDGE_BAND = 0.1         # ... within this fraction of the fault's length (width) from its ends (edges)
+SIZE_BINS = (100, 200, 400, 800, 1600, math.inf)     # blocks slipped: the shape's bins of size
 CHUNKS = 20             # stretches of consecutive events the bootstrap resamples
 RESAMPLES = 400
 LEVEL = 0.95
@@ -74,6 +77,17 @@ def numbers(ev, n_blocks):
     # the epicenter near the fault's own edges: within EDGE_BAND of its length of an end, or of its width of an
     # edge across strike (a plane); a uniformly placed one is there with the chance `edge_chance`
     near = (np.minimum(x, N - 1 - x) < EDGE_BAND * N) | ((M > 1) & (np.minimum(y, M - 1 - y) < EDGE_BAND * M))
+    elongation = np.maximum(length, width) / np.minimum(length, width)
+    fill = slipped / (length * width)
+    bins = np.digitize(slipped, SIZE_BINS) - 1
+
+    def median(values, where):
+        return float(np.median(values[where])) if where.any() else math.nan
+
+    shapes = {"along_over_across": length / width, "elongation": elongation, "fill": fill}
+    by_size = {"count": [int(np.sum(own_shape & (bins == k))) for k in range(len(SIZE_BINS) - 1)],
+               **{key: [median(v, own_shape & (bins == k)) for k in range(len(SIZE_BINS) - 1)]
+                  for key, v in shapes.items()}}
     return {"events": int(len(mu)), "whole": float(np.mean(slipped == n_blocks)),
             "spanning": float(np.mean((length == N) & (width == M))),
             "best_two_decades": dict(zip(("ks", "from_mu", "b"), best)),
@@ -82,8 +96,9 @@ def numbers(ev, n_blocks):
             "unilateral": float(np.mean(at_end[own_ends])) if own_ends.any() else math.nan,
             "near_edge": float(np.mean(near[large])) if large.any() else math.nan,
             "edge_chance": 1 - (1 - 2 * EDGE_BAND) ** (2 if M > 1 else 1),
-            "anisotropy_median": (float(np.median(length[own_shape] / width[own_shape])) if own_shape.any()
-                                  else math.nan)}
+            "anisotropy_median": median(length / width, own_shape),
+            "elongation_median": median(elongation, own_shape), "fill_median": median(fill, own_shape),
+            "by_size": by_size}
 
 
 def with_intervals(ev, n_blocks, rng):
@@ -100,8 +115,12 @@ def with_intervals(ev, n_blocks, rng):
         values = np.array([get(d) for d in draws], dtype=float)
         return [float(v) for v in np.nanpercentile(values, q)] if np.isfinite(values).any() else [math.nan] * 2
 
-    for key in ("whole", "spanning", "unilateral", "near_edge", "anisotropy_median"):
+    for key in ("whole", "spanning", "unilateral", "near_edge", "anisotropy_median", "elongation_median",
+                "fill_median"):
         whole[f"{key}_interval"] = interval(lambda d, key=key: d[key])
+    for key in ("along_over_across", "elongation", "fill"):
+        whole["by_size"][f"{key}_interval"] = [interval(lambda d, key=key, k=k: d["by_size"][key][k])
+                                               for k in range(len(SIZE_BINS) - 1)]
     for key in ("best_two_decades", "top_two_decades"):
         whole[key]["ks_interval"] = interval(lambda d, key=key: d[key]["ks"])
         whole[key]["b_interval"] = interval(lambda d, key=key: d[key]["b"])
@@ -214,6 +233,22 @@ def table(results, rims):
                      f"{iv(r['near_edge'], r['near_edge_interval'])} ({r['edge_chance']:.2f}) | "
                      + (f"{iv(r['anisotropy_median'], r['anisotropy_median_interval'], 2)} |" if "plane" in name
                         else "- |"))
+    lines += ["", "The large events' shapes (those that span neither the fault's length nor its width), by blocks "
+              "slipped:",
+              "", "| catalog | blocks slipped | events | extent along / across | longer / shorter | fill of the "
+              "bounding box |", "|---|---|---|---|---|---|"]
+    for name, r in results.items():
+        if "plane" not in name or not r["large_own_shape"]:
+            continue
+        lines.append(f"| {name} | all | {r['large_own_shape']} | "
+                     + " | ".join(iv(r[f"{key}_median"], r[f"{key}_median_interval"], 2)
+                                  for key in ("anisotropy", "elongation", "fill")) + " |")
+        s = r["by_size"]
+        for k, (lo, hi) in enumerate(zip(SIZE_BINS[:-1], SIZE_BINS[1:])):
+            if s["count"][k]:
+                lines.append(f"| | {lo}-{hi - 1 if math.isfinite(hi) else ''} | {s['count'][k]} | "
+                             + " | ".join(iv(s[key][k], s[f"{key}_interval"][k], 2)
+                                          for key in ("along_over_across", "elongation", "fill")) + " |")
     for name, r in rims.items():
         if r["kept"]:
             lines += ["", f"{name}: {r['kept']} kept large events: epicenter on the rupture zone's rim in "
