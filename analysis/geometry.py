@@ -1,30 +1,32 @@
-"""Where a catalog's blocks lie and how far apart they are, by model.geometry: the analysis' registry of the
-geometries it reads (the kernels' is ensemble/model/geometry/; merge.read refuses a catalog of any other in one
+"""Where a catalog's blocks lie and how far apart they are: the geometries the analysis reads, those of the
+kernels' registry (ensemble/model/geometry/) that declare `grid` (merge.read refuses a catalog of any other in one
 line).
 
 Block i lies at x = i % N along strike and y = i // N across (ensemble/store/schema.py, /events/epicenter): the
 chain is a plane of one row, y = 0. The distance between two blocks is Euclidean in block units,
-sqrt(dx^2 + dy^2), which on the chain is |i - j| exactly. The recurrences' window compares dx^2 + dy^2 with
-window^2 in integers on a plane and |dx| with window on one row; the seismicity keeps the chain's own kernels: a
+sqrt(dx^2 + dy^2), which on one row is |i - j| exactly. The recurrences' window compares dx^2 + dy^2 with
+window^2 in integers on a plane and |dx| with window on one row; the seismicity keeps the row's own kernels: a
 chain's numbers are those of before, bit for bit.
 
-A geometry declares the task columns beyond reduce.PARAMS that tell its points apart (`keys`: two planes of
-other M or l_across never pool) and the most large events that can be pending at once in the recurrence scan,
-each more than `window` blocks from every other (`pending`: the scanner's buffers, analysis/recurrence.py).
+A geometry's points are told apart by the task columns of its [model] keys beyond reduce.PARAMS (Geometry.keys
+of the kernels' registry: two planes of other M or l_across never pool); the most large events that can be
+pending at once in the recurrence scan, each more than `window` blocks from every other, is the packing bound
+of one row or of a plane (Shape.pending: the scanner's buffers, analysis/recurrence.py).
 """
 import math
 import zlib
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
+
+from ensemble.model import geometry as kernel_geometry
 
 CHAIN = "chain"
 
 
-def _chain_pending(N, M, window):
+def _row_pending(N, window):
     """Blocks 0..N-1 pairwise more than `window` apart: gaps of window + 1 at least, so at most
-    (N - 1) // (window + 1) + 1, and N for window 0; today's bound N // window + 4 holds both."""
+    (N - 1) // (window + 1) + 1, and N for window 0; the bound N // window + 4 holds both."""
     return N // max(window, 1) + 4
 
 
@@ -36,15 +38,8 @@ def _plane_pending(N, M, window):
     return -(-N // side) * -(-M // side)
 
 
-@dataclass(frozen=True)
-class Geometry:
-    name: str
-    keys: tuple          # the task columns (of schema.GEOMETRY_TASKS) that tell its points apart
-    pending: Callable    # (N, M, window) -> most blocks pairwise more than window apart
-
-
-GEOMETRIES = {g.name: g for g in (Geometry(CHAIN, (), _chain_pending),
-                                  Geometry("lattice", ("M", "l_across"), _plane_pending))}
+# name -> the kernels' Geometry, of those on the grid
+GEOMETRIES = {name: g for name, g in kernel_geometry.GEOMETRIES.items() if g.grid}
 
 
 @dataclass(frozen=True)
@@ -64,8 +59,14 @@ class Shape:
         block = np.asarray(block, dtype=np.int64)
         return block % self.N, block // self.N
 
+    @property
+    def one_row(self):
+        """Its blocks lie on one row (a chain, or a plane of M = 1): the analysis' row kernels."""
+        return self.M == 1
+
     def pending(self, window):
-        return GEOMETRIES[self.geometry].pending(self.N, self.M, int(window))
+        window = int(window)
+        return _row_pending(self.N, window) if self.one_row else _plane_pending(self.N, self.M, window)
 
 
 def shape(blocks):

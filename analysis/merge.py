@@ -38,7 +38,7 @@ def _known_geometry(path, tasks):
     other = sorted({str(name) for name in tasks["geometry"]} - set(geometry.GEOMETRIES))
     if other:
         raise MergeError(f"{path}: a catalog of model.geometry = {other[0]!r}; the analysis reads "
-                         f"{', '.join(geometry.GEOMETRIES)} (analysis/geometry.py: where its blocks lie)")
+                         f"{', '.join(geometry.GEOMETRIES)} (those on a grid: Geometry.grid, ensemble/model/geometry/)")
 
 
 def _chains_without_geometry(tables):

@@ -135,9 +135,11 @@ def _onsets(paths, tasks):
 def _transient_warnings(paths, discarded, tasks, rows, r):
     out = []
     for g in rows:
-        need, c = MEASURED_TRANSIENT_PER_BLOCK * geometry.task_shape(tasks, g).n_blocks, int(tasks["catalog"][g])
+        shape, c = geometry.task_shape(tasks, g), int(tasks["catalog"][g])
+        need = MEASURED_TRANSIENT_PER_BLOCK * shape.n_blocks
+        size = f"N = {shape.N}" if shape.one_row else f"{shape.N} x {shape.M} blocks"
         if discarded[c] < need:
-            out.append(f"region {r}: {paths[c]} task {tasks['catalog_task'][g]} (N = {tasks['N'][g]}) discarded "
+            out.append(f"region {r}: {paths[c]} task {tasks['catalog_task'][g]} ({size}) discarded "
                        f"{discarded[c]} events before it recorded, fewer than the {need:g} its transient may last "
                        f"({MEASURED_TRANSIENT_PER_BLOCK:g} per block)")
     return out

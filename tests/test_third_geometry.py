@@ -4,7 +4,9 @@ A copy of the package gets one new module, ensemble/model/geometry/ring.py, whic
 springs and positions; geometry/graph.py supplies the rest (forces, energy, clusters and their creep). Nothing else is
 edited; the copy then validates, runs and records `model.geometry = "ring"`. Two exact answers: a ring has no ends,
 so every block is as stiff as the chain's interior ones, and turning its initial state by k blocks turns its whole
-sequence by k blocks (the same onsets, slips and extents, epicenters moved by k), which a chain's ends break.
+sequence by k blocks (the same onsets, slips and extents, epicenters moved by k), which a chain's ends break. The
+analysis refuses the ring's catalog in one line: it reads the geometries on a grid (Geometry.grid), and a ring's
+distances are its own.
 
 Slow by nature (the slower tier, `make slow`, which CI runs): the copy's kernels compile for the new geometry,
 about a minute.
@@ -102,7 +104,7 @@ print(json.dumps(out))
 @pytest.fixture(scope="module")
 def copy_with_a_ring(tmp_path_factory):
     root = tmp_path_factory.mktemp("third_geometry")
-    env = package_copy(root, "ensemble", own_cache=True)
+    env = package_copy(root, "ensemble", "analysis", own_cache=True)
     (root / "ensemble/model/geometry/ring.py").write_text(RING)
     (root / "cfg.toml").write_text('[model]\nN = 40\ngeometry = "ring"\n\n[sweep]\nb = [15.0, 20.0]\n\n'
                                    '[run]\nseeds = 1\nevents = 100\ntransient = 20\n\n[integrator]\nmethod = "exp4"\n')
@@ -130,6 +132,12 @@ def test_a_geometry_in_one_new_module_validates_runs_and_is_recorded(copy_with_a
     # b = 15 below the ring's stiffness 1 + 2 l^2 = 19 everywhere: its blocks creep (the graph's clusters)
     creep = events["kind"] == 1
     assert creep[events["task"] == 0].sum() > 10 and not creep[events["task"] == 1].any()
+    # the analysis reads the geometries on a grid (Geometry.grid); a ring's distances are its own: refused
+    res = run_bounded([sys.executable, "-m", "analysis", "reduce", "ring.h5", "-o", "ring.summary.h5"], 300,
+                      cwd=root, env=env)
+    assert res.returncode == 2 and "ring.h5: a catalog of model.geometry = 'ring'; the analysis reads chain, " \
+        "lattice" in res.stderr, res.stderr
+    assert not (root / "ring.summary.h5").exists()
 
 
 @pytest.mark.slow

@@ -1,5 +1,5 @@
 """How regular the events come: the coefficient of variation of the local recurrence times (< 1
-quasi-periodic, 1 Poisson, > 1 clustered), and the inter-event times of the whole chain (the time from
+quasi-periodic, 1 Poisson, > 1 clustered), and the inter-event times of the whole fault (the time from
 one inertial event's onset to the next's, whatever their size and place) with their mean and CV.
 
 CV = std / mean with the sample standard deviation (n - 1), from additive sums of T and T^2, so that
@@ -41,13 +41,13 @@ def estimate(u, opt):
 
 STATISTIC = Statistic(
     "intervals", 25, needs=("recurrences",),
-    tables=(Table("intervals", "sum or count", "sums of the recurrence times' squares and of the whole chain's "
+    tables=(Table("intervals", "sum or count", "sums of the recurrence times' squares and of the whole fault's "
                                                "inter-event times",
                   columns=("sum_tnu2", "n_gaps", "sum_gap", "sum_gap2")),),
     numbers=(Number("cv_tnu", "1", "coefficient of variation of the local recurrence times T nu "
                                    "(< 1 quasi-periodic, 1 Poisson, > 1 clustered)", "CV of T*nu"),
-             Number("mean_gap", "model length", "mean inter-event time of the whole chain, times nu "
+             Number("mean_gap", "model length", "mean inter-event time of the whole fault, times nu "
                                                 "(onset to the next inertial event's onset)", "mean gap*nu"),
-             Number("cv_gap", "1", "coefficient of variation of the whole chain's inter-event times",
+             Number("cv_gap", "1", "coefficient of variation of the whole fault's inter-event times",
                     "CV of gaps")),
     feed=feed, estimate=estimate, uses_tables=("numbers",))

@@ -18,8 +18,8 @@ edges). A mainshock's exposure is added when its window has been seen to its end
 the task's last inertial event; so it is added once, the same way whatever the chunks. The map is the
 counts over the summed exposures: events per mainshock per block per unit T nu, like the background
 rate: every inertial event after the task's first, over the blocks of the chain (N M of a plane) times the
-task's span. The chain keeps its own kernels (count_pairs, expose), the plane has its own (count_pairs_plane,
-expose_plane): KERNELS, by geometry.
+task's span. One row (a chain) keeps its own kernels (count_pairs, expose), a plane has its own
+(count_pairs_plane, expose_plane): _kernels, by the task's Shape.
 
 The numbers take the cells whose bins lie wholly within a region (options seis_near, seis_ring,
 seis_short, seis_long: put them on the bins' edges): near = distance < seis_near, ring = seis_near <=
@@ -183,17 +183,18 @@ def _plane_expose(T, epicenter, s, start, end, opt, shape, out):
     expose_plane(T, x, y, s, start, end, shape.N, shape.M, opt.seis_time_edges, opt.seis_distance_edges, out)
 
 
-# the kernels of each geometry (analysis/geometry.py): (count the pairs, add the exposures), each taking the
-# epicenters' block indices and the task's Shape
-KERNELS = {"chain": (_chain_pairs, _chain_expose), "lattice": (_plane_pairs, _plane_expose)}
+def _kernels(shape):
+    """(count the pairs, add the exposures) of a task's Shape, each taking the epicenters' block indices and the
+    Shape: one row's own (a chain's numbers as before, bit for bit), else the plane's."""
+    return (_chain_pairs, _chain_expose) if shape.one_row else (_plane_pairs, _plane_expose)
 
 
 def _expose(acc, carry, take, end, opt):
     """Add the exposures of the pending mainshocks `take` (a mask, in time order) with the span ending at `end`,
     one after the other (the sums are the same whatever the chunks)."""
-    KERNELS[carry["shape"].geometry][1](carry["pending_T"][take], carry["pending_x"][take],
-                                        carry["pending_s"][take].astype(np.int64), carry["start"], end, opt,
-                                        carry["shape"], acc["seis_exposure"])
+    _kernels(carry["shape"])[1](carry["pending_T"][take], carry["pending_x"][take],
+                                carry["pending_s"][take].astype(np.int64), carry["start"], end, opt, carry["shape"],
+                                acc["seis_exposure"])
 
 
 def feed(acc, rows):
@@ -210,7 +211,7 @@ def feed(acc, rows):
             "start": T[0], "shape": rows.shape or geometry.shape(rows.n_blocks), "T": T[:0], "x": x[:0],
             "main": main[:0], "s": rows.block[:0],
             "pending_T": T[:0], "pending_x": x[:0], "pending_s": rows.block[:0]}
-    # the background: every event after the task's first closes a gap of the whole chain (or plane)
+    # the background: every event after the task's first closes a gap of the whole fault (chain or plane)
     t = np.concatenate([[rows.t_before], rows.ev["t"]])
     gap = np.diff(t) * rows.nu
     first = 0 if np.isfinite(rows.t_before) else 1
@@ -223,8 +224,8 @@ def feed(acc, rows):
     allx = np.concatenate([carry["x"], x])
     allm = np.concatenate([carry["main"], main])
     alls = np.concatenate([carry["s"], rows.block])
-    KERNELS[carry["shape"].geometry][0](allT, allx, allm, alls.astype(np.int64), n_old, opt, carry["shape"],
-                                        acc["seis_pairs"])
+    _kernels(carry["shape"])[0](allT, allx, allm, alls.astype(np.int64), n_old, opt, carry["shape"],
+                                acc["seis_pairs"])
     keep = allT >= allT[-1] - max(abs(edges[0]), abs(edges[-1]))
     carry.update(T=allT[keep], x=allx[keep], main=allm[keep], s=alls[keep])
     # the exposures: of every mainshock whose window has been seen to its end, in time order
@@ -387,8 +388,8 @@ STATISTIC = Statistic(
                   weights=True),
             Table(NAME, "count or sum", "mainshocks, and the events and block x T nu of the background",
                   columns=("n_main", "n_gaps", "block_span"))),
-    numbers=(Number("background_rate", RATE, "inertial events per block per unit T nu over the whole chain and "
-                                             "task (the events after the task's first over N times its span)",
+    numbers=(Number("background_rate", RATE, "inertial events per block per unit T nu over all the blocks and "
+                                             "task (the events after the task's first over N M blocks times its span)",
                     "background rate"),
              Number("foreshock_rate", RATE, "events per mainshock per block per T nu at distance < seis_near from "
                                             "its epicenter in [-seis_short, 0) before its onset", "foreshock rate"),

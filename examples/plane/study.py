@@ -1,9 +1,10 @@
 """The plane's events against the claims of the two-dimensional model's paper (docs/plane.md):
 
-    python -m examples.plane.study CATALOG [CATALOG ...] [--histories CATALOG] [--events K] [-o docs/plane/study]
+    python -m examples.plane.study CATALOG [CATALOG ...] [--histories CATALOG ...] [--events K] [-o docs/plane/study]
 
 Each CATALOG is one task of a chain or a plane (its *.partial file while its run goes on: the numbers then say how
-many events they rest on). For each, of its inertial events (the creep episodes between them are counted):
+many events they rest on); catalogs of the same shape and b (seeds of one point) pool, one's events after the
+other's. For each, of its inertial events (the creep episodes between them are counted):
 
 - R(mu): the magnitudes in bins of 0.01; the fraction of events that slip every block (a plane's characteristic
   event); Gutenberg-Richter over the best two decades of mu and over the top two decades (KS distance and b,
@@ -20,11 +21,11 @@ many events they rest on). For each, of its inertial events (the creep episodes 
 - intervals: 95 %, over the catalog cut into CHUNKS stretches of consecutive events resampled (a block bootstrap:
   events close in time are not independent).
 
-With --histories (a plane's catalog run with output.history): each kept event's rupture zone (the blocks that
-slipped), whether its epicenter lies on the zone's rim (a slipped block beside one that did not slip or beside
-the plane's edge; against the fraction of the zone's blocks on its rim, what a uniformly placed epicenter gives),
-and two figures of the largest kept event that slips at most half the plane (else the largest that does not slip
-all of it): its slip on the plane and the time each block started to slip (the rupture's growth).
+With --histories (a plane's catalogs run with output.history, one plane and b): each kept event's rupture zone
+(the blocks that slipped), whether its epicenter lies on the zone's rim (a slipped block beside one that did not
+slip or beside the plane's edge; against the fraction of the zone's blocks on its rim, what a uniformly placed
+epicenter gives), and two figures of the largest kept event that slips at most half the plane (else the largest
+that does not slip all of it): its slip on the plane and the time each block started to slip(the rupture's growth).
 
 Writes OUT.json (every number), OUT.md (the table) and OUT_{mu,zone,growth}.png.
 """
@@ -225,7 +226,9 @@ def table(results, rims):
 
     for name, r in results.items():
         best, top = r["best_two_decades"], r["top_two_decades"]
-        lines.append(f"| {name} | {r['events']} ({r['creep_episodes']}) | {iv(r['whole'], r['whole_interval'])} | "
+        seeds = f" ({r['catalogs']} catalogs)" if r.get("catalogs", 1) > 1 else ""
+        lines.append(f"| {name}{seeds} | {r['events']} ({r['creep_episodes']}) | "
+                     f"{iv(r['whole'], r['whole_interval'])} | "
                      f"{iv(r['spanning'], r['spanning_interval'])} | "
                      f"{decades(best)} | {decades(top)} | "
                      f"{r['large']}, {r['large_own_ends']}, {r['large_own_shape']} | "
@@ -260,13 +263,13 @@ def table(results, rims):
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("catalogs", nargs="+")
-    p.add_argument("--histories", help="a plane's catalog with output.history")
+    p.add_argument("--histories", nargs="+", help="a plane's catalogs with output.history (seeds of one point)")
     p.add_argument("-o", "--out", default="docs/plane/study")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--events", type=int, help="the first this many inertial events of each catalog")
     args = p.parse_args(argv)
     rng = np.random.default_rng(args.seed)
-    results, hists = {}, []
+    pooled = {}     # name -> (blocks, [events of each catalog], creep episodes): catalogs of one point pool
     for path in args.catalogs:
         with reader.Reader(path) as cat:
             geometry, N, M = shape(cat.tasks)
@@ -274,17 +277,30 @@ def main(argv=None):
             ev = cat.events()
         inertial = np.flatnonzero(ev["kind"] == KIND_EVENT)[:args.events]        # not the creep episodes
         creep = int(np.sum(ev["kind"][:inertial[-1] + 1] != KIND_EVENT)) if len(inertial) else 0
-        ev = {**{k: v[inertial] for k, v in ev.items()}, "N": N}
         name = f"chain N = {N}, b = {b:g}" if geometry == "chain" else f"plane {N} x {M}, b = {b:g}"
-        results[name], counts = with_intervals(ev, N * M, rng)
-        results[name]["creep_episodes"] = creep
+        blocks, parts, creeps = pooled.setdefault(name, (N * M, [], []))
+        parts.append({**{k: v[inertial] for k, v in ev.items()}, "N": N})
+        creeps.append(creep)
+        print(f"{path}: {name}, {len(inertial)} events", flush=True)
+    results, hists = {}, []
+    for name, (blocks, parts, creeps) in pooled.items():
+        # one catalog's events after another's: the bootstrap's stretches of consecutive events stay within one
+        # catalog but at a seam
+        ev = {k: (np.concatenate([part[k] for part in parts]) if k != "N" else parts[0]["N"]) for k in parts[0]}
+        results[name], counts = with_intervals(ev, blocks, rng)
+        results[name].update(creep_episodes=sum(creeps), catalogs=len(parts))
         hists.append(counts)
-        print(f"{path}: {name}, {results[name]['events']} events", flush=True)
     rims = {}
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     if args.histories:
-        N, M, b, kept = zones(args.histories)
+        shapes, kept = set(), []
+        for path in args.histories:
+            N, M, b, own = zones(path)
+            shapes.add((N, M, b))
+            kept += own
+        if len(shapes) > 1:
+            p.error(f"--histories: catalogs of one plane and b, not {sorted(shapes)}")
         rims[f"plane {N} x {M}"] = rim_numbers(N, M, kept)
         partial = [k for k in kept if LARGE_BLOCKS <= (k["slip"] > 0).sum() < N * M]
         if partial:
@@ -294,8 +310,8 @@ def main(argv=None):
             figure_zone(N, M, b, k, f"{out}_zone.png", "slip")
             figure_zone(N, M, b, k, f"{out}_growth.png", "start")
     figure_mu(results, hists, f"{out}_mu.png")
-    Path(f"{out}.json").write_text(json.dumps({"catalogs": args.catalogs, "results": results, "rims": rims},
-                                              indent=1, default=float))
+    record = {"catalogs": args.catalogs, "histories": args.histories, "results": results, "rims": rims}
+    Path(f"{out}.json").write_text(json.dumps(record, indent=1, default=float))
     text = "\n".join(table(results, rims)) + "\n"
     Path(f"{out}.md").write_text(text)
     sys.stdout.write(text)

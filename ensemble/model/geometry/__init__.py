@@ -66,6 +66,10 @@ class Geometry:
                           # update of the creeping blocks lst[:m] into CR_UPPER (Jacobian diagonal CR_DIAG, residual
                           # CR_RES, J[i, j] = K_ij h_j; pivots into CR_DIAG)
     keys: tuple = ()      # the [model] keys of the geometry's shape it takes (of KEYS: "M", "l_across")
+    grid: bool = False    # block i lies at (i % N, i // N) of an N x M grid with free edges and its distances are
+                          # Euclidean there: the analysis reads its catalogs (analysis/geometry.py); a geometry
+                          # whose distances differ (a ring's ends joined) leaves it False, and the analysis
+                          # refuses its catalogs in one line
 
     def kernel_params(self, model):
         """The geometry's record for the kernels from a config's model section."""

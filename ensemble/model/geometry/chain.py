@@ -213,4 +213,4 @@ def _record(model):
 
 GEOMETRY = Geometry("chain", ChainParams, _record, spring_force, spring_force_at, neighbours, around, stiffness,
                     coupling, along, across, drop_stiffness, spring_energy, max_stiffness, cluster, stable,
-                    fastest_creep, creep_force, creep_load, creep_solve)
+                    fastest_creep, creep_force, creep_load, creep_solve, grid=True)

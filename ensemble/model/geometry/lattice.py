@@ -216,4 +216,4 @@ GEOMETRY = graph.geometry("lattice", LatticeParams, _record, neighbours=neighbou
                           spring_force=spring_force, spring_force_at=spring_force_at, drop_stiffness=drop_stiffness,
                           spring_energy=spring_energy, stable=stable, fastest_creep=fastest_creep,
                           creep_force=creep_force, creep_load=creep_load, creep_solve=creep_solve,
-                          keys=("M", "l_across"))
+                          keys=("M", "l_across"), grid=True)
