@@ -1,7 +1,7 @@
 """examples/plane/study.py's measures of a plane's events (docs/plane.md) on hand-built events with known answers."""
 import numpy as np
 
-from examples.plane.study import numbers, rim, rim_numbers
+from examples.plane.study import boundary, numbers, past_rims, rim, rim_numbers
 
 
 def test_the_rim_of_a_rupture_zone_is_its_blocks_beside_another_or_beside_the_edge():
@@ -66,3 +66,24 @@ def test_shapes_by_size_measure_elongation_either_way_and_how_much_of_the_box_sl
     assert s["count"] == [1, 1, 0, 1, 0]
     assert s["along_over_across"][:2] == [0.5, 2.0] and s["elongation"][:2] == [2.0, 2.0]
     assert s["fill"][0] == 0.5 and s["fill"][3] == 0.625 and np.isnan(s["fill"][2])
+
+
+def test_an_epicenter_next_to_a_past_zones_edge_against_the_other_epicenters():
+    """On a 10 x 10 plane: the boundary of a 4 x 4 zone inside it is its 12 outer blocks and the 16 outside them;
+    of a zone against the plane's edge, the blocks on either side of its one inner edge. Three kept events: A (the
+    4 x 4 zone, epicenter in its middle), B (the whole plane, epicenter on A's edge) and C (epicenter in the far
+    corner): B is next to A's edge, C is not (B's zone is the whole plane: no edge); against the others'
+    epicenters: none next to A's edge for B, B's own for C (one of two)."""
+    N = M = 10
+    zone = np.zeros((M, N), bool)
+    zone[2:6, 2:6] = True
+    assert boundary(zone.ravel(), N, M).sum() == 28
+    edge = np.zeros((M, N), bool)
+    edge[:, :3] = True
+    b = boundary(edge.ravel(), N, M).reshape(M, N)
+    assert b.sum() == 20 and b[:, 2].all() and b[:, 3].all() and not b[:, 0].any()
+    kept = [{"slip": zone.ravel() * 1.0, "epicenter": 3 * N + 3},
+            {"slip": np.ones(N * M), "epicenter": 2 * N + 6},        # (x 6, y 2): just outside A
+            {"slip": np.ones(N * M), "epicenter": 9 * N + 9}]
+    hits, chance = past_rims(N, M, kept)
+    assert hits == [True, False] and chance == [0.0, 0.5]

@@ -48,6 +48,7 @@ LARGE_BLOCKS = 100      # a large event slips at least this many blocks (and not
 UNILATERAL = 0.1        # an epicenter within this fraction of the extent's length from one of its ends
 EDGE_BAND = 0.1         # ... within this fraction of the fault's length (width) from its ends (edges)
 SIZE_BINS = (100, 200, 400, 800, 1600, math.inf)     # blocks slipped: the shape's bins of size
+PAST = 10               # an epicenter next to the zones of this many kept events before it
 CHUNKS = 20             # stretches of consecutive events the bootstrap resamples
 RESAMPLES = 400
 LEVEL = 0.95
@@ -166,6 +167,44 @@ def rim_numbers(N, M, kept):
     return {"kept": len(rows), "epicenter_on_rim": float(at.mean()), "rim_share_of_zone": float(share.mean())}
 
 
+def boundary(zone, N, M):
+    """The blocks next to the zone's edge inside the plane (bool, N x M as rows of N): the zone's blocks with a
+    neighbour outside it and the blocks outside with a neighbour in it; the plane's own edge is no boundary."""
+    z = zone.reshape(M, N)
+    padded = np.pad(z, 1, mode="edge")          # beyond the plane's edge: the edge block itself
+    around = [padded[:-2, 1:-1], padded[2:, 1:-1], padded[1:-1, :-2], padded[1:-1, 2:]]
+    differs = np.zeros_like(z)
+    for other in around:
+        differs |= other != z
+    return differs.ravel()
+
+
+def past_rims(N, M, kept, past=PAST):
+    """How often a kept event's epicenter lies next to the edge of one of the `past` kept events before it (in one
+    catalog's order: the first events of mu >= history_mu, consecutive), zones that slip the whole plane left out;
+    against the same for the other kept events' epicenters (where events start, whenever they do)."""
+    hits, chance = [], []
+    epicenters = np.array([k["epicenter"] for k in kept])
+    for i in range(1, len(kept)):
+        band = np.zeros(N * M, bool)
+        for k in kept[max(0, i - past):i]:
+            zone = k["slip"] > 0.0
+            if not zone.all():
+                band |= boundary(zone, N, M)
+        if not band.any():
+            continue
+        hits.append(band[epicenters[i]])
+        chance.append(band[np.delete(epicenters, i)].mean())
+    return hits, chance
+
+
+def wilson(k, n, z=1.96):
+    """The 95 % Wilson interval of a fraction k / n."""
+    f, d = k / n, 1 + z * z / n
+    centre, half = (f + z * z / (2 * n)) / d, z * math.sqrt(f * (1 - f) / n + z * z / (4 * n * n)) / d
+    return [centre - half, centre + half]
+
+
 def figure_mu(results, hists, path):
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(5.2, 4.0))
@@ -257,6 +296,11 @@ def table(results, rims):
             lines += ["", f"{name}: {r['kept']} kept large events: epicenter on the rupture zone's rim in "
                           f"{r['epicenter_on_rim']:.2f} of them; the rim holds {r['rim_share_of_zone']:.2f} of a "
                           f"zone's blocks (a uniformly placed epicenter's chance)"]
+        if r.get("past_rim_events"):
+            near = iv(r["next_to_past_rim"], r["next_to_past_rim_interval"], 2)
+            lines += ["", f"{name}: {r['past_rim_events']} kept events after another: epicenter next to the edge of "
+                          f"one of the {PAST} kept events' zones before it in {near} of them; the other kept "
+                          f"events' epicenters are there in {r['next_to_past_rim_chance']:.2f}"]
     return lines
 
 
@@ -294,14 +338,20 @@ def main(argv=None):
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     if args.histories:
-        shapes, kept = set(), []
+        shapes, kept, hits, chance = set(), [], [], []
         for path in args.histories:
             N, M, b, own = zones(path)
             shapes.add((N, M, b))
             kept += own
+            h, c = past_rims(N, M, own)
+            hits += h
+            chance += c
         if len(shapes) > 1:
             p.error(f"--histories: catalogs of one plane and b, not {sorted(shapes)}")
-        rims[f"plane {N} x {M}"] = rim_numbers(N, M, kept)
+        rims[f"plane {N} x {M}"] = {**rim_numbers(N, M, kept), "past_rim_events": len(hits),
+                                    "next_to_past_rim": float(np.mean(hits)) if hits else math.nan,
+                                    "next_to_past_rim_interval": wilson(sum(hits), len(hits)) if hits else None,
+                                    "next_to_past_rim_chance": float(np.mean(chance)) if hits else math.nan}
         partial = [k for k in kept if LARGE_BLOCKS <= (k["slip"] > 0).sum() < N * M]
         if partial:
             # the largest that slips at most half the plane, else the largest that does not slip all of it
