@@ -37,6 +37,7 @@ os.environ["PATH"] = os.path.dirname(sys.executable) + os.pathsep + os.environ.g
 # that every name exists and that every test file is here or in NOT_QUICK, with the reason.
 QUICK = {
     "test_plane_study.py": ["test_an_epicenter_on_the_rim_against_its_share_of_the_zone"],
+    "test_example_configs.py": ["test_the_examples_hold_configs", "test_an_example_config_loads"],
     "test_creep.py": ["test_a_cluster_too_soft_to_creep_hands_over_to_an_event",
                       "test_above_the_block_stiffness_nothing_creeps"],
     "test_intervals.py": ["test_every_statistic_is_the_same_whatever_the_chunks"],
