@@ -36,11 +36,11 @@ def test_unilateral_ruptures_and_shapes_count_only_ruptures_bounded_by_their_own
     """On a 100 x 10 plane: a rupture over x 10..59 from x = 12 (within a tenth of its length of an end), one over
     20..69 from x = 45 (in the middle), one over the whole length (not counted: its ends are the fault's), and a
     small one (below LARGE_BLOCKS); the shape's extent along over across strike of the first alone, 50 / 5 (the
-    second spans the plane's width)."""
+    second reaches the plane's sides)."""
     N, M = 100, 10
     ev = {"mu": np.array([4.0, 4.0, 5.0, 1.0]), "n_slipped": np.array([250, 500, 1000, 1]), "N": N,
           "first": np.array([10, 20, 0, 3]), "last": np.array([59, 69, 99, 3]),
-          "across_first": np.array([0, 0, 0, 0]), "across_last": np.array([4, 9, 9, 0]),
+          "across_first": np.array([1, 0, 0, 0]), "across_last": np.array([5, 9, 9, 0]),
           "epicenter": np.array([12 + N * 2, 45 + N * 5, 50, 3])}
     r = numbers(ev, N * M)
     assert (r["large"], r["large_own_ends"], r["large_own_shape"]) == (3, 2, 1)
@@ -53,12 +53,13 @@ def test_unilateral_ruptures_and_shapes_count_only_ruptures_bounded_by_their_own
 def test_shapes_by_size_measure_elongation_either_way_and_how_much_of_the_box_slipped():
     """On a 100 x 100 plane, three bounded ruptures: 20 x 10 blocks full (200 blocks: along / across 2, elongation
     2, fill 1), 10 x 20 with half its box slipped (100 blocks: 0.5, 2, 0.5) and 40 x 40 with 1000 blocks (1, 1,
-    0.625); their bins of size 100-199, 200-399 and 800-1599; the medians over all three: 1, 2 and 0.625."""
+    0.625); their bins of size 100-199, 200-399 and 800-1599; the medians over all three: 1, 2 and 0.625. A
+    fourth, 30 x 10 from the plane's end along strike (its shape cut by the edge), is left out."""
     N, M = 100, 100
-    ev = {"mu": np.full(3, 4.0), "n_slipped": np.array([200, 100, 1000]), "N": N,
-          "first": np.array([10, 50, 30]), "last": np.array([29, 59, 69]),
-          "across_first": np.array([0, 30, 50]), "across_last": np.array([9, 49, 89]),
-          "epicenter": np.array([10, 50 + 30 * N, 30 + 50 * N])}
+    ev = {"mu": np.full(4, 4.0), "n_slipped": np.array([200, 100, 1000, 300]), "N": N,
+          "first": np.array([10, 50, 30, 0]), "last": np.array([29, 59, 69, 29]),
+          "across_first": np.array([1, 30, 50, 60]), "across_last": np.array([10, 49, 89, 69]),
+          "epicenter": np.array([10, 50 + 30 * N, 30 + 50 * N, 60 * N])}
     r = numbers(ev, N * M)
     assert r["large_own_shape"] == 3
     assert (r["anisotropy_median"], r["elongation_median"], r["fill_median"]) == (1.0, 2.0, 0.625)

@@ -12,10 +12,11 @@ other's. For each, of its inertial events (the creep episodes between them are c
 - the fraction of events that slip every block, and of those whose extent spans the fault both ways;
 - the large events (LARGE_BLOCKS blocks or more): of those that do not run from one end of the fault to the other,
   how often their epicenter lies at an end of the rupture's extent along strike (within a tenth of its length:
-  UNILATERAL; a uniformly placed epicenter is there 1 time in 5); of those that span neither the fault's length
-  nor its width, the median of their extent along over across strike (anisotropy along strike), of the longer
-  extent over the shorter one (elongation, either way) and of the blocks slipped over their bounding box (fill: a
-  disc fills pi / 4 of it, a jagged zone less), overall and in bins of size (blocks slipped, SIZE_BINS); of all
+  UNILATERAL; a uniformly placed epicenter is there 1 time in 5); of those that reach none of the fault's edges
+  (a shape the edges did not cut), the median of their extent along over across strike (anisotropy along
+  strike), of the longer extent over the shorter one (elongation, either way) and of the blocks slipped over their
+  bounding box (fill: a disc fills pi / 4 of it, a jagged zone less), overall and in bins of size (blocks slipped,
+  SIZE_BINS); of all
   of them, how often the epicenter lies near the fault's own edges (within EDGE_BAND of its length of an end, or of
   its width of an edge), beside a uniformly placed epicenter's chance;
 - intervals: 95 %, over the catalog cut into CHUNKS stretches of consecutive events resampled (a block bootstrap:
@@ -71,9 +72,11 @@ def numbers(ev, n_blocks):
     width = ev["across_last"] - ev["across_first"] + 1
     large = slipped >= LARGE_BLOCKS
     # the ends along strike are the rupture's own where it does not run from one end of the fault to the other;
-    # its shape is its own where it spans neither the fault's length nor (on a plane) its width
+    # its shape is its own where it reaches none of the fault's edges (ends and, on a plane, sides)
     own_ends = large & (length < N)
-    own_shape = own_ends & ((width < M) | (M == 1))
+    own_shape = large & (ev["first"] > 0) & (ev["last"] < N - 1)
+    if M > 1:
+        own_shape &= (ev["across_first"] > 0) & (ev["across_last"] < M - 1)
     x, y = ev["epicenter"] % N, ev["epicenter"] // N
     at_end = np.minimum(x - ev["first"], ev["last"] - x) <= UNILATERAL * np.maximum(length - 1, 1)
     # the epicenter near the fault's own edges: within EDGE_BAND of its length of an end, or of its width of an
@@ -275,7 +278,7 @@ def table(results, rims):
                      f"{iv(r['near_edge'], r['near_edge_interval'])} ({r['edge_chance']:.2f}) | "
                      + (f"{iv(r['anisotropy_median'], r['anisotropy_median_interval'], 2)} |" if "plane" in name
                         else "- |"))
-    lines += ["", "The large events' shapes (those that span neither the fault's length nor its width), by blocks "
+    lines += ["", "The large events' shapes (those that reach none of the fault's edges), by blocks "
               "slipped:",
               "", "| catalog | blocks slipped | events | extent along / across | longer / shorter | fill of the "
               "bounding box |", "|---|---|---|---|---|---|"]
