@@ -16,9 +16,8 @@ other's. For each, of its inertial events (the creep episodes between them are c
   (a shape the edges did not cut), the median of their extent along over across strike (anisotropy along
   strike), of the longer extent over the shorter one (elongation, either way) and of the blocks slipped over their
   bounding box (fill: a disc fills pi / 4 of it, a jagged zone less), overall and in bins of size (blocks slipped,
-  SIZE_BINS); of all
-  of them, how often the epicenter lies near the fault's own edges (within EDGE_BAND of its length of an end, or of
-  its width of an edge), beside a uniformly placed epicenter's chance;
+  SIZE_BINS); of all of them, how often the epicenter lies near the fault's own edges (within EDGE_BAND of its
+  length of an end, or of its width of an edge), beside a uniformly placed epicenter's chance;
 - intervals: 95 %, over the catalog cut into CHUNKS stretches of consecutive events resampled (a block bootstrap:
   events close in time are not independent).
 
