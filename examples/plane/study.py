@@ -1,10 +1,11 @@
 """The plane's events against the claims of the two-dimensional model's paper (docs/plane.md):
 
-    python -m examples.plane.study CATALOG [CATALOG ...] [--histories CATALOG ...] [--events K] [-o docs/plane/study]
+    python -m examples.plane.study CATALOG[@K] [...] [--histories CATALOG ...] [--events K] [-o docs/plane/study]
 
 Each CATALOG is one task of a chain or a plane (its *.partial file while its run goes on: the numbers then say how
-many events they rest on); catalogs of the same shape and b (seeds of one point) pool, one's events after the
-other's. For each, of its inertial events (the creep episodes between them are counted):
+many events they rest on; CATALOG@K: its first K inertial events, --events K: of every catalog); catalogs of the
+same shape and b (seeds of one point) pool, one's events after the other's. For each, of its inertial events (the
+creep episodes between them are counted):
 
 - R(mu): the magnitudes in bins of 0.01; the fraction of events that slip every block (a plane's characteristic
   event); Gutenberg-Richter over the best two decades of mu and over the top two decades (KS distance and b,
@@ -316,12 +317,14 @@ def main(argv=None):
     args = p.parse_args(argv)
     rng = np.random.default_rng(args.seed)
     pooled = {}     # name -> (blocks, [events of each catalog], creep episodes): catalogs of one point pool
-    for path in args.catalogs:
+    for given in args.catalogs:
+        path, _, first = given.rpartition("@") if "@" in given else (given, "", "")
+        limit = int(first) if first else args.events
         with reader.Reader(path) as cat:
             geometry, N, M = shape(cat.tasks)
             b = float(cat.tasks["b"][0])
             ev = cat.events()
-        inertial = np.flatnonzero(ev["kind"] == KIND_EVENT)[:args.events]        # not the creep episodes
+        inertial = np.flatnonzero(ev["kind"] == KIND_EVENT)[:limit]        # not the creep episodes
         creep = int(np.sum(ev["kind"][:inertial[-1] + 1] != KIND_EVENT)) if len(inertial) else 0
         name = f"chain N = {N}, b = {b:g}" if geometry == "chain" else f"plane {N} x {M}, b = {b:g}"
         blocks, parts, creeps = pooled.setdefault(name, (N * M, [], []))
