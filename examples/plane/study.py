@@ -167,7 +167,8 @@ def rim_numbers(N, M, kept):
     if not rows:
         return {"kept": 0}
     at, share = np.array(rows).T
-    return {"kept": len(rows), "epicenter_on_rim": float(at.mean()), "rim_share_of_zone": float(share.mean())}
+    return {"kept": len(rows), "epicenter_on_rim": float(at.mean()),
+            "epicenter_on_rim_interval": wilson(int(at.sum()), len(rows)), "rim_share_of_zone": float(share.mean())}
 
 
 def boundary(zone, N, M):
@@ -296,8 +297,9 @@ def table(results, rims):
                                           for key in ("along_over_across", "elongation", "fill")) + " |")
     for name, r in rims.items():
         if r["kept"]:
+            on_rim = iv(r["epicenter_on_rim"], r["epicenter_on_rim_interval"], 2)
             lines += ["", f"{name}: {r['kept']} kept large events: epicenter on the rupture zone's rim in "
-                          f"{r['epicenter_on_rim']:.2f} of them; the rim holds {r['rim_share_of_zone']:.2f} of a "
+                          f"{on_rim} of them; the rim holds {r['rim_share_of_zone']:.2f} of a "
                           f"zone's blocks (a uniformly placed epicenter's chance)"]
         if r.get("past_rim_events"):
             near = iv(r["next_to_past_rim"], r["next_to_past_rim_interval"], 2)
