@@ -13,6 +13,7 @@ The run: a plane of 8 x 6 blocks at b = 30 (l = 3), l_across 2 and 3: two points
 (at 3 its interior blocks, 1 + 2 l^2 + 2 l_across^2 = 37 > b, creep; at 2, 27, none do), two seeds of 300 rows
 each, the history of one event per task (about 10 s); and a chain of 8 blocks of the same parameters.
 """
+import json
 import math
 import sys
 
@@ -253,3 +254,20 @@ def test_a_geometry_the_analysis_does_not_know_is_refused_in_one_line():
         merge._known_geometry("ring.h5", {"geometry": np.array(["chain", "ring"])})
     assert "\n" not in str(err.value) and "model.geometry = 'ring'" in str(err.value) and "ring.h5" in str(err.value)
     assert refusal(next(st for st in LAYOUT.statistics if st.name == "slow_slip"), "chain") == ""
+
+
+def test_the_plane_study_pools_the_seeds_of_each_point(plane, tmp_path):
+    """`python -m examples.plane.study` on the plane's catalog (two values of l_across, two seeds each): a point per
+    l_across, each the inertial events of its two tasks, its creep episodes counted apart."""
+    from examples.plane import study
+    _, catalog = plane
+    study.main([str(catalog), "-o", str(tmp_path / "study")])
+    results = json.loads((tmp_path / "study.json").read_text())["results"]
+    events, tasks, _ = reader.read(catalog)
+    assert len(results) == 2
+    for l_across in (2.0, 3.0):
+        mine = np.isin(events["task"], np.flatnonzero(tasks["l_across"] == l_across))
+        name = f"plane {N} x {M}, b = 30" + (", l_across = 2" if l_across == 2.0 else "")
+        r = results[name]
+        assert r["seeds"] == 2 and r["events"] == np.sum(mine & (events["kind"] == 0)) > 100
+        assert r["creep_episodes"] <= np.sum(mine & (events["kind"] != 0))

@@ -2,10 +2,11 @@
 
     python -m examples.plane.study CATALOG[@K] [...] [--histories CATALOG ...] [--events K] [-o docs/plane/study]
 
-Each CATALOG is one task of a chain or a plane (its *.partial file while its run goes on: the numbers then say how
-many events they rest on; CATALOG@K: its first K inertial events, --events K: of every catalog); catalogs of the
-same shape and b (seeds of one point) pool, one's events after the other's. For each, of its inertial events (the
-creep episodes between them are counted):
+Each CATALOG holds tasks of a chain or a plane (its *.partial file while its run goes on: the numbers then say how
+many events they rest on; CATALOG@K: the first K inertial events of each of its tasks, --events K: of every
+catalog's); tasks of the same shape and b (seeds of one point, in one catalog or several) pool, one's events after
+the other's (a plane's l_across, where it is not l, tells its points apart too). For each, of its inertial events
+(the creep episodes between them are counted):
 
 - R(mu): the magnitudes in bins of 0.01; the fraction of events that slip every block (a plane's characteristic
   event); Gutenberg-Richter over the best two decades of mu and over the top two decades (KS distance and b,
@@ -22,11 +23,12 @@ creep episodes between them are counted):
 - intervals: 95 %, over the catalog cut into CHUNKS stretches of consecutive events resampled (a block bootstrap:
   events close in time are not independent).
 
-With --histories (a plane's catalogs run with output.history, one plane and b): each kept event's rupture zone
-(the blocks that slipped), whether its epicenter lies on the zone's rim (a slipped block beside one that did not
-slip or beside the plane's edge; against the fraction of the zone's blocks on its rim, what a uniformly placed
-epicenter gives), and two figures of the largest kept event that slips at most half the plane (else the largest
-that does not slip all of it): its slip on the plane and the time each block started to slip(the rupture's growth).
+With --histories (a plane's catalogs run with output.history, one plane and b; the histories of each catalog's
+first task): each kept event's rupture zone (the blocks that slipped), whether its epicenter lies on the zone's
+rim (a slipped block beside one that did not slip or beside the plane's edge; against the fraction of the zone's
+blocks on its rim, what a uniformly placed epicenter gives), and two figures of the largest kept event that slips
+at most half the plane (else the largest that does not slip all of it): its slip on the plane and the time each
+block started to slip (the rupture's growth).
 
 Writes OUT.json (every number), OUT.md (the table) and OUT_{mu,zone,growth}.png.
 """
@@ -55,11 +57,11 @@ RESAMPLES = 400
 LEVEL = 0.95
 
 
-def shape(tasks):
-    """(geometry, N, M) of a catalog's single task."""
-    geometry = tasks["geometry"][0]
+def shape(tasks, k=0):
+    """(geometry, N, M) of a catalog's task k."""
+    geometry = tasks["geometry"][k]
     geometry = geometry.decode() if isinstance(geometry, bytes) else str(geometry)
-    return geometry, int(tasks["N"][0]), int(tasks["M"][0])
+    return geometry, int(tasks["N"][k]), int(tasks["M"][k])
 
 
 def numbers(ev, n_blocks):
@@ -269,7 +271,7 @@ def table(results, rims):
 
     for name, r in results.items():
         best, top = r["best_two_decades"], r["top_two_decades"]
-        seeds = f" ({r['catalogs']} catalogs)" if r.get("catalogs", 1) > 1 else ""
+        seeds = f" ({r['seeds']} seeds)" if r.get("seeds", 1) > 1 else ""
         lines.append(f"| {name}{seeds} | {r['events']} ({r['creep_episodes']}) | "
                      f"{iv(r['whole'], r['whole_interval'])} | "
                      f"{iv(r['spanning'], r['spanning_interval'])} | "
@@ -318,28 +320,34 @@ def main(argv=None):
     p.add_argument("--events", type=int, help="the first this many inertial events of each catalog")
     args = p.parse_args(argv)
     rng = np.random.default_rng(args.seed)
-    pooled = {}     # name -> (blocks, [events of each catalog], creep episodes): catalogs of one point pool
+    pooled = {}     # name -> (blocks, [events of each task], creep episodes): the tasks (seeds) of one point pool
     for given in args.catalogs:
         path, _, first = given.rpartition("@") if "@" in given else (given, "", "")
         limit = int(first) if first else args.events
         with reader.Reader(path) as cat:
-            geometry, N, M = shape(cat.tasks)
-            b = float(cat.tasks["b"][0])
-            ev = cat.events()
-        inertial = np.flatnonzero(ev["kind"] == KIND_EVENT)[:limit]        # not the creep episodes
-        creep = int(np.sum(ev["kind"][:inertial[-1] + 1] != KIND_EVENT)) if len(inertial) else 0
-        name = f"chain N = {N}, b = {b:g}" if geometry == "chain" else f"plane {N} x {M}, b = {b:g}"
-        blocks, parts, creeps = pooled.setdefault(name, (N * M, [], []))
-        parts.append({**{k: v[inertial] for k, v in ev.items()}, "N": N})
-        creeps.append(creep)
-        print(f"{path}: {name}, {len(inertial)} events", flush=True)
+            tasks, every = cat.tasks, cat.events()
+        for task in range(len(tasks["N"])):
+            geometry, N, M = shape(tasks, task)
+            b = float(tasks["b"][task])
+            ev = {k: v[every["task"] == task] for k, v in every.items()}
+            inertial = np.flatnonzero(ev["kind"] == KIND_EVENT)[:limit]        # not the creep episodes
+            creep = int(np.sum(ev["kind"][:inertial[-1] + 1] != KIND_EVENT)) if len(inertial) else 0
+            name = f"chain N = {N}, b = {b:g}" if geometry == "chain" else f"plane {N} x {M}, b = {b:g}"
+            if geometry != "chain" and tasks["l_across"][task] != tasks["l"][task]:
+                name += f", l_across = {tasks['l_across'][task]:g}"
+            print(f"{path} task {task}: {name}, {len(inertial)} events", flush=True)
+            if not len(inertial):       # (a partial catalog's task still in its transient)
+                continue
+            blocks, parts, creeps = pooled.setdefault(name, (N * M, [], []))
+            parts.append({**{k: v[inertial] for k, v in ev.items()}, "N": N})
+            creeps.append(creep)
     results, hists = {}, []
     for name, (blocks, parts, creeps) in pooled.items():
-        # one catalog's events after another's: the bootstrap's stretches of consecutive events stay within one
-        # catalog but at a seam
+        # one task's events after another's: the bootstrap's stretches of consecutive events stay within one task
+        # but at a seam
         ev = {k: (np.concatenate([part[k] for part in parts]) if k != "N" else parts[0]["N"]) for k in parts[0]}
         results[name], counts = with_intervals(ev, blocks, rng)
-        results[name].update(creep_episodes=sum(creeps), catalogs=len(parts))
+        results[name].update(creep_episodes=sum(creeps), seeds=len(parts))
         hists.append(counts)
     rims = {}
     out = Path(args.out)
