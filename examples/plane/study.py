@@ -41,6 +41,7 @@ from pathlib import Path
 import numpy as np
 
 from analysis.drawing import FONT, palette, save
+from analysis.stats import percentile_interval
 from ensemble.model.workspace import KIND_EVENT
 from ensemble.store import reader
 
@@ -116,11 +117,9 @@ def with_intervals(ev, n_blocks, rng):
     for _ in range(RESAMPLES):
         pick = np.concatenate([cuts[k] for k in rng.integers(0, CHUNKS, CHUNKS)])
         draws.append(numbers({k: v[pick] if np.ndim(v) else v for k, v in ev.items()}, n_blocks))
-    q = [(1 - LEVEL) / 2 * 100, (1 + LEVEL) / 2 * 100]
 
     def interval(get):
-        values = np.array([get(d) for d in draws], dtype=float)
-        return [float(v) for v in np.nanpercentile(values, q)] if np.isfinite(values).any() else [math.nan] * 2
+        return [float(v) for v in percentile_interval(np.array([get(d) for d in draws], dtype=float), LEVEL)]
 
     for key in ("whole", "spanning", "unilateral", "near_edge", "anisotropy_median", "elongation_median",
                 "fill_median"):
