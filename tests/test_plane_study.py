@@ -1,7 +1,7 @@
 """examples/plane/study.py's measures of a plane's events (docs/plane.md) on hand-built events with known answers."""
 import numpy as np
 
-from examples.plane.study import boundary, numbers, past_rims, rim, rim_numbers
+from examples.plane.study import CHUNKS, boundary, numbers, past_rims, rim, rim_numbers, stretches
 
 
 def test_the_rim_of_a_rupture_zone_is_its_blocks_beside_another_or_beside_the_edge():
@@ -89,3 +89,13 @@ def test_an_epicenter_next_to_a_past_zones_edge_against_the_other_epicenters():
             {"slip": np.ones(N * M), "epicenter": 9 * N + 9}]
     hits, chance = past_rims(N, M, kept)
     assert hits == [True, False] and chance == [0.0, 0.5]
+
+
+def test_the_bootstraps_stretches_of_pooled_seeds_never_span_the_seam():
+    """Seeds of 31 and 9 events (a seam at 30 | 31 where 20 equal stretches would cut 30, 31 together): 16 stretches
+    of the first, 4 of the second, every event once, in order; one seed alone: CHUNKS stretches."""
+    cuts = stretches([31, 9])
+    assert len(cuts) == CHUNKS and np.array_equal(np.concatenate(cuts), np.arange(40))
+    assert all(c.max() < 31 or c.min() >= 31 for c in cuts)
+    assert sum(c.max() < 31 for c in cuts) == 16
+    assert len(stretches([1000])) == CHUNKS

@@ -109,13 +109,24 @@ def numbers(ev, n_blocks):
             "by_size": by_size}
 
 
-def with_intervals(ev, n_blocks, rng):
-    """numbers() of all the events, each number with its block-bootstrap interval."""
+def stretches(lengths):
+    """The bootstrap's stretches of consecutive events (index arrays) of seeds of these lengths, one after another:
+    about CHUNKS in all, each seed cut into its share of them (at least one), none across the seam of two seeds."""
+    starts = np.cumsum([0] + list(lengths))
+    return [cut for s, n in zip(starts, lengths)
+            for cut in np.array_split(np.arange(s, s + n), max(1, round(CHUNKS * n / starts[-1])))]
+
+
+def with_intervals(ev, n_blocks, rng, lengths=None):
+    """numbers() of all the events, each number with its block-bootstrap interval.
+
+    lengths: the events of each seed, one seed's after another's (default: one seed). Each seed is cut into its
+    share of the CHUNKS stretches, so that no stretch spans the seam between two seeds."""
     whole = numbers(ev, n_blocks)
-    cuts = np.array_split(np.arange(len(ev["mu"])), CHUNKS)
+    cuts = stretches(lengths or [len(ev["mu"])])
     draws = []
     for _ in range(RESAMPLES):
-        pick = np.concatenate([cuts[k] for k in rng.integers(0, CHUNKS, CHUNKS)])
+        pick = np.concatenate([cuts[k] for k in rng.integers(0, len(cuts), len(cuts))])
         draws.append(numbers({k: v[pick] if np.ndim(v) else v for k, v in ev.items()}, n_blocks))
 
     def interval(get):
@@ -240,8 +251,8 @@ def figure_zone(N, M, b, k, path, what):
         data, label = np.where(zone, k["slip"], np.nan), "slip"
         title = f"slip of an event on a {N} x {M} plane, b = {b:g} (mu = {k['mu']:.2f}, {zone.sum()} blocks)"
     else:
-        data, label = k["start"], "time since the onset when the block starts to slip"
-        title = f"its growth on the {N} x {M} plane: when each block started to slip"
+        data, label = k["start"], "model time since the onset when the block starts to slip"
+        title = f"its growth on the {N} x {M} plane, b = {b:g}: when each block started to slip"
     image = ax.imshow(data.reshape(M, N), origin="lower", cmap="viridis", interpolation="nearest")
     x, y = k["epicenter"] % N, k["epicenter"] // N
     ax.plot([x], [y], "r*", ms=10, label="epicenter")
@@ -343,9 +354,8 @@ def main(argv=None):
     results, hists = {}, []
     for name, (blocks, parts, creeps) in pooled.items():
         # one task's events after another's: the bootstrap's stretches of consecutive events stay within one task
-        # but at a seam
         ev = {k: (np.concatenate([part[k] for part in parts]) if k != "N" else parts[0]["N"]) for k in parts[0]}
-        results[name], counts = with_intervals(ev, blocks, rng)
+        results[name], counts = with_intervals(ev, blocks, rng, [len(part["mu"]) for part in parts])
         results[name].update(creep_episodes=sum(creeps), seeds=len(parts))
         hists.append(counts)
     rims = {}
