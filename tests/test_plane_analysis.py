@@ -261,9 +261,13 @@ def test_the_plane_study_pools_the_seeds_of_each_point(plane, tmp_path):
     l_across, each the inertial events of its two tasks, its creep episodes counted apart."""
     from examples.plane import study
     _, catalog = plane
-    study.main([str(catalog), "-o", str(tmp_path / "study")])
-    results = json.loads((tmp_path / "study.json").read_text())["results"]
+    study.main([str(catalog), "--histories", str(catalog), "-o", str(tmp_path / "study")])
+    record = json.loads((tmp_path / "study.json").read_text())
+    results = record["results"]
     events, tasks, _ = reader.read(catalog)
+    with reader.Reader(catalog) as cat:
+        kept = [len(cat.histories(task)) for task in range(len(tasks["N"]))]
+    assert sum(kept) > 0, kept
     assert len(results) == 2
     for l_across in (2.0, 3.0):
         mine = np.isin(events["task"], np.flatnonzero(tasks["l_across"] == l_across))
@@ -271,3 +275,10 @@ def test_the_plane_study_pools_the_seeds_of_each_point(plane, tmp_path):
         r = results[name]
         assert r["seeds"] == 2 and r["events"] == np.sum(mine & (events["kind"] == 0)) > 100
         assert r["creep_episodes"] <= np.sum(mine & (events["kind"] != 0))
+        # the histories of every task of the point, pooled under the point's name
+        seeds = [k for k in np.flatnonzero(tasks["l_across"] == l_across) if kept[k]]
+        if seeds:
+            rims = record["rims"][name]
+            assert (rims["seeds"], rims["histories"]) == (len(seeds), sum(kept[k] for k in seeds))
+    assert len(record["rims"]) == sum(1 for v in (2.0, 3.0) if any(kept[k] for k in np.flatnonzero(
+        tasks["l_across"] == v)))

@@ -23,10 +23,11 @@ the other's (a plane's l_across, where it is not l, tells its points apart too).
 - intervals: 95 %, over the catalog cut into CHUNKS stretches of consecutive events resampled (a block bootstrap:
   events close in time are not independent).
 
-With --histories (a plane's catalogs run with output.history, one plane and b; the histories of each catalog's
-first task): each kept event's rupture zone (the blocks that slipped), whether its epicenter lies on the zone's
+With --histories (catalogs of planes run with output.history; the histories of every task, pooled by plane and
+b): each kept event's rupture zone (the blocks that slipped), whether its epicenter lies on the zone's
 rim (a slipped block beside one that did not slip or beside the plane's edge; against the fraction of the zone's
-blocks on its rim, what a uniformly placed epicenter gives), and two figures of the largest kept event that slips
+blocks on its rim, what a uniformly placed epicenter gives), whether it lies next to the edge of one of the PAST
+kept zones of its seed before it, and, of the first plane given, two figures of the largest kept event that slips
 at most half the plane (else the largest that does not slip all of it): its slip on the plane and the time each
 block started to slip (the rupture's growth).
 
@@ -144,20 +145,35 @@ def with_intervals(ev, n_blocks, rng, lengths=None):
     return whole, np.histogram(ev["mu"], EDGES)[0]
 
 
+def point_name(tasks, task):
+    """The name of a task's point, which its seeds share: geometry, size, b and (on a plane, if not l) l_across."""
+    geometry, N, M = shape(tasks, task)
+    b = float(tasks["b"][task])
+    name = f"chain N = {N}, b = {b:g}" if geometry == "chain" else f"plane {N} x {M}, b = {b:g}"
+    if geometry != "chain" and tasks["l_across"][task] != tasks["l"][task]:
+        name += f", l_across = {tasks['l_across'][task]:g}"
+    return name
+
+
 def zones(path):
-    """Per kept history of the catalog at `path`: (row, slip at the end, first-slip time per block, epicenter)."""
+    """Per task of the catalog at `path` that kept histories: (its point's name, N, M, b, its kept events in order:
+    row, slip at the end, first-slip time per block, epicenter, mu)."""
     with reader.Reader(path) as cat:
-        geometry, N, M = shape(cat.tasks)
-        b = float(cat.tasks["b"][0])
-        ev = cat.events()
+        every = cat.events()
         out = []
-        for h in cat.histories(0):
-            slip = h["slip"]
-            moved = slip > 0.0
-            started = np.where(moved.any(axis=0), h["time"][np.argmax(moved, axis=0)], np.nan)
-            out.append({"row": int(h["row"]), "slip": slip[-1], "start": started,
-                        "epicenter": int(ev["epicenter"][h["row"]]), "mu": float(ev["mu"][h["row"]])})
-    return N, M, b, out
+        for task in range(len(cat.tasks["N"])):
+            _, N, M = shape(cat.tasks, task)
+            ev = {k: every[k][every["task"] == task] for k in ("epicenter", "mu")}
+            kept = []
+            for h in cat.histories(task):
+                slip = h["slip"]
+                moved = slip > 0.0
+                started = np.where(moved.any(axis=0), h["time"][np.argmax(moved, axis=0)], np.nan)
+                kept.append({"row": int(h["row"]), "slip": slip[-1], "start": started,
+                             "epicenter": int(ev["epicenter"][h["row"]]), "mu": float(ev["mu"][h["row"]])})
+            if kept:
+                out.append((point_name(cat.tasks, task), N, M, float(cat.tasks["b"][task]), kept))
+    return out
 
 
 def rim(zone, N, M):
@@ -324,7 +340,7 @@ def table(results, rims):
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("catalogs", nargs="+")
-    p.add_argument("--histories", nargs="+", help="a plane's catalogs with output.history (seeds of one point)")
+    p.add_argument("--histories", nargs="+", help="catalogs of planes with output.history (figures: the first plane)")
     p.add_argument("-o", "--out", default="docs/plane/study")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--events", type=int, help="the first this many inertial events of each catalog")
@@ -337,14 +353,11 @@ def main(argv=None):
         with reader.Reader(path) as cat:
             tasks, every = cat.tasks, cat.events()
         for task in range(len(tasks["N"])):
-            geometry, N, M = shape(tasks, task)
-            b = float(tasks["b"][task])
+            _, N, M = shape(tasks, task)
             ev = {k: v[every["task"] == task] for k, v in every.items()}
             inertial = np.flatnonzero(ev["kind"] == KIND_EVENT)[:limit]        # not the creep episodes
             creep = int(np.sum(ev["kind"][:inertial[-1] + 1] != KIND_EVENT)) if len(inertial) else 0
-            name = f"chain N = {N}, b = {b:g}" if geometry == "chain" else f"plane {N} x {M}, b = {b:g}"
-            if geometry != "chain" and tasks["l_across"][task] != tasks["l"][task]:
-                name += f", l_across = {tasks['l_across'][task]:g}"
+            name = point_name(tasks, task)
             print(f"{path} task {task}: {name}, {len(inertial)} events", flush=True)
             if not len(inertial):       # (a partial catalog's task still in its transient)
                 continue
@@ -361,22 +374,25 @@ def main(argv=None):
     rims = {}
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    if args.histories:
-        shapes, kept, hits, chance = set(), [], [], []
-        for path in args.histories:
-            N, M, b, own = zones(path)
-            shapes.add((N, M, b))
-            kept += own
+    planes = {}     # point -> (N, M, b, the kept events of each of its tasks (seeds) with histories)
+    for path in args.histories or ():
+        for name, N, M, b, own in zones(path):
+            planes.setdefault(name, (N, M, b, []))[3].append(own)
+    for name, (N, M, b, seeds) in planes.items():
+        hits, chance = [], []
+        for own in seeds:       # a past zone is one of the same seed's
             h, c = past_rims(N, M, own)
             hits += h
             chance += c
-        if len(shapes) > 1:
-            p.error(f"--histories: catalogs of one plane and b, not {sorted(shapes)}")
-        rims[f"plane {N} x {M}"] = {**rim_numbers(N, M, kept), "past_rim_events": len(hits),
-                                    "next_to_past_rim": float(np.mean(hits)) if hits else math.nan,
-                                    "next_to_past_rim_interval": wilson(sum(hits), len(hits)) if hits else None,
-                                    "next_to_past_rim_chance": float(np.mean(chance)) if hits else math.nan}
-        partial = [k for k in kept if LARGE_BLOCKS <= (k["slip"] > 0).sum() < N * M]
+        rims[name] = {
+            **rim_numbers(N, M, [k for own in seeds for k in own]), "seeds": len(seeds),
+            "histories": sum(map(len, seeds)), "past_rim_events": len(hits),
+            "next_to_past_rim": float(np.mean(hits)) if hits else math.nan,
+            "next_to_past_rim_interval": wilson(sum(hits), len(hits)) if hits else None,
+            "next_to_past_rim_chance": float(np.mean(chance)) if hits else math.nan}
+    if planes:      # the figures: the first plane given
+        N, M, b, seeds = next(iter(planes.values()))
+        partial = [k for own in seeds for k in own if LARGE_BLOCKS <= (k["slip"] > 0).sum() < N * M]
         if partial:
             # the largest that slips at most half the plane, else the largest that does not slip all of it
             half = [k for k in partial if (k["slip"] > 0).sum() <= N * M // 2]
