@@ -99,3 +99,19 @@ def test_the_bootstraps_stretches_of_pooled_seeds_never_span_the_seam():
     assert all(c.max() < 31 or c.min() >= 31 for c in cuts)
     assert sum(c.max() < 31 for c in cuts) == 16
     assert len(stretches([1000])) == CHUNKS
+
+
+def test_an_epicenter_at_a_side_of_its_ruptures_box_against_the_boxs_share():
+    """On a 100 x 100 plane, three bounded ruptures of 21 x 11 blocks (a band of 3 columns at either end along, of 2
+    rows at either side across): epicenters at the box's left side, at its top side and in its middle: two of three
+    at a side, where the box's share is 1 - (1 - 6 / 21) (1 - 4 / 11); a rupture touching the plane's edge is left
+    out."""
+    N = M = 100
+    first, across_first = np.array([10, 40, 60, 0]), np.array([10, 30, 60, 5])
+    x = first + np.array([2, 10, 10, 1])            # 2 from the left end (<= 0.1 * 20), the middle, the middle
+    y = across_first + np.array([5, 9, 5, 1])       # the middle, 1 from the top (<= 0.1 * 10), the middle
+    ev = {"mu": np.full(4, 4.0), "n_slipped": np.full(4, 231), "N": N, "first": first, "last": first + 20,
+          "across_first": across_first, "across_last": across_first + 10, "epicenter": x + N * y}
+    r = numbers(ev, N * M)
+    assert r["large_own_shape"] == 3 and r["box_side"] == 2 / 3
+    assert abs(r["box_side_chance"] - (1 - (1 - 6 / 21) * (1 - 4 / 11))) < 1e-12

@@ -15,7 +15,9 @@ the other's (a plane's l_across, where it is not l, tells its points apart too).
 - the large events (LARGE_BLOCKS blocks or more): of those that do not run from one end of the fault to the other,
   how often their epicenter lies at an end of the rupture's extent along strike (within a tenth of its length:
   UNILATERAL; a uniformly placed epicenter is there 1 time in 5); of those that reach none of the fault's edges
-  (a shape the edges did not cut), the median of their extent along over across strike (anisotropy along
+  (a shape the edges did not cut), how often their epicenter lies at a side of their bounding box (within a tenth
+  of its extent of one of its four sides; against the fraction of the box's blocks that are), the median of their
+  extent along over across strike (anisotropy along
   strike), of the longer extent over the shorter one (elongation, either way) and of the blocks slipped over their
   bounding box (fill: a disc fills pi / 4 of it, a jagged zone less), overall and in bins of size (blocks slipped,
   SIZE_BINS); of all of them, how often the epicenter lies near the fault's own edges (within EDGE_BAND of its
@@ -83,6 +85,12 @@ def numbers(ev, n_blocks):
         own_shape &= (ev["across_first"] > 0) & (ev["across_last"] < M - 1)
     x, y = ev["epicenter"] % N, ev["epicenter"] // N
     at_end = np.minimum(x - ev["first"], ev["last"] - x) <= UNILATERAL * np.maximum(length - 1, 1)
+    # on a plane, at a side of its bounding box (within a tenth of its extent of one of its four sides), against
+    # the fraction of the box's blocks that are (a uniformly placed epicenter's chance)
+    at_side = at_end | (np.minimum(y - ev["across_first"], ev["across_last"] - y)
+                        <= UNILATERAL * np.maximum(width - 1, 1))
+    band = [np.minimum(n, 2 * (np.floor(UNILATERAL * np.maximum(n - 1, 1)) + 1)) / n for n in (length, width)]
+    side_chance = 1 - (1 - band[0]) * (1 - band[1])
     # the epicenter near the fault's own edges: within EDGE_BAND of its length of an end, or of its width of an
     # edge across strike (a plane); a uniformly placed one is there with the chance `edge_chance`
     near = (np.minimum(x, N - 1 - x) < EDGE_BAND * N) | ((M > 1) & (np.minimum(y, M - 1 - y) < EDGE_BAND * M))
@@ -103,6 +111,8 @@ def numbers(ev, n_blocks):
             "top_two_decades": dict(zip(("ks", "from_mu", "b"), top)),
             "large": int(large.sum()), "large_own_ends": int(own_ends.sum()), "large_own_shape": int(own_shape.sum()),
             "unilateral": float(np.mean(at_end[own_ends])) if own_ends.any() else math.nan,
+            "box_side": float(np.mean(at_side[own_shape])) if own_shape.any() else math.nan,
+            "box_side_chance": float(np.mean(side_chance[own_shape])) if own_shape.any() else math.nan,
             "near_edge": float(np.mean(near[large])) if large.any() else math.nan,
             "edge_chance": 1 - (1 - 2 * EDGE_BAND) ** (2 if M > 1 else 1),
             "anisotropy_median": median(length / width, own_shape),
@@ -133,7 +143,7 @@ def with_intervals(ev, n_blocks, rng, lengths=None):
     def interval(get):
         return [float(v) for v in percentile_interval(np.array([get(d) for d in draws], dtype=float), LEVEL)]
 
-    for key in ("whole", "spanning", "unilateral", "near_edge", "anisotropy_median", "elongation_median",
+    for key in ("whole", "spanning", "unilateral", "box_side", "near_edge", "anisotropy_median", "elongation_median",
                 "fill_median"):
         whole[f"{key}_interval"] = interval(lambda d, key=key: d[key])
     for key in ("along_over_across", "elongation", "fill"):
@@ -323,6 +333,12 @@ def table(results, rims):
                 lines.append(f"| | {lo}-{hi - 1 if math.isfinite(hi) else ''} | {s['count'][k]} | "
                              + " | ".join(iv(s[key][k], s[f"{key}_interval"][k], 2)
                                           for key in ("along_over_across", "elongation", "fill")) + " |")
+    for name, r in results.items():
+        if "plane" in name and r["large_own_shape"]:
+            lines += ["", f"{name}: of the {r['large_own_shape']} large events that reach none of the fault's edges, "
+                          f"epicenter within a tenth of its extent of a side of the rupture's bounding box in "
+                          f"{iv(r['box_side'], r['box_side_interval'], 2)}; a uniformly placed epicenter: "
+                          f"{r['box_side_chance']:.2f}"]
     for name, r in rims.items():
         if r["kept"]:
             on_rim = iv(r["epicenter_on_rim"], r["epicenter_on_rim_interval"], 2)
